@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Idempotent set-up: installs the Debian packages that are missing, then
+# configures and builds posebench (Release) into build/.
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$ROOT"
+
+PACKAGES=(build-essential cmake pkg-config ccache libpcl-dev libeigen3-dev libosmesa6-dev
+          libassimp-dev nlohmann-json3-dev libyaml-cpp-dev libbenchmark-dev libgtest-dev
+          libpng-dev libcli11-dev python3 python3-matplotlib)
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}"
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+export CCACHE_BASEDIR="$ROOT"
+export CCACHE_DIR="${CCACHE_DIR:-$HOME/.cache/ccache}"
+# A PCL-heavy translation unit takes about 2 GB and a minute: at most one
+# job per core.
+JOBS="${POSEBENCH_BUILD_JOBS:-$(nproc)}"
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release ${POSEBENCH_CMAKE_ARGS:-} >/dev/null
+cmake --build build -j "$JOBS"

@@ -1,0 +1,110 @@
+#include "core/yaml.h"
+
+#include <fstream>
+#include <sstream>
+
+namespace pb {
+
+YamlNode YamlNode::load_file(const std::string& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file, "", "cannot open file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return load_string(ss.str(), file);
+}
+
+YamlNode YamlNode::load_string(const std::string& text, const std::string& name) {
+  try {
+    YAML::Node n = YAML::Load(text);
+    if (!n.IsDefined() || n.IsNull()) n = YAML::Node(YAML::NodeType::Map);
+    return YamlNode(n, name);
+  } catch (const YAML::Exception& e) {
+    throw InputError(name, "", "malformed YAML at line " + std::to_string(e.mark.line + 1) +
+                                   ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
+  }
+}
+
+bool YamlNode::has(const std::string& key) const {
+  return node_.IsMap() && node_[key].IsDefined() && !node_[key].IsNull();
+}
+
+YamlNode YamlNode::operator[](const std::string& key) const {
+  const std::string p = path_.empty() ? key : path_ + "." + key;
+  if (!node_.IsMap()) return YamlNode(YAML::Node(), file_, p);
+  return YamlNode(node_[key], file_, p);
+}
+
+YamlNode YamlNode::at(size_t i) const {
+  const std::string p = path_ + "[" + std::to_string(i) + "]";
+  if (!node_.IsSequence() || i >= node_.size()) fail("index " + std::to_string(i) + " out of range");
+  return YamlNode(node_[i], file_, p);
+}
+
+size_t YamlNode::size() const { return node_.IsSequence() || node_.IsMap() ? node_.size() : 0; }
+
+std::vector<std::string> YamlNode::keys() const {
+  std::vector<std::string> k;
+  if (node_.IsMap())
+    for (const auto& kv : node_) k.push_back(kv.first.as<std::string>());
+  return k;
+}
+
+void YamlNode::check_keys(const std::set<std::string>& allowed) const {
+  if (!defined()) return;
+  if (!node_.IsMap()) fail("expected a mapping");
+  for (const auto& kv : node_) {
+    const std::string key = kv.first.as<std::string>();
+    if (!allowed.count(key)) {
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      const std::string p = path_.empty() ? key : path_ + "." + key;
+      throw InputError(file_, p,
+                       "unknown key at line " + std::to_string(kv.first.Mark().line + 1) +
+                           " (allowed: " + list + ")");
+    }
+  }
+}
+
+void YamlNode::fail(const std::string& what) const {
+  std::string w = what;
+  if (node_.IsDefined() && node_.Mark().line >= 0) w += " (line " + std::to_string(line()) + ")";
+  throw InputError(file_, path_, w);
+}
+
+template <typename T>
+T YamlNode::as() const {
+  if (!node_.IsDefined() || node_.IsNull()) fail("missing value");
+  try {
+    return node_.as<T>();
+  } catch (const YAML::Exception&) {
+    fail("wrong type or malformed value '" + (node_.IsScalar() ? node_.Scalar() : std::string("<non-scalar>")) + "'");
+  }
+}
+
+template int YamlNode::as<int>() const;
+template unsigned YamlNode::as<unsigned>() const;
+template long YamlNode::as<long>() const;
+template unsigned long YamlNode::as<unsigned long>() const;
+template long long YamlNode::as<long long>() const;
+template unsigned long long YamlNode::as<unsigned long long>() const;
+template double YamlNode::as<double>() const;
+template float YamlNode::as<float>() const;
+template bool YamlNode::as<bool>() const;
+template std::string YamlNode::as<std::string>() const;
+template std::vector<double> YamlNode::as<std::vector<double>>() const;
+template std::vector<int> YamlNode::as<std::vector<int>>() const;
+template std::vector<std::string> YamlNode::as<std::vector<std::string>>() const;
+
+double YamlNode::get_positive(const std::string& key, double fallback) const {
+  const double v = get_or<double>(key, fallback);
+  if (!(v > 0)) (*this)[key].fail("must be positive, got " + std::to_string(v));
+  return v;
+}
+
+double YamlNode::get_nonnegative(const std::string& key, double fallback) const {
+  const double v = get_or<double>(key, fallback);
+  if (!(v >= 0)) (*this)[key].fail("must be non-negative, got " + std::to_string(v));
+  return v;
+}
+
+}  // namespace pb

@@ -1,0 +1,95 @@
+// The BOP dataset layout (../shared/reference/bop_datasets_format.md): one
+// reader for datasets written by posebench's generator and for real BOP
+// datasets, and the writer the generator uses.
+#pragma once
+
+#include <array>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/types.h"
+
+namespace pb {
+
+struct ContinuousSymmetry {
+  Vec3 axis = Vec3::UnitZ();    // unit axis in the model frame
+  Vec3 offset = Vec3::Zero();   // a point on the axis (mm)
+};
+
+// One entry of models/models_info.json.
+struct ModelInfo {
+  int obj_id = 0;
+  std::string name;            // posebench extension ("name"); empty in real BOP sets
+  double diameter = 0;         // mm, largest vertex-to-vertex distance
+  Vec3 min = Vec3::Zero();     // bounding box min (min_x, min_y, min_z)
+  Vec3 size = Vec3::Zero();    // bounding box size (size_x, ...)
+  std::vector<Mat4> symmetries_discrete;  // 4x4, translation in mm
+  std::vector<ContinuousSymmetry> symmetries_continuous;
+};
+
+// One ground-truth object instance in an image (scene_gt.json).
+struct GtObject {
+  int obj_id = 0;
+  Pose T_cam_model;  // cam_R_m2c, cam_t_m2c
+};
+
+// Per ground truth statistics (scene_gt_info.json).
+struct GtInfo {
+  std::array<int, 4> bbox_obj{{-1, -1, 0, 0}};    // x, y, w, h
+  std::array<int, 4> bbox_visib{{-1, -1, 0, 0}};
+  int px_count_all = 0;
+  int px_count_valid = 0;
+  int px_count_visib = 0;
+  double visib_fract = 0;
+};
+
+struct ImageInfo {
+  int im_id = 0;
+  Intrinsics K;
+  double depth_scale = 1.0;         // depth_png * depth_scale = mm
+  std::vector<GtObject> gt;         // may be empty (no ground truth)
+  std::vector<GtInfo> gt_info;      // empty or parallel to gt
+};
+
+struct SceneInfo {
+  int scene_id = 0;
+  std::map<int, ImageInfo> images;  // by im_id
+};
+
+// Read access to a dataset root (DIR with models/ and SPLIT/ folders).
+class BopDataset {
+ public:
+  // Throws InputError naming the path if it is not a BOP dataset
+  // (no models/models_info.json or no split folder).
+  explicit BopDataset(std::string root);
+
+  const std::string& root() const { return root_; }
+  std::vector<std::string> splits() const;
+  std::vector<int> scene_ids(const std::string& split) const;
+  SceneInfo load_scene(const std::string& split, int scene_id) const;
+  DepthImage load_depth(const std::string& split, int scene_id, const ImageInfo& im) const;
+  const std::map<int, ModelInfo>& models() const { return models_; }
+  const ModelInfo& model_info(int obj_id) const;        // InputError if unknown
+  int resolve_object(const std::string& name_or_id) const;  // "3", "obj_000003" or a name
+  Mesh load_model(int obj_id) const;                     // models/obj_XXXXXX.ply (mm)
+  std::string model_path(int obj_id) const;
+
+ private:
+  std::string root_;
+  std::map<int, ModelInfo> models_;
+};
+
+// Writing a dataset. Each JSON file is written atomically (temp + rename).
+std::map<int, ModelInfo> read_models_info(const std::string& path);
+void write_models_info(const std::string& path, const std::map<int, ModelInfo>& models);
+void write_camera_json(const std::string& path, const Intrinsics& K, double depth_scale);
+// Writes scene_camera.json, scene_gt.json and scene_gt_info.json of a scene
+// folder from its images.
+void write_scene_json(const std::string& scene_dir, const SceneInfo& scene);
+SceneInfo read_scene_json(const std::string& scene_dir);
+
+std::string bop_id(int id);  // 6 digits: 000042
+
+}  // namespace pb

@@ -1,0 +1,43 @@
+// PCL-free point sets passed between recognition stages. Stage
+// implementations convert to PCL types inside their .cpp files.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/types.h"
+
+namespace pb {
+
+// An unorganized cloud with normals (mm). `pixel` keeps the link to the
+// organized source image (index v * width + u, or -1), so later stages can
+// exploit the organized structure.
+struct PointSet {
+  std::vector<Vec3f> points;
+  std::vector<Vec3f> normals;    // unit, oriented toward the viewpoint; may be empty
+  std::vector<float> curvature;  // surface variation; may be empty
+  std::vector<int> pixel;        // may be empty
+  int source_width = 0, source_height = 0;
+
+  size_t size() const { return points.size(); }
+  bool empty() const { return points.empty(); }
+  bool has_normals() const { return normals.size() == points.size() && !points.empty(); }
+};
+
+// A pose hypothesis for the object in the scene.
+struct Hypothesis {
+  Pose T_cam_model;      // model -> scene camera
+  int view = -1;         // training view it came from (-1: none)
+  double score = 0;      // method-specific (votes, 1/histogram distance, ...), higher is better
+  int inliers = 0;       // set by verification
+  double fitness = 0;    // mean squared inlier distance after refinement (mm^2)
+  bool refined = false;
+};
+
+// Seconds per stage of one recognition call.
+struct StageTimes {
+  double preprocess = 0, describe = 0, match = 0, group = 0, initial_pose = 0, refine = 0, verify = 0;
+  double total() const { return preprocess + describe + match + group + initial_pose + refine + verify; }
+};
+
+}  // namespace pb
