@@ -1,0 +1,27 @@
+// Global pipeline settings (CVFH, ESF, CESF, OUR-CVFH, CRH). THESIS.md
+// "Global pipeline".
+#pragma once
+
+#include "core/yaml.h"
+
+namespace pb {
+
+struct GlobalSettings {
+  double cluster_tolerance_mm = 20.0;   // Euclidean cluster extraction distance
+  int cluster_min_points = 50;          // smaller scene clusters are ignored
+  int cluster_max_points = 100000;
+  double cvfh_eps_angle_deg = 7.5;      // smooth region growing: normal angle threshold (t_n)
+  double cvfh_curvature_threshold = 0.025;  // high-curvature points removed before growing
+  double cvfh_cluster_tolerance_mm = 15.0;  // region growing distance threshold (t_d)
+  int cvfh_min_region_points = 20;      // "sufficiently large" stable region (also CESF)
+  int esf_samples = 20000;              // ESF random triples (PCL's value)
+  int top_k = 5;                        // hypotheses passed to refinement (thesis: 5)
+  int crh_bins = 90;                    // CRH bins (4 degrees)
+  double crh_peak_threshold = 0.3;      // distinct CRH peaks above this fraction of the max
+  int crh_max_peaks = 3;                // at most this many roll hypotheses per match
+  bool skip_crh = false;                // assume the object upright: roll from the view (Table 4.4)
+};
+
+void parse_global(const YamlNode& node, GlobalSettings& s);
+
+}  // namespace pb

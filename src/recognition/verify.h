@@ -1,0 +1,40 @@
+// Verification: the hypothesis with the most inliers wins (thesis 3.1). An
+// inlier is a model point whose nearest scene point is within a threshold.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "core/types.h"
+#include "core/yaml.h"
+#include "recognition/cloud.h"
+
+namespace pb {
+
+struct VerifySettings {
+  double inlier_threshold_mm = 10.0;  // model point -> nearest scene point distance
+};
+
+void parse_verify(const YamlNode& node, VerifySettings& s);
+
+// A kd-tree over 3D points (PCL inside), for nearest neighbour queries.
+class PointIndex {
+ public:
+  explicit PointIndex(const std::vector<Vec3f>& points);
+  ~PointIndex();
+  // Index of the nearest point and its squared distance; -1 if empty.
+  int nearest(const Vec3f& q, float* sq_dist = nullptr) const;
+  std::vector<int> radius(const Vec3f& q, float r) const;
+  size_t size() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Number of model points (model frame) that, mapped by T_cam_model, have a
+// scene point within the threshold.
+int count_inliers(const std::vector<Vec3f>& model_points, const Pose& T_cam_model,
+                  const PointIndex& scene, double threshold_mm);
+
+}  // namespace pb
