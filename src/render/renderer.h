@@ -2,6 +2,16 @@
 // linearized to millimetres). Camera: OpenCV convention, pixel centres at
 // integer coordinates, row 0 at the top; depth exactly consistent with
 // Intrinsics::backproject.
+//
+// How: the projection matrix maps OpenCV camera coordinates straight to clip
+// space (x_ndc = (2 fx X/Z + 2 cx + 1)/W - 1, y flipped, w = Z), so pixel
+// (u, v) is sampled at its centre. Each triangle is drawn flat-shaded with a
+// unique 32-bit id in the RGBA colour buffer; the depth test decides
+// visibility. Per pixel the id gives the item (label) and the face; with
+// exact_depth the depth is the intersection of the pixel's ray with that
+// face's plane in double precision (no depth-buffer quantization at any
+// distance), otherwise the 24-bit buffer linearized by
+// z = 2fn / ((f+n) - z_ndc (f-n)). Normals come from the same face plane.
 #pragma once
 
 #include <cstdint>
@@ -21,8 +31,9 @@ struct RenderItem {
 struct RenderOutput {
   DepthImage depth;             // mm, 0 where nothing was drawn
   std::vector<int32_t> labels;  // per pixel the label of the visible item, -1 none
-  // Per pixel surface normal in the camera frame (unit), zero where empty;
-  // filled only when requested (used by sensor noise models).
+  // Per pixel surface normal in the camera frame (unit, oriented towards the
+  // camera: n . ray < 0), zero where empty; filled only when requested (used
+  // by sensor noise models).
   std::vector<Vec3f> normals;
 };
 
@@ -30,6 +41,10 @@ struct RenderSettings {
   double near_mm = 50.0;     // near clipping plane
   double far_mm = 20000.0;   // far clipping plane
   bool normals = false;      // also compute per pixel normals
+  // Depth from the visible face's plane intersected with the pixel ray
+  // (double precision, exact at any distance); false: the linearized 24-bit
+  // depth buffer (quantization grows with z^2 / near_mm).
+  bool exact_depth = true;
 };
 
 // One renderer owns one OSMesa context and buffers; use one per thread.
