@@ -59,6 +59,18 @@ std::shared_ptr<const TrainedModel> train_model(const Mesh& mesh, const Recognit
                                                 const TrainOptions& opt = {},
                                                 bool* from_cache = nullptr);
 
+// What a trained model holds (for messages, tests and benchmarks).
+struct TrainedModelInfo {
+  std::string descriptor;
+  std::string model_name;
+  int views = 0;            // training views kept (views with too few points are dropped)
+  size_t view_points = 0;   // preprocessed points over all views
+  bool empty = true;        // nothing to recognize (empty mesh or no view points)
+  std::string empty_reason;
+  std::string cache_file;   // the cache file read or written ("" = no cache)
+};
+TrainedModelInfo trained_model_info(const TrainedModel& model);
+
 struct RecognitionResult {
   std::string status = "no_hypothesis";  // "ok" | "no_hypothesis"
   std::string message;                   // why no hypothesis, when so

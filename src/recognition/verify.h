@@ -13,6 +13,10 @@ namespace pb {
 
 struct VerifySettings {
   double inlier_threshold_mm = 10.0;  // model point -> nearest scene point distance
+  // The best hypothesis is accepted only if at least this fraction of its
+  // model points are inliers (0 = the thesis: the most inliers wins, as long
+  // as it has one); below it the result is "no_hypothesis".
+  double min_inlier_fraction = 0.0;
 };
 
 void parse_verify(const YamlNode& node, VerifySettings& s);

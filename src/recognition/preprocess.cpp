@@ -1,0 +1,249 @@
+// Preprocessing (THESIS.md "Shared preprocessing"): range cut, voxel grid,
+// dominant plane removal, normals. The voxel grid and the RANSAC plane fit
+// are implemented here (same cells and semantics as pcl::VoxelGrid and
+// pcl::SACSegmentation) so that each output point keeps its source pixel and
+// every random choice draws from pb::Rng; normals go through PCL
+// (preprocess_normals.cpp).
+#include "recognition/preprocess.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include <Eigen/Eigenvalues>
+
+#include "core/random.h"
+#include "recognition/preprocess_internal.h"
+
+namespace pb {
+
+void parse_preprocess(const YamlNode& node, PreprocessSettings& s) {
+  if (!node.defined()) return;
+  node.check_keys({"min_range_mm", "max_range_mm", "voxel_mm", "remove_plane", "plane_threshold_mm",
+                   "plane_iterations", "min_plane_fraction", "normal_radius_mm"});
+  s.min_range_mm = node.get_nonnegative("min_range_mm", s.min_range_mm);
+  s.max_range_mm = node.get_positive("max_range_mm", s.max_range_mm);
+  if (s.max_range_mm <= s.min_range_mm)
+    node["max_range_mm"].fail("must be greater than min_range_mm (" + std::to_string(s.min_range_mm) + ")");
+  s.voxel_mm = node.get_nonnegative("voxel_mm", s.voxel_mm);
+  node.read("remove_plane", s.remove_plane);
+  s.plane_threshold_mm = node.get_positive("plane_threshold_mm", s.plane_threshold_mm);
+  s.plane_iterations = node.get_or<int>("plane_iterations", s.plane_iterations);
+  if (s.plane_iterations < 1) node["plane_iterations"].fail("must be at least 1");
+  s.min_plane_fraction = node.get_nonnegative("min_plane_fraction", s.min_plane_fraction);
+  if (s.min_plane_fraction > 1) node["min_plane_fraction"].fail("must be in [0, 1]");
+  s.normal_radius_mm = node.get_positive("normal_radius_mm", s.normal_radius_mm);
+}
+
+namespace detail {
+
+PointSet select(const PointSet& in, const std::vector<char>& keep) {
+  PointSet out;
+  out.source_width = in.source_width;
+  out.source_height = in.source_height;
+  const bool n = in.normals.size() == in.points.size(), c = in.curvature.size() == in.points.size(),
+             px = in.pixel.size() == in.points.size();
+  for (size_t i = 0; i < in.points.size(); ++i) {
+    if (!keep[i]) continue;
+    out.points.push_back(in.points[i]);
+    if (n) out.normals.push_back(in.normals[i]);
+    if (c) out.curvature.push_back(in.curvature[i]);
+    if (px) out.pixel.push_back(in.pixel[i]);
+  }
+  return out;
+}
+
+PointSet voxel_downsample(const PointSet& in, double leaf_mm) {
+  if (!(leaf_mm > 0) || in.points.empty()) return in;
+  const size_t n = in.points.size();
+  const bool has_n = in.normals.size() == n, has_c = in.curvature.size() == n, has_px = in.pixel.size() == n;
+  struct Key {
+    int64_t x, y, z;
+    uint32_t i;
+  };
+  std::vector<Key> keys;
+  keys.reserve(n);
+  const double inv = 1.0 / leaf_mm;
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3f& p = in.points[i];
+    if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) continue;
+    keys.push_back({static_cast<int64_t>(std::floor(p.x() * inv)), static_cast<int64_t>(std::floor(p.y() * inv)),
+                    static_cast<int64_t>(std::floor(p.z() * inv)), static_cast<uint32_t>(i)});
+  }
+  // pcl::VoxelGrid orders its output by the linear cell index i + j*dx +
+  // k*dx*dy, i.e. by z, then y, then x; points in a cell keep input order.
+  std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
+    if (a.z != b.z) return a.z < b.z;
+    if (a.y != b.y) return a.y < b.y;
+    if (a.x != b.x) return a.x < b.x;
+    return a.i < b.i;
+  });
+  PointSet out;
+  out.source_width = in.source_width;
+  out.source_height = in.source_height;
+  for (size_t b = 0; b < keys.size();) {
+    size_t e = b + 1;
+    while (e < keys.size() && keys[e].x == keys[b].x && keys[e].y == keys[b].y && keys[e].z == keys[b].z) ++e;
+    Vec3 c = Vec3::Zero(), nrm = Vec3::Zero();
+    double curv = 0;
+    for (size_t k = b; k < e; ++k) {
+      c += in.points[keys[k].i].cast<double>();
+      if (has_n) nrm += in.normals[keys[k].i].cast<double>();
+      if (has_c) curv += in.curvature[keys[k].i];
+    }
+    const double cnt = static_cast<double>(e - b);
+    c /= cnt;
+    out.points.push_back(c.cast<float>());
+    if (has_n) {
+      const double l = nrm.norm();
+      out.normals.push_back(l > 0 ? Vec3f((nrm / l).cast<float>()) : in.normals[keys[b].i]);
+    }
+    if (has_c) out.curvature.push_back(static_cast<float>(curv / cnt));
+    if (has_px) {
+      int best_px = -1;
+      double best_d = std::numeric_limits<double>::infinity();
+      for (size_t k = b; k < e; ++k) {
+        const double d = (in.points[keys[k].i].cast<double>() - c).squaredNorm();
+        const int px = in.pixel[keys[k].i];
+        if (d < best_d || (d == best_d && px < best_px)) {
+          best_d = d;
+          best_px = px;
+        }
+      }
+      out.pixel.push_back(best_px);
+    }
+    b = e;
+  }
+  return out;
+}
+
+namespace {
+
+// Least squares plane through points (PCA): the normal is the eigenvector of
+// the smallest eigenvalue of the covariance.
+bool fit_plane(const std::vector<Vec3f>& pts, const std::vector<char>& use, Eigen::Vector4d& plane) {
+  Vec3 mean = Vec3::Zero();
+  size_t cnt = 0;
+  for (size_t i = 0; i < pts.size(); ++i)
+    if (use[i]) {
+      mean += pts[i].cast<double>();
+      ++cnt;
+    }
+  if (cnt < 3) return false;
+  mean /= static_cast<double>(cnt);
+  Mat3 cov = Mat3::Zero();
+  for (size_t i = 0; i < pts.size(); ++i)
+    if (use[i]) {
+      const Vec3 d = pts[i].cast<double>() - mean;
+      cov += d * d.transpose();
+    }
+  Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
+  if (es.info() != Eigen::Success) return false;
+  const Vec3 nrm = es.eigenvectors().col(0).normalized();
+  if (!nrm.allFinite()) return false;
+  plane << nrm, -nrm.dot(mean);
+  return true;
+}
+
+size_t within(const std::vector<Vec3f>& pts, const Eigen::Vector4d& plane, double thr, std::vector<char>* flags) {
+  size_t cnt = 0;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const Vec3 p = pts[i].cast<double>();
+    const bool in = std::abs(plane.head<3>().dot(p) + plane[3]) <= thr;
+    cnt += in;
+    if (flags) (*flags)[i] = in;
+  }
+  return cnt;
+}
+
+}  // namespace
+
+std::vector<char> ransac_plane(const std::vector<Vec3f>& pts, double thr, int iterations, uint64_t seed,
+                               Eigen::Vector4d* plane_out) {
+  const size_t n = pts.size();
+  std::vector<char> flags(n, 0);
+  if (n < 3) return flags;
+  Rng rng(seed);
+  Eigen::Vector4d best = Eigen::Vector4d::Zero();
+  size_t best_count = 0;
+  const int max_n = static_cast<int>(n) - 1;
+  for (int it = 0; it < iterations; ++it) {
+    const int a = rng.uniform_int(0, max_n), b = rng.uniform_int(0, max_n), c = rng.uniform_int(0, max_n);
+    if (a == b || b == c || a == c) continue;  // a degenerate sample costs its iteration, as in PCL
+    const Vec3 pa = pts[a].cast<double>(), pb_ = pts[b].cast<double>(), pc = pts[c].cast<double>();
+    Vec3 nrm = (pb_ - pa).cross(pc - pa);
+    const double l = nrm.norm();
+    if (!(l > 1e-9)) continue;  // collinear sample
+    nrm /= l;
+    Eigen::Vector4d plane;
+    plane << nrm, -nrm.dot(pa);
+    const size_t cnt = within(pts, plane, thr, nullptr);
+    if (cnt > best_count) {
+      best_count = cnt;
+      best = plane;
+    }
+  }
+  if (best_count < 3) return flags;
+  within(pts, best, thr, &flags);
+  Eigen::Vector4d refined;
+  if (fit_plane(pts, flags, refined)) {
+    // Keep the refit only if it does not lose support (PCL keeps the refit
+    // unconditionally; a refit tilted by a large object can lose the plane).
+    std::vector<char> f2(n, 0);
+    if (within(pts, refined, thr, &f2) >= best_count) {
+      best = refined;
+      flags.swap(f2);
+    }
+  }
+  if (plane_out) *plane_out = best;
+  return flags;
+}
+
+}  // namespace detail
+
+namespace {
+
+PointSet range_cut(const OrganizedCloud& cloud, double min_z, double max_z) {
+  PointSet ps;
+  ps.source_width = cloud.width;
+  ps.source_height = cloud.height;
+  for (size_t i = 0; i < cloud.points.size(); ++i) {
+    const Vec3f& p = cloud.points[i];
+    if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) continue;
+    if (p.z() < min_z || p.z() > max_z) continue;
+    ps.points.push_back(p);
+    ps.pixel.push_back(static_cast<int>(i));
+  }
+  return ps;
+}
+
+}  // namespace
+
+PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings& s, uint64_t seed) {
+  PointSet ps = range_cut(cloud, s.min_range_mm, s.max_range_mm);
+  ps = detail::voxel_downsample(ps, s.voxel_mm);
+  if (s.remove_plane && ps.size() >= 3) {
+    const std::vector<char> on_plane =
+        detail::ransac_plane(ps.points, s.plane_threshold_mm, s.plane_iterations, seed);
+    const size_t cnt = static_cast<size_t>(std::count(on_plane.begin(), on_plane.end(), 1));
+    if (cnt > 0 && static_cast<double>(cnt) >= s.min_plane_fraction * static_cast<double>(ps.size())) {
+      std::vector<char> keep(on_plane.size());
+      for (size_t i = 0; i < keep.size(); ++i) keep[i] = !on_plane[i];
+      ps = detail::select(ps, keep);
+    }
+  }
+  detail::estimate_normals(ps, s.normal_radius_mm);
+  return ps;
+}
+
+PointSet preprocess_view(const OrganizedCloud& cloud, const PreprocessSettings& s, uint64_t /*seed*/) {
+  // The model is alone in its view, rendered at the distance the view
+  // settings chose: no range cut, no plane.
+  PointSet ps = range_cut(cloud, 0.0, std::numeric_limits<double>::infinity());
+  ps = detail::voxel_downsample(ps, s.voxel_mm);
+  detail::estimate_normals(ps, s.normal_radius_mm);
+  return ps;
+}
+
+}  // namespace pb

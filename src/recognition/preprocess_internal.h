@@ -1,0 +1,39 @@
+// Internal helpers of the preprocessing stage, shared by the recognition
+// .cpp files (not part of the public contract). PCL-free.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/types.h"
+#include "recognition/cloud.h"
+
+namespace pb::detail {
+
+// Voxel grid with the cells of pcl::VoxelGrid (cell = floor(p / leaf)) and
+// its output order (cells by increasing z, then y, then x index). Each cell
+// becomes the centroid of its points; normals (if present) are averaged and
+// renormalized, curvature averaged; the pixel of a cell is the pixel of its
+// point nearest to the centroid (ties: the smaller pixel index).
+PointSet voxel_downsample(const PointSet& in, double leaf_mm);
+
+// Seeded RANSAC plane fit (as pcl::SACSegmentation with SACMODEL_PLANE and
+// optimized coefficients): `iterations` random triples, the plane with most
+// points within `threshold_mm` wins (first found on ties), then a least
+// squares refit on its inliers and a final inlier selection. Returns the
+// inlier flags; `plane` (n, d with n.p + d = 0) when not null. Fewer than 3
+// points or no valid sample: all false.
+std::vector<char> ransac_plane(const std::vector<Vec3f>& points, double threshold_mm, int iterations,
+                               uint64_t seed, Eigen::Vector4d* plane = nullptr);
+
+// Normals by PCA of the neighbours within `radius_mm` (pcl::NormalEstimationOMP
+// on a kd-tree, one thread per omp_get_max_threads()), flipped toward the
+// viewpoint (origin), and the surface variation as curvature. Points whose
+// normal cannot be estimated (fewer than 3 neighbours) are dropped, with
+// their pixel.
+void estimate_normals(PointSet& cloud, double radius_mm);
+
+// Keeps the points whose flag is set (all per-point arrays).
+PointSet select(const PointSet& in, const std::vector<char>& keep);
+
+}  // namespace pb::detail
