@@ -1,0 +1,114 @@
+#include "runner/store.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+#include "io/png.h"
+
+namespace fs = std::filesystem;
+
+namespace pb {
+
+std::string ResultStore::records_path() const { return (fs::path(dir_) / "records.jsonl").string(); }
+
+// Parses records.jsonl. Returns the records and the byte length of the valid
+// prefix (a torn final line from a killed run is excluded).
+static std::vector<nlohmann::json> parse_records(const std::string& path, size_t* valid_bytes) {
+  std::vector<nlohmann::json> out;
+  *valid_bytes = 0;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return out;
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  size_t pos = 0;
+  int line_no = 0;
+  while (pos < text.size()) {
+    const size_t nl = text.find('\n', pos);
+    ++line_no;
+    if (nl == std::string::npos) break;  // torn last line: no newline yet
+    const std::string line = text.substr(pos, nl - pos);
+    if (!line.empty()) {
+      try {
+        out.push_back(nlohmann::json::parse(line));
+      } catch (const nlohmann::json::exception& e) {
+        throw InputError(path, "line " + std::to_string(line_no), std::string("corrupt record: ") + e.what());
+      }
+    }
+    pos = nl + 1;
+    *valid_bytes = pos;
+  }
+  return out;
+}
+
+std::vector<nlohmann::json> ResultStore::read_records(const std::string& dir) {
+  const std::string path = (fs::path(dir) / "records.jsonl").string();
+  if (!fs::exists(path)) throw InputError(path, "", "no records: not a posebench results folder (run `posebench run` first)");
+  size_t valid = 0;
+  return parse_records(path, &valid);
+}
+
+ResultStore::ResultStore(const std::string& dir, const nlohmann::json& experiment, const std::string& hash)
+    : dir_(dir) {
+  const fs::path exp_path = fs::path(dir) / "experiment.json";
+  if (fs::exists(exp_path)) {
+    std::ifstream in(exp_path);
+    nlohmann::json prev;
+    try {
+      in >> prev;
+    } catch (const nlohmann::json::exception&) {
+      throw InputError(exp_path.string(), "", "unreadable experiment record; refusing to touch this folder");
+    }
+    const std::string prev_hash = prev.value("hash", "");
+    if (prev_hash != hash)
+      throw InputError(exp_path.string(), "hash",
+                       "this results folder belongs to another experiment ('" + prev.value("name", "?") +
+                           "', hash " + prev_hash + "; this one is " + hash +
+                           "): choose another --out or remove the folder");
+  } else if (fs::exists(fs::path(dir) / "records.jsonl")) {
+    throw InputError((fs::path(dir) / "records.jsonl").string(), "",
+                     "records without experiment.json: not a folder of this experiment");
+  }
+  fs::create_directories(dir);
+  if (!fs::exists(exp_path)) {
+    nlohmann::json e = experiment;
+    e["hash"] = hash;
+    atomic_write_text(exp_path.string(), e.dump(2) + "\n");
+  }
+  size_t valid = 0;
+  records_ = parse_records(records_path(), &valid);
+  if (fs::exists(records_path()) && fs::file_size(records_path()) != valid)
+    fs::resize_file(records_path(), valid);  // drop a torn last line
+  for (size_t i = 0; i < records_.size(); ++i) index_.emplace(records_[i].value("key", ""), i);
+}
+
+bool ResultStore::has(const std::string& key) const { return index_.count(key) > 0; }
+
+void ResultStore::append(const nlohmann::json& record) {
+  std::lock_guard<std::mutex> lock(mu_);
+  const std::string key = record.value("key", "");
+  if (index_.count(key)) return;
+  const std::string line = record.dump() + "\n";
+  const int fd = ::open(records_path().c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+  if (fd < 0) throw std::runtime_error("cannot open " + records_path() + " for appending");
+  size_t off = 0;
+  while (off < line.size()) {
+    const ssize_t n = ::write(fd, line.data() + off, line.size() - off);
+    if (n <= 0) {
+      ::close(fd);
+      throw std::runtime_error("write failed: " + records_path());
+    }
+    off += static_cast<size_t>(n);
+  }
+  ::fdatasync(fd);
+  ::close(fd);
+  index_.emplace(key, records_.size());
+  records_.push_back(record);
+}
+
+}  // namespace pb
