@@ -11,15 +11,35 @@
 
 namespace pb {
 
+// Units: every *_mm field is in millimetres. PCL registers in metres (float),
+// in a frame centred on the cropped scene (refine_pose.cpp), so the epsilons
+// marked "m" are in metres as PCL compares them.
 struct RefineSettings {
   int max_iterations = 40;                 // thesis: at most 40 iterations
   double max_correspondence_mm = 20.0;     // pairs farther apart are rejected
-  double transformation_epsilon = 1e-8;    // stop on small change of transform (PCL units)
-  double fitness_epsilon = 1e-6;           // stop on small change of mean squared error
+  double transformation_epsilon = 1e-8;    // stop on small change of transform: squared translation
+                                           // step below this (m^2; 1e-8 = (0.1 mm)^2), together with
+                                           // a rotation step below rotation_epsilon_deg
+  double rotation_epsilon_deg = 0.05;      // rotation part of the transform-change stopping rule
+  double fitness_epsilon = 1e-6;           // stop on small change of mean squared error: relative
+                                           // change between iterations (ICP, ICP-LM, ICP-plane)
   int icp_sample_points = 0;               // ICP point-to-point: random subset of source points (0 = all)
-  double ndt_resolution_mm = 20.0;         // NDT grid cell (sized to the object, PCL_NOTES)
+  double ndt_resolution_mm = 20.0;         // NDT grid cell (sized to the object, PCL_NOTES); used as
+                                           // is when ndt_resolution_fraction is 0
+  double ndt_resolution_fraction = 0.0;    // if > 0: NDT cell = this fraction of the model diameter,
+                                           // but at least ndt_resolution_mm
   double ndt_step_size_mm = 10.0;          // NDT max More-Thuente step
-  double gicp_correspondence_randomness = 20;  // GICP neighbours for covariances
+  double ndt_outlier_ratio = 0.55;         // NDT outlier ratio of the Gaussian mixture (PCL default)
+  int ndt_min_points_per_cell = 6;         // NDT cells with fewer scene points are ignored (PCL
+                                           // default 6, at least 3)
+  double gicp_correspondence_randomness = 20;  // GICP neighbours for covariances (when not from normals)
+  bool gicp_covariances_from_normals = true;   // GICP plane covariances built from the clouds' normals
+                                               // (thesis: "covariances from normals"); false = PCL's
+                                               // own k-neighbour covariances
+  double crop_margin_mm = -1;              // scene crop: points within model radius + this of the
+                                           // initial model centre are registered (< 0: use
+                                           // max_correspondence_mm)
+  int normal_neighbours = 10;              // k for PCA normals when a cloud has none (icp_plane, gicp)
 };
 
 void parse_refine(const YamlNode& node, RefineSettings& s);

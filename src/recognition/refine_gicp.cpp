@@ -1,0 +1,80 @@
+// Generalized ICP (pcl::GeneralizedIterativeClosestPoint, plane-to-plane):
+// each point carries a covariance that is flat along its surface; by default
+// built from the clouds' normals (thesis: "covariances from normals"),
+// otherwise PCL computes them from k neighbours. The clouds arrive de-meaned
+// (centred on the scene crop, refine_internal.h): PCL issue 6263, GICP fails
+// on clouds far from the origin.
+#include <pcl/point_types.h>
+#include <pcl/registration/gicp.h>
+
+#include <cmath>
+
+#include "recognition/refine_internal.h"
+
+namespace pb {
+namespace refine_detail {
+
+namespace {
+
+using Gicp = pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ>;
+
+class GicpCount : public Gicp {
+ public:
+  int iterations() const { return nr_iterations_; }
+};
+
+// Covariance of a locally planar patch with unit normal n: variance 1 in the
+// plane, eps along the normal (PCL's gicp_epsilon 0.001).
+Gicp::MatricesVectorPtr plane_covariances(const std::vector<Vec3f>& normals) {
+  constexpr double kEps = 1e-3;
+  auto cov = std::make_shared<Gicp::MatricesVector>(normals.size());
+  for (size_t i = 0; i < normals.size(); ++i) {
+    const Eigen::Vector3d n = normals[i].cast<double>().normalized();
+    (*cov)[i] = Eigen::Matrix3d::Identity() - (1.0 - kEps) * n * n.transpose();
+  }
+  return cov;
+}
+
+}  // namespace
+
+Outcome run_gicp(const Problem& p, const RefineSettings& s) {
+  using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+  Cloud::Ptr src(new Cloud), tgt(new Cloud), out(new Cloud);
+  src->resize(p.src.size());
+  for (size_t i = 0; i < p.src.size(); ++i) (*src)[i].getVector3fMap() = p.src[i];
+  tgt->resize(p.tgt.size());
+  for (size_t i = 0; i < p.tgt.size(); ++i) (*tgt)[i].getVector3fMap() = p.tgt[i];
+
+  Outcome o;
+  const int k = static_cast<int>(s.gicp_correspondence_randomness);
+  const bool from_normals = s.gicp_covariances_from_normals && p.src_normals.size() == p.src.size() &&
+                            p.tgt_normals.size() == p.tgt.size();
+  // PCL's own covariances need k neighbours in both clouds.
+  if (!from_normals && (static_cast<int>(src->size()) < k || static_cast<int>(tgt->size()) < k)) return o;
+
+  GicpCount gicp;
+  gicp.setInputSource(src);
+  gicp.setInputTarget(tgt);
+  if (from_normals) {
+    gicp.setSourceCovariances(plane_covariances(p.src_normals));
+    gicp.setTargetCovariances(plane_covariances(p.tgt_normals));
+  } else {
+    gicp.setCorrespondenceRandomness(k);
+  }
+  gicp.setMaximumIterations(s.max_iterations);
+  gicp.setMaxCorrespondenceDistance(s.max_correspondence_mm * 1e-3);
+  // PCL's GICP stops when every translation entry of the per-iteration change
+  // is below transformation_epsilon (m, not squared) and every rotation entry
+  // below rotation_epsilon (~ radians): the same rule as the ICP family.
+  gicp.setTransformationEpsilon(std::sqrt(s.transformation_epsilon));
+  gicp.setRotationEpsilon(s.rotation_epsilon_deg * M_PI / 180.0);
+  gicp.align(*out);
+
+  o.delta = gicp.getFinalTransformation();
+  o.iterations = gicp.iterations();
+  o.converged = gicp.hasConverged() && o.iterations < s.max_iterations;
+  return o;
+}
+
+}  // namespace refine_detail
+}  // namespace pb

@@ -1,0 +1,217 @@
+// refine_pose: the common frame, crop and bookkeeping around the PCL
+// registration methods (one .cpp per method: refine_icp.cpp,
+// refine_icp_lm.cpp, refine_icp_plane.cpp, refine_gicp.cpp, refine_ndt.cpp),
+// and parse_refine. See refine_internal.h for the frame and units.
+#include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/point_types.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/error.h"
+#include "recognition/refine.h"
+#include "recognition/refine_internal.h"
+
+namespace pb {
+
+namespace {
+
+pcl::PointCloud<pcl::PointXYZ>::Ptr to_pcl(const std::vector<Vec3f>& pts) {
+  pcl::PointCloud<pcl::PointXYZ>::Ptr c(new pcl::PointCloud<pcl::PointXYZ>);
+  c->resize(pts.size());
+  for (size_t i = 0; i < pts.size(); ++i) (*c)[i].getVector3fMap() = pts[i];
+  return c;
+}
+
+bool needs_normals(const std::string& method, const RefineSettings& s) {
+  return method == "icp_plane" || (method == "gicp" && s.gicp_covariances_from_normals);
+}
+
+}  // namespace
+
+namespace refine_detail {
+
+std::vector<Vec3f> estimate_normals(const std::vector<Vec3f>& pts, int k) {
+  std::vector<Vec3f> normals(pts.size(), Vec3f(0, 0, 1));
+  if (pts.size() < 3) return normals;
+  auto cloud = to_pcl(pts);
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+  tree.setInputCloud(cloud);
+  const int kk = std::max(3, std::min<int>(k, static_cast<int>(pts.size())));
+  pcl::Indices idx;
+  std::vector<float> d2;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    if (tree.nearestKSearch((*cloud)[i], kk, idx, d2) < 3) continue;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int j : idx) mean += pts[j].cast<double>();
+    mean /= static_cast<double>(idx.size());
+    Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+    for (int j : idx) {
+      const Eigen::Vector3d d = pts[j].cast<double>() - mean;
+      C += d * d.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(C);
+    normals[i] = es.eigenvectors().col(0).cast<float>().normalized();
+  }
+  return normals;
+}
+
+}  // namespace refine_detail
+
+RefineResult refine_pose(const std::string& method, const PointSet& model, const PointSet& scene,
+                         const Pose& init, const RefineSettings& s, uint64_t seed) {
+  static const char* kMethods[] = {"none", "icp", "icp_lm", "icp_plane", "gicp", "ndt"};
+  if (std::find_if(std::begin(kMethods), std::end(kMethods),
+                   [&](const char* m) { return method == m; }) == std::end(kMethods))
+    throw InputError("", "refinement",
+                     "unknown refinement method '" + method +
+                         "' (known: none, icp, icp_lm, icp_plane, gicp, ndt)");
+
+  RefineResult res;
+  res.T_cam_model = init;
+  const double max_corr = s.max_correspondence_mm;
+  res.fitness = max_corr * max_corr;
+  if (model.empty() || scene.empty()) return res;
+
+  // Model at the initial pose (camera frame, mm), its centre and radius.
+  std::vector<Eigen::Vector3d> moved(model.size());
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < model.size(); ++i) {
+    moved[i] = init * model.points[i].cast<double>();
+    centre += moved[i];
+  }
+  centre /= static_cast<double>(model.size());
+  double radius = 0;
+  Eigen::AlignedBox3d box;
+  for (const auto& p : moved) {
+    radius = std::max(radius, (p - centre).norm());
+    box.extend(p);
+  }
+  const double margin = s.crop_margin_mm >= 0 ? s.crop_margin_mm : max_corr;
+  const double crop_r2 = (radius + margin) * (radius + margin);
+
+  // Scene crop and its centroid: the local frame's origin.
+  std::vector<size_t> crop;
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < scene.size(); ++i) {
+    const Eigen::Vector3d q = scene.points[i].cast<double>();
+    if (!q.allFinite() || (q - centre).squaredNorm() > crop_r2) continue;
+    crop.push_back(i);
+    c += q;
+  }
+  if (crop.size() < 3) return res;
+  c /= static_cast<double>(crop.size());
+
+  refine_detail::Problem p;
+  p.model_diameter_m = box.diagonal().norm() * 1e-3;
+  p.src.reserve(model.size());
+  for (const auto& q : moved) p.src.push_back(((q - c) * 1e-3).cast<float>());
+  p.tgt.reserve(crop.size());
+  for (size_t i : crop) p.tgt.push_back(((scene.points[i].cast<double>() - c) * 1e-3).cast<float>());
+
+  if (method != "none") {
+    if (needs_normals(method, s)) {
+      if (model.has_normals()) {
+        p.src_normals.reserve(model.size());
+        for (const auto& n : model.normals) p.src_normals.push_back((init.R * n.cast<double>()).cast<float>());
+      } else {
+        p.src_normals = refine_detail::estimate_normals(p.src, s.normal_neighbours);
+      }
+      if (scene.has_normals()) {
+        p.tgt_normals.reserve(crop.size());
+        for (size_t i : crop) p.tgt_normals.push_back(scene.normals[i]);
+      } else {
+        p.tgt_normals = refine_detail::estimate_normals(p.tgt, s.normal_neighbours);
+      }
+    }
+    refine_detail::Outcome o;
+    if (method == "icp") o = refine_detail::run_icp(p, s, seed);
+    else if (method == "icp_lm") o = refine_detail::run_icp_lm(p, s);
+    else if (method == "icp_plane") o = refine_detail::run_icp_plane(p, s);
+    else if (method == "gicp") o = refine_detail::run_gicp(p, s);
+    else o = refine_detail::run_ndt(p, s);
+
+    const Eigen::Matrix4d D = o.delta.cast<double>();
+    if (D.allFinite()) {
+      // Re-orthonormalize the float rotation (SVD projection onto SO(3)).
+      Eigen::JacobiSVD<Eigen::Matrix3d> svd(D.block<3, 3>(0, 0), Eigen::ComputeFullU | Eigen::ComputeFullV);
+      Mat3 Rd = svd.matrixU() * svd.matrixV().transpose();
+      if (Rd.determinant() < 0) {
+        Mat3 U = svd.matrixU();
+        U.col(2) *= -1;
+        Rd = U * svd.matrixV().transpose();
+      }
+      const Vec3 td = D.block<3, 1>(0, 3) * 1e3;
+      // x_cam = c + Rd (R x + t - c) + td
+      res.T_cam_model.R = Rd * init.R;
+      res.T_cam_model.t = Rd * (init.t - c) + td + c;
+      res.converged = o.converged;
+      res.iterations = o.iterations;
+    }
+  } else {
+    res.converged = true;
+  }
+
+  // Fitness: mean squared distance (mm^2) of the model points to their
+  // nearest cropped scene point, over pairs within max_correspondence_mm.
+  {
+    auto tgt = to_pcl(p.tgt);
+    pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+    tree.setInputCloud(tgt);
+    pcl::Indices idx(1);
+    std::vector<float> d2(1);
+    double sum = 0;
+    size_t n = 0;
+    const double lim = max_corr * max_corr;
+    for (const auto& x : model.points) {
+      const Eigen::Vector3d q = (res.T_cam_model * x.cast<double>() - c) * 1e-3;
+      pcl::PointXYZ pt;
+      pt.getVector3fMap() = q.cast<float>();
+      if (tree.nearestKSearch(pt, 1, idx, d2) < 1) continue;
+      const double dmm2 = static_cast<double>(d2[0]) * 1e6;
+      if (dmm2 <= lim) {
+        sum += dmm2;
+        ++n;
+      }
+    }
+    if (n > 0) res.fitness = sum / static_cast<double>(n);
+  }
+  return res;
+}
+
+void parse_refine(const YamlNode& node, RefineSettings& s) {
+  if (!node.defined()) return;
+  node.check_keys({"max_iterations", "max_correspondence_mm", "transformation_epsilon",
+                   "rotation_epsilon_deg", "fitness_epsilon", "icp_sample_points",
+                   "ndt_resolution_mm", "ndt_resolution_fraction", "ndt_step_size_mm",
+                   "ndt_outlier_ratio", "ndt_min_points_per_cell", "gicp_correspondence_randomness",
+                   "gicp_covariances_from_normals", "crop_margin_mm", "normal_neighbours"});
+  auto positive_int = [&](const std::string& key, int& v, int min_value) {
+    if (!node.has(key)) return;
+    const int x = node.get<int>(key);
+    if (x < min_value) node[key].fail("must be at least " + std::to_string(min_value) + ", got " + std::to_string(x));
+    v = x;
+  };
+  positive_int("max_iterations", s.max_iterations, 1);
+  s.max_correspondence_mm = node.get_positive("max_correspondence_mm", s.max_correspondence_mm);
+  s.transformation_epsilon = node.get_nonnegative("transformation_epsilon", s.transformation_epsilon);
+  s.rotation_epsilon_deg = node.get_nonnegative("rotation_epsilon_deg", s.rotation_epsilon_deg);
+  s.fitness_epsilon = node.get_nonnegative("fitness_epsilon", s.fitness_epsilon);
+  positive_int("icp_sample_points", s.icp_sample_points, 0);
+  s.ndt_resolution_mm = node.get_positive("ndt_resolution_mm", s.ndt_resolution_mm);
+  s.ndt_resolution_fraction = node.get_nonnegative("ndt_resolution_fraction", s.ndt_resolution_fraction);
+  s.ndt_step_size_mm = node.get_positive("ndt_step_size_mm", s.ndt_step_size_mm);
+  s.ndt_outlier_ratio = node.get_positive("ndt_outlier_ratio", s.ndt_outlier_ratio);
+  if (s.ndt_outlier_ratio >= 1) node["ndt_outlier_ratio"].fail("must be below 1");
+  positive_int("ndt_min_points_per_cell", s.ndt_min_points_per_cell, 3);
+  s.gicp_correspondence_randomness =
+      node.get_positive("gicp_correspondence_randomness", s.gicp_correspondence_randomness);
+  if (s.gicp_correspondence_randomness < 3) node["gicp_correspondence_randomness"].fail("must be at least 3");
+  node.read("gicp_covariances_from_normals", s.gicp_covariances_from_normals);
+  if (node.has("crop_margin_mm")) s.crop_margin_mm = node.get<double>("crop_margin_mm");
+  positive_int("normal_neighbours", s.normal_neighbours, 3);
+}
+
+}  // namespace pb
