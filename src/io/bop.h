@@ -75,21 +75,34 @@ class BopDataset {
   int resolve_object(const std::string& name_or_id) const;  // "3", "obj_000003" or a name
   Mesh load_model(int obj_id) const;                     // models/obj_XXXXXX.ply (mm)
   std::string model_path(int obj_id) const;
+  std::string scene_dir(const std::string& split, int scene_id) const;  // ROOT/SPLIT/NNNNNN
+  // camera.json of the root, when present (image size and sensor intrinsics).
+  const std::optional<Intrinsics>& camera() const { return camera_; }
+  double camera_depth_scale() const { return camera_depth_scale_; }
 
  private:
   std::string root_;
   std::map<int, ModelInfo> models_;
+  std::optional<Intrinsics> camera_;
+  double camera_depth_scale_ = 1.0;
 };
 
 // Writing a dataset. Each JSON file is written atomically (temp + rename).
 std::map<int, ModelInfo> read_models_info(const std::string& path);
 void write_models_info(const std::string& path, const std::map<int, ModelInfo>& models);
 void write_camera_json(const std::string& path, const Intrinsics& K, double depth_scale);
+// Reads camera.json (fx, fy, cx, cy, width, height, depth_scale).
+Intrinsics read_camera_json(const std::string& path, double* depth_scale = nullptr);
 // Writes scene_camera.json, scene_gt.json and scene_gt_info.json of a scene
-// folder from its images.
+// folder from its images (creates the folder; scene_gt_info.json only when
+// some image has gt_info). Image width/height are not part of BOP's
+// scene_camera.json: readers take them from camera.json or the depth PNG
+// (BopDataset::load_scene does); read_scene_json leaves them 0.
 void write_scene_json(const std::string& scene_dir, const SceneInfo& scene);
 SceneInfo read_scene_json(const std::string& scene_dir);
 
 std::string bop_id(int id);  // 6 digits: 000042
+// SCENE_DIR/depth/IIIIII.png
+std::string bop_depth_path(const std::string& scene_dir, int im_id);
 
 }  // namespace pb

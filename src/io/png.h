@@ -19,8 +19,24 @@ DepthImage read_depth_png(const std::string& path, double depth_scale);
 void write_depth_png(const std::string& path, const DepthImage& depth, double depth_scale);
 
 // 8-bit images (masks, previews, overlays).
+// Reads an 8-bit gray PNG (e.g. a BOP mask); InputError(path, "image", ...)
+// for any other format.
+std::vector<uint8_t> read_gray8_png(const std::string& path, int* width, int* height);
 void write_gray8_png(const std::string& path, int width, int height, const std::vector<uint8_t>& px);
 void write_rgb8_png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
+
+// Size and format of a PNG from its header (any PNG); InputError(path,
+// "image", ...) if missing or not a PNG.
+struct PngHeader {
+  int width = 0, height = 0;
+  int bit_depth = 0;  // bits per channel
+  int channels = 0;
+};
+PngHeader read_png_header(const std::string& path);
+
+// Writes bytes to `path + ".tmp"` and renames it into place (see below).
+// InputError(path, "output", ...) if the file cannot be written.
+void atomic_write_bytes(const std::string& path, const void* data, size_t size);
 
 // Writes the file to `path + ".tmp"` and renames it into place, so a reader
 // never sees a half-written file. Used by every writer of posebench.

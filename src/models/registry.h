@@ -5,6 +5,7 @@
 #pragma once
 
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -35,29 +36,47 @@ class ModelRegistry {
  public:
   // Parses a registry file; InputError naming file and field on any bad entry
   // (unknown key, negative size, unknown up axis...). Missing mesh files are
-  // not an error here: see available()/load().
+  // not an error here: see available()/load_model().
   static ModelRegistry load(const std::string& registry_path);
   // The registry of the source tree: POSEBENCH_SOURCE_DIR/models/models.yaml,
   // or $POSEBENCH_MODELS when set.
   static ModelRegistry load_default();
+  // The path load_default() reads: $POSEBENCH_MODELS (a file, or a folder
+  // holding models.yaml) or POSEBENCH_SOURCE_DIR/models/models.yaml.
+  static std::string default_path();
 
   const std::map<std::string, ModelSpec>& specs() const { return specs_; }
   const ModelSpec& spec(const std::string& name) const;  // InputError if unknown
+  const ModelSpec& spec_by_id(int obj_id) const;          // InputError if unknown
+  // Model names, sorted; only those of `role` when it is not empty.
+  std::vector<std::string> names(const std::string& role = "") const;
+  const std::string& file() const { return file_; }
   // Path of the mesh file ("" for generated ones).
   std::string mesh_path(const std::string& name) const;
   // Whether the mesh can be loaded; `why` gets a clear message if not.
   bool available(const std::string& name, std::string* why = nullptr) const;
   // Loads (or generates) and normalizes the mesh; InputError when missing.
-  Mesh load(const std::string& name) const;
+  // Meshes are cached per registry (thread-safe): later calls return a copy.
+  // (Named load_model, not load: a member load(name) cannot overload the
+  // static load(registry_path) above, same parameter types.)
+  Mesh load_model(const std::string& name) const;
+  // The normalization load_model() applies: vertices * scale, rotation of the up
+  // axis to +z, uniform scaling to fit_size (largest extent) when > 0, bbox
+  // centre to the origin, vertex normals.
+  static void normalize(Mesh* mesh, const ModelSpec& spec);
   // models_info entry (diameter, bbox, symmetries) for a loaded mesh.
   ModelInfo info(const std::string& name, const Mesh& mesh) const;
 
-  std::string shared_models_dir;  // where "shared:" sources are looked up
+  // Where "shared:" sources are looked up: $POSEBENCH_SHARED_MODELS, else
+  // POSEBENCH_SOURCE_DIR/../shared/models.
+  std::string shared_models_dir;
 
  private:
   std::string file_;
   std::string base_dir_;
   std::map<std::string, ModelSpec> specs_;
+  struct Cache;
+  std::shared_ptr<Cache> cache_;  // shared by copies of this registry
 };
 
 }  // namespace pb

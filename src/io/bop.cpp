@@ -1,0 +1,500 @@
+// BOP dataset reading and writing (../shared/reference/bop_datasets_format.md).
+// JSON keys are image/object ids as strings ("0", "1", ...), matrices are
+// row-major flat lists, translations in mm, depth_png * depth_scale = mm.
+// Numbers are written by nlohmann-json with the shortest representation that
+// reads back to the same double, so poses round-trip bit for bit.
+#include "io/bop.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/error.h"
+#include "io/mesh_io.h"
+#include "io/png.h"
+
+namespace fs = std::filesystem;
+
+namespace pb {
+
+namespace {
+
+using json = nlohmann::json;
+using ojson = nlohmann::ordered_json;
+
+json read_json(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "", std::string("cannot open JSON file: ") + std::strerror(errno));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  try {
+    return json::parse(ss.str());
+  } catch (const json::parse_error& e) {
+    throw InputError(path, "", std::string("malformed JSON: ") + e.what());
+  }
+}
+
+// A JSON value with the file it came from and its key path, for messages.
+struct JRef {
+  const json& j;
+  const std::string& file;
+  std::string path;
+
+  JRef key(const std::string& k) const {
+    if (!j.is_object()) throw InputError(file, path, "expected a JSON object");
+    auto it = j.find(k);
+    if (it == j.end()) throw InputError(file, join(k), "missing key");
+    return JRef{*it, file, join(k)};
+  }
+  bool has(const std::string& k) const { return j.is_object() && j.contains(k) && !j.at(k).is_null(); }
+  JRef at(size_t i) const { return JRef{j.at(i), file, path + "[" + std::to_string(i) + "]"}; }
+  std::string join(const std::string& k) const { return path.empty() ? k : path + "." + k; }
+
+  double num() const {
+    if (!j.is_number()) throw InputError(file, path, "expected a number");
+    const double v = j.get<double>();
+    if (!std::isfinite(v)) throw InputError(file, path, "not a finite number");
+    return v;
+  }
+  int integer() const {
+    if (!j.is_number_integer() && !(j.is_number_float() && std::floor(j.get<double>()) == j.get<double>()))
+      throw InputError(file, path, "expected an integer");
+    return static_cast<int>(j.get<double>());
+  }
+  const json& array(size_t n) const {
+    if (!j.is_array()) throw InputError(file, path, "expected a list");
+    if (n && j.size() != n)
+      throw InputError(file, path, "expected " + std::to_string(n) + " numbers, got " + std::to_string(j.size()));
+    return j;
+  }
+  std::vector<double> nums(size_t n) const {
+    array(n);
+    std::vector<double> v;
+    for (size_t i = 0; i < j.size(); ++i) v.push_back(at(i).num());
+    return v;
+  }
+  std::array<int, 4> int4() const {
+    array(4);
+    return {at(0).integer(), at(1).integer(), at(2).integer(), at(3).integer()};
+  }
+};
+
+int parse_id(const std::string& key, const std::string& file) {
+  if (key.empty() || key.size() > 9 || !std::all_of(key.begin(), key.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    throw InputError(file, key, "expected an integer id as key");
+  return std::stoi(key);
+}
+
+Mat3 mat3_rowmajor(const std::vector<double>& v) {
+  Mat3 M;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) M(r, c) = v[3 * r + c];
+  return M;
+}
+ojson rowmajor(const Mat3& M) {
+  ojson a = ojson::array();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) a.push_back(M(r, c));
+  return a;
+}
+ojson rowmajor(const Mat4& M) {
+  ojson a = ojson::array();
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) a.push_back(M(r, c));
+  return a;
+}
+ojson vec3(const Vec3& v) { return ojson::array({v.x(), v.y(), v.z()}); }
+ojson int4(const std::array<int, 4>& a) { return ojson::array({a[0], a[1], a[2], a[3]}); }
+
+void write_json(const std::string& path, const ojson& j) {
+  // One entry per line keeps the files readable and diffable, like BOP's.
+  atomic_write_text(path, j.dump(1) + "\n");
+}
+
+bool is_digits(const std::string& s) {
+  return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
+std::string join_path(const std::string& a, const std::string& b) { return (fs::path(a) / b).string(); }
+
+}  // namespace
+
+std::string bop_id(int id) {
+  char buf[16];
+  std::snprintf(buf, sizeof(buf), "%06d", id);
+  return buf;
+}
+
+std::string bop_depth_path(const std::string& scene_dir, int im_id) {
+  return join_path(join_path(scene_dir, "depth"), bop_id(im_id) + ".png");
+}
+
+// ---------------------------------------------------------------- models_info
+
+std::map<int, ModelInfo> read_models_info(const std::string& path) {
+  const json root = read_json(path);
+  if (!root.is_object()) throw InputError(path, "", "expected a JSON object keyed by object id");
+  std::map<int, ModelInfo> out;
+  for (auto it = root.begin(); it != root.end(); ++it) {
+    ModelInfo m;
+    m.obj_id = parse_id(it.key(), path);
+    const JRef e{it.value(), path, it.key()};
+    if (!e.j.is_object()) throw InputError(path, it.key(), "expected a JSON object");
+    m.diameter = e.key("diameter").num();
+    if (!(m.diameter > 0)) throw InputError(path, e.join("diameter"), "must be positive");
+    m.min = Vec3(e.key("min_x").num(), e.key("min_y").num(), e.key("min_z").num());
+    m.size = Vec3(e.key("size_x").num(), e.key("size_y").num(), e.key("size_z").num());
+    for (int k = 0; k < 3; ++k)
+      if (m.size[k] < 0) throw InputError(path, e.join(std::string("size_") + "xyz"[k]), "must not be negative");
+    if (e.has("name")) {
+      if (!e.j.at("name").is_string()) throw InputError(path, e.join("name"), "expected a string");
+      m.name = e.j.at("name").get<std::string>();
+    }
+    if (e.has("symmetries_discrete")) {
+      const JRef s = e.key("symmetries_discrete");
+      s.array(0);
+      for (size_t i = 0; i < s.j.size(); ++i) {
+        const auto v = s.at(i).nums(16);
+        Mat4 T;
+        for (int r = 0; r < 4; ++r)
+          for (int c = 0; c < 4; ++c) T(r, c) = v[4 * r + c];
+        m.symmetries_discrete.push_back(T);
+      }
+    }
+    if (e.has("symmetries_continuous")) {
+      const JRef s = e.key("symmetries_continuous");
+      s.array(0);
+      for (size_t i = 0; i < s.j.size(); ++i) {
+        const JRef c = s.at(i);
+        const auto a = c.key("axis").nums(3);
+        const auto o = c.key("offset").nums(3);
+        ContinuousSymmetry cs;
+        cs.axis = Vec3(a[0], a[1], a[2]);
+        cs.offset = Vec3(o[0], o[1], o[2]);
+        if (cs.axis.norm() == 0) throw InputError(path, c.join("axis"), "axis must not be zero");
+        m.symmetries_continuous.push_back(cs);
+      }
+    }
+    out[m.obj_id] = m;
+  }
+  return out;
+}
+
+void write_models_info(const std::string& path, const std::map<int, ModelInfo>& models) {
+  ojson root = ojson::object();
+  for (const auto& [id, m] : models) {
+    ojson e = ojson::object();
+    e["diameter"] = m.diameter;
+    e["min_x"] = m.min.x();
+    e["min_y"] = m.min.y();
+    e["min_z"] = m.min.z();
+    e["size_x"] = m.size.x();
+    e["size_y"] = m.size.y();
+    e["size_z"] = m.size.z();
+    if (!m.symmetries_discrete.empty()) {
+      ojson a = ojson::array();
+      for (const auto& T : m.symmetries_discrete) a.push_back(rowmajor(T));
+      e["symmetries_discrete"] = a;
+    }
+    if (!m.symmetries_continuous.empty()) {
+      ojson a = ojson::array();
+      for (const auto& c : m.symmetries_continuous) {
+        ojson s = ojson::object();
+        s["axis"] = vec3(c.axis);
+        s["offset"] = vec3(c.offset);
+        a.push_back(s);
+      }
+      e["symmetries_continuous"] = a;
+    }
+    if (!m.name.empty()) e["name"] = m.name;  // posebench extension
+    root[std::to_string(id)] = e;
+  }
+  write_json(path, root);
+}
+
+// ---------------------------------------------------------------- camera.json
+
+void write_camera_json(const std::string& path, const Intrinsics& K, double depth_scale) {
+  ojson j = ojson::object();
+  j["cx"] = K.cx;
+  j["cy"] = K.cy;
+  j["depth_scale"] = depth_scale;
+  j["fx"] = K.fx;
+  j["fy"] = K.fy;
+  j["height"] = K.height;
+  j["width"] = K.width;
+  write_json(path, j);
+}
+
+Intrinsics read_camera_json(const std::string& path, double* depth_scale) {
+  const json j = read_json(path);
+  const JRef r{j, path, ""};
+  if (!j.is_object()) throw InputError(path, "", "expected a JSON object");
+  Intrinsics K;
+  K.cx = r.key("cx").num();
+  K.cy = r.key("cy").num();
+  K.fx = r.key("fx").num();
+  K.fy = r.key("fy").num();
+  K.width = r.key("width").integer();
+  K.height = r.key("height").integer();
+  if (K.width <= 0) throw InputError(path, "width", "must be positive");
+  if (K.height <= 0) throw InputError(path, "height", "must be positive");
+  if (!(K.fx > 0)) throw InputError(path, "fx", "must be positive");
+  if (!(K.fy > 0)) throw InputError(path, "fy", "must be positive");
+  if (depth_scale) {
+    *depth_scale = r.has("depth_scale") ? r.key("depth_scale").num() : 1.0;
+    if (!(*depth_scale > 0)) throw InputError(path, "depth_scale", "must be positive");
+  }
+  return K;
+}
+
+// ---------------------------------------------------------------- scene json
+
+void write_scene_json(const std::string& scene_dir, const SceneInfo& scene) {
+  std::error_code ec;
+  fs::create_directories(scene_dir, ec);
+  if (ec) throw InputError(scene_dir, "output", "cannot create the folder: " + ec.message());
+  ojson cam = ojson::object(), gt = ojson::object(), info = ojson::object();
+  bool any_info = false;
+  for (const auto& [id, im] : scene.images) {
+    if (!im.gt_info.empty() && im.gt_info.size() != im.gt.size())
+      throw std::invalid_argument("write_scene_json: image " + std::to_string(id) +
+                                  " has gt_info not parallel to gt");
+    any_info = any_info || !im.gt_info.empty();
+  }
+  for (const auto& [id, im] : scene.images) {
+    const std::string key = std::to_string(id);
+    ojson c = ojson::object();
+    c["cam_K"] = rowmajor(im.K.K());
+    c["depth_scale"] = im.depth_scale;
+    cam[key] = c;
+    ojson g = ojson::array();
+    for (const auto& o : im.gt) {
+      ojson e = ojson::object();
+      e["cam_R_m2c"] = rowmajor(o.T_cam_model.R);
+      e["cam_t_m2c"] = vec3(o.T_cam_model.t);
+      e["obj_id"] = o.obj_id;
+      g.push_back(e);
+    }
+    gt[key] = g;
+    if (any_info) {
+      ojson a = ojson::array();
+      for (const auto& gi : im.gt_info) {
+        ojson e = ojson::object();
+        e["bbox_obj"] = int4(gi.bbox_obj);
+        e["bbox_visib"] = int4(gi.bbox_visib);
+        e["px_count_all"] = gi.px_count_all;
+        e["px_count_valid"] = gi.px_count_valid;
+        e["px_count_visib"] = gi.px_count_visib;
+        e["visib_fract"] = gi.visib_fract;
+        a.push_back(e);
+      }
+      info[key] = a;
+    }
+  }
+  write_json(join_path(scene_dir, "scene_camera.json"), cam);
+  write_json(join_path(scene_dir, "scene_gt.json"), gt);
+  if (any_info) write_json(join_path(scene_dir, "scene_gt_info.json"), info);
+}
+
+SceneInfo read_scene_json(const std::string& scene_dir) {
+  SceneInfo scene;
+  const std::string dirname = fs::path(scene_dir).lexically_normal().filename().string();
+  const std::string base = dirname.empty() ? fs::path(scene_dir).parent_path().filename().string() : dirname;
+  scene.scene_id = is_digits(base) && base.size() <= 9 ? std::stoi(base) : 0;
+
+  const std::string cam_path = join_path(scene_dir, "scene_camera.json");
+  const json cam = read_json(cam_path);
+  if (!cam.is_object()) throw InputError(cam_path, "", "expected a JSON object keyed by image id");
+  for (auto it = cam.begin(); it != cam.end(); ++it) {
+    ImageInfo im;
+    im.im_id = parse_id(it.key(), cam_path);
+    const JRef e{it.value(), cam_path, it.key()};
+    im.K = Intrinsics::from_K(mat3_rowmajor(e.key("cam_K").nums(9)), 0, 0);
+    im.depth_scale = e.has("depth_scale") ? e.key("depth_scale").num() : 1.0;
+    if (!(im.depth_scale > 0)) throw InputError(cam_path, e.join("depth_scale"), "must be positive");
+    scene.images[im.im_id] = im;
+  }
+
+  const std::string gt_path = join_path(scene_dir, "scene_gt.json");
+  if (fs::exists(gt_path)) {
+    const json gt = read_json(gt_path);
+    if (!gt.is_object()) throw InputError(gt_path, "", "expected a JSON object keyed by image id");
+    for (auto it = gt.begin(); it != gt.end(); ++it) {
+      const int id = parse_id(it.key(), gt_path);
+      auto im = scene.images.find(id);
+      if (im == scene.images.end()) throw InputError(gt_path, it.key(), "image id not in scene_camera.json");
+      const JRef list{it.value(), gt_path, it.key()};
+      list.array(0);
+      for (size_t i = 0; i < list.j.size(); ++i) {
+        const JRef e = list.at(i);
+        GtObject o;
+        o.obj_id = e.key("obj_id").integer();
+        o.T_cam_model.R = mat3_rowmajor(e.key("cam_R_m2c").nums(9));
+        const auto t = e.key("cam_t_m2c").nums(3);
+        o.T_cam_model.t = Vec3(t[0], t[1], t[2]);
+        im->second.gt.push_back(o);
+      }
+    }
+  }
+
+  const std::string info_path = join_path(scene_dir, "scene_gt_info.json");
+  if (fs::exists(info_path)) {
+    const json info = read_json(info_path);
+    if (!info.is_object()) throw InputError(info_path, "", "expected a JSON object keyed by image id");
+    for (auto it = info.begin(); it != info.end(); ++it) {
+      const int id = parse_id(it.key(), info_path);
+      auto im = scene.images.find(id);
+      if (im == scene.images.end()) throw InputError(info_path, it.key(), "image id not in scene_camera.json");
+      const JRef list{it.value(), info_path, it.key()};
+      list.array(0);
+      if (list.j.size() != im->second.gt.size())
+        throw InputError(info_path, it.key(),
+                         std::to_string(list.j.size()) + " entries but scene_gt.json has " +
+                             std::to_string(im->second.gt.size()));
+      for (size_t i = 0; i < list.j.size(); ++i) {
+        const JRef e = list.at(i);
+        GtInfo g;
+        g.bbox_obj = e.key("bbox_obj").int4();
+        g.bbox_visib = e.key("bbox_visib").int4();
+        g.px_count_all = e.key("px_count_all").integer();
+        g.px_count_valid = e.key("px_count_valid").integer();
+        g.px_count_visib = e.key("px_count_visib").integer();
+        g.visib_fract = e.key("visib_fract").num();
+        im->second.gt_info.push_back(g);
+      }
+    }
+  }
+  return scene;
+}
+
+// ---------------------------------------------------------------- BopDataset
+
+BopDataset::BopDataset(std::string root) : root_(std::move(root)) {
+  std::error_code ec;
+  if (!fs::is_directory(root_, ec))
+    throw InputError(root_, "dataset", "not a BOP dataset: no such folder");
+  const std::string info = join_path(join_path(root_, "models"), "models_info.json");
+  if (!fs::exists(info, ec))
+    throw InputError(root_, "dataset", "not a BOP dataset: models/models_info.json is missing");
+  if (splits().empty())
+    throw InputError(root_, "dataset",
+                     "not a BOP dataset: no split folder with scenes (e.g. test/000001/scene_camera.json)");
+  models_ = read_models_info(info);
+  const std::string cam = join_path(root_, "camera.json");
+  if (fs::exists(cam, ec)) {
+    double s = 1.0;
+    camera_ = read_camera_json(cam, &s);
+    camera_depth_scale_ = s;
+  }
+}
+
+std::vector<std::string> BopDataset::splits() const {
+  std::vector<std::string> out;
+  std::error_code ec;
+  for (const auto& d : fs::directory_iterator(root_, ec)) {
+    if (!d.is_directory()) continue;
+    const std::string name = d.path().filename().string();
+    if (name.rfind("models", 0) == 0) continue;
+    if (!scene_ids(name).empty()) out.push_back(name);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<int> BopDataset::scene_ids(const std::string& split) const {
+  std::vector<int> ids;
+  std::error_code ec;
+  const fs::path dir = fs::path(root_) / split;
+  if (!fs::is_directory(dir, ec)) return ids;
+  for (const auto& d : fs::directory_iterator(dir, ec)) {
+    const std::string name = d.path().filename().string();
+    if (d.is_directory() && is_digits(name) && name.size() <= 9 && fs::exists(d.path() / "scene_camera.json"))
+      ids.push_back(std::stoi(name));
+  }
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
+
+std::string BopDataset::scene_dir(const std::string& split, int scene_id) const {
+  return join_path(join_path(root_, split), bop_id(scene_id));
+}
+
+SceneInfo BopDataset::load_scene(const std::string& split, int scene_id) const {
+  const std::string dir = scene_dir(split, scene_id);
+  if (!fs::exists(join_path(dir, "scene_camera.json")))
+    throw InputError(dir, "scene", "no scene " + std::to_string(scene_id) + " in split '" + split + "'");
+  SceneInfo s = read_scene_json(dir);
+  s.scene_id = scene_id;
+  for (auto& [id, im] : s.images) {
+    if (camera_) {
+      im.K.width = camera_->width;
+      im.K.height = camera_->height;
+    } else {
+      const std::string p = bop_depth_path(dir, id);
+      if (fs::exists(p)) {
+        const PngHeader h = read_png_header(p);
+        im.K.width = h.width;
+        im.K.height = h.height;
+      }
+    }
+  }
+  return s;
+}
+
+DepthImage BopDataset::load_depth(const std::string& split, int scene_id, const ImageInfo& im) const {
+  const std::string p = bop_depth_path(scene_dir(split, scene_id), im.im_id);
+  DepthImage d = read_depth_png(p, im.depth_scale);
+  if ((im.K.width > 0 && d.width != im.K.width) || (im.K.height > 0 && d.height != im.K.height))
+    throw InputError(p, "depth",
+                     "image is " + std::to_string(d.width) + "x" + std::to_string(d.height) + " but the camera is " +
+                         std::to_string(im.K.width) + "x" + std::to_string(im.K.height));
+  return d;
+}
+
+const ModelInfo& BopDataset::model_info(int obj_id) const {
+  auto it = models_.find(obj_id);
+  if (it == models_.end())
+    throw InputError(join_path(join_path(root_, "models"), "models_info.json"), std::to_string(obj_id),
+                     "unknown object id " + std::to_string(obj_id));
+  return it->second;
+}
+
+int BopDataset::resolve_object(const std::string& s) const {
+  const std::string info = join_path(join_path(root_, "models"), "models_info.json");
+  std::string digits;
+  if (is_digits(s)) digits = s;
+  else if (s.rfind("obj_", 0) == 0 && is_digits(s.substr(4))) digits = s.substr(4);
+  if (!digits.empty() && digits.size() <= 9) {
+    const int id = std::stoi(digits);
+    if (models_.count(id)) return id;
+  }
+  for (const auto& [id, m] : models_)
+    if (!m.name.empty() && m.name == s) return id;
+  std::string known;
+  for (const auto& [id, m] : models_) {
+    if (!known.empty()) known += ", ";
+    known += std::to_string(id);
+    if (!m.name.empty()) known += " (" + m.name + ")";
+  }
+  throw InputError(info, "object", "unknown object '" + s + "' (known: " + known + ")");
+}
+
+std::string BopDataset::model_path(int obj_id) const {
+  return join_path(join_path(root_, "models"), "obj_" + bop_id(obj_id) + ".ply");
+}
+
+Mesh BopDataset::load_model(int obj_id) const {
+  model_info(obj_id);  // unknown id -> InputError
+  return load_mesh(model_path(obj_id));
+}
+
+}  // namespace pb
