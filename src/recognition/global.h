@@ -20,6 +20,13 @@ struct GlobalSettings {
   double crh_peak_threshold = 0.3;      // distinct CRH peaks above this fraction of the max
   int crh_max_peaks = 3;                // at most this many roll hypotheses per match
   bool skip_crh = false;                // assume the object upright: roll from the view (Table 4.4)
+  // Added by the global pipeline (PCL's defaults where PCL has the value):
+  double cvfh_normal_radius_mm = 20.0;  // normals recomputed on the low-curvature points (CVFH, CESF)
+  bool cvfh_normalize_bins = false;     // CVFH bins count points (thesis, PCL default); true: percentages
+  double crh_peak_distance_deg = 10.0;  // distinct CRH peaks are at least this far apart (PCL: 10)
+  double ourcvfh_axis_ratio = 0.8;      // OUR-CVFH: axes this similarly hard to disambiguate -> several frames
+  double ourcvfh_min_axis_value = 0.925;  // OUR-CVFH: above this, all 4 axis combinations are kept
+  double ourcvfh_refine_clusters = 1.0; // OUR-CVFH: region points within this x eps angle of the mean normal
 };
 
 void parse_global(const YamlNode& node, GlobalSettings& s);

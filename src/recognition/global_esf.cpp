@@ -1,0 +1,202 @@
+// Our ESF (see global_esf.h). No global state: the occupancy grid and every
+// histogram live on this call's stack/heap, randomness comes from `rng`.
+#include "recognition/global_esf.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+
+namespace pb {
+namespace {
+
+constexpr int kG = kEsfGridSize;
+constexpr int kHalf = kG / 2;
+constexpr int kB = kEsfBinsPerHistogram;
+
+enum Cls { kOn = 0, kOff = 1, kMixed = 2 };
+
+// Round-to-nearest of num / den for den > 0 (halves rounded up), exact in
+// integers for negative numerators too.
+inline int round_div(int num, int den) {
+  const int n2 = 2 * num + den, d2 = 2 * den;
+  return n2 >= 0 ? n2 / d2 : -((-n2 + d2 - 1) / d2);
+}
+
+class OccupancyGrid {
+ public:
+  OccupancyGrid() : cells_(static_cast<size_t>(kG) * kG * kG, 0) {}
+  static int cell(float c) { return std::clamp(static_cast<int>(std::floor(c)) + kHalf, 0, kG - 1); }
+  static Eigen::Vector3i cell(const Vec3f& p) { return {cell(p.x()), cell(p.y()), cell(p.z())}; }
+  // Marks the voxel of p and its 26 neighbours.
+  void mark(const Eigen::Vector3i& v) {
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const int x = v.x() + dx, y = v.y() + dy, z = v.z() + dz;
+          if (x < 0 || y < 0 || z < 0 || x >= kG || y >= kG || z >= kG) continue;
+          cells_[index(x, y, z)] = 1;
+        }
+  }
+  bool occupied(int x, int y, int z) const { return cells_[index(x, y, z)] != 0; }
+
+ private:
+  static size_t index(int x, int y, int z) { return (static_cast<size_t>(x) * kG + y) * kG + z; }
+  std::vector<uint8_t> cells_;
+};
+
+struct Line {
+  int count = 0;     // voxels visited
+  int occupied = 0;  // of which occupied
+  Cls cls = kOff;
+  float ratio = 0;   // occupied / count (used for MIXED)
+};
+
+// Traces the line from voxel a toward voxel b: max(|d|) voxels (at least
+// one), a included, b excluded, the minor axes rounded to nearest.
+Line trace(const OccupancyGrid& g, const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
+  const Eigen::Vector3i d = b - a;
+  const int n = std::max({std::abs(d.x()), std::abs(d.y()), std::abs(d.z())});
+  Line L;
+  L.count = std::max(n, 1);
+  for (int i = 0; i < L.count; ++i) {
+    const int x = n ? a.x() + round_div(d.x() * i, n) : a.x();
+    const int y = n ? a.y() + round_div(d.y() * i, n) : a.y();
+    const int z = n ? a.z() + round_div(d.z() * i, n) : a.z();
+    L.occupied += g.occupied(x, y, z) ? 1 : 0;
+  }
+  if (L.occupied >= L.count - 1) {
+    L.cls = kOn;
+  } else if (L.occupied <= 7) {
+    L.cls = kOff;
+  } else {
+    L.cls = kMixed;
+    L.ratio = static_cast<float>(L.occupied) / static_cast<float>(L.count);
+  }
+  return L;
+}
+
+// Bin of a value in [0, 1] over 64 bins (rounded), clamped.
+inline int unit_bin(double v) {
+  return std::clamp(static_cast<int>(std::lround(v * (kB - 1))), 0, kB - 1);
+}
+
+// Bin of an angle from |cos|, folded to [0, 90] degrees.
+inline int angle_bin(float abs_cos) {
+  const double c = std::clamp(static_cast<double>(abs_cos), 0.0, 1.0);
+  return unit_bin(std::acos(c) / (M_PI / 2));
+}
+
+}  // namespace
+
+std::vector<float> compute_esf(const std::vector<Vec3f>& points_in, Rng& rng, int samples) {
+  std::vector<float> out(kEsfBins, 0.f);
+  std::vector<Vec3f> pts;
+  pts.reserve(points_in.size());
+  for (const auto& p : points_in)
+    if (p.allFinite()) pts.push_back(p);
+  const int n = static_cast<int>(pts.size());
+  if (n < 3 || samples <= 0) return out;
+
+  // Centre on the centroid, scale the farthest point to kHalf voxels.
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const auto& p : pts) c += p.cast<double>();
+  c /= n;
+  double max_d = 0;
+  for (const auto& p : pts) max_d = std::max(max_d, (p.cast<double>() - c).norm());
+  if (!(max_d > 0)) return out;
+  const double scale = kHalf / max_d;
+  std::vector<Vec3f> q(n);
+  std::vector<Eigen::Vector3i> vox(n);
+  OccupancyGrid grid;
+  for (int i = 0; i < n; ++i) {
+    q[i] = ((pts[i].cast<double>() - c) * scale).cast<float>();
+    vox[i] = OccupancyGrid::cell(q[i]);
+    grid.mark(vox[i]);
+  }
+
+  // Per valid triple: three D2 values with their classes, one D3 value with
+  // its class; A3 and the D2 ratio are binned directly.
+  std::vector<float> d2;
+  std::vector<uint8_t> d2_cls;
+  std::vector<float> d3;
+  std::vector<uint8_t> d3_cls;
+  d2.reserve(3 * static_cast<size_t>(samples));
+  d2_cls.reserve(3 * static_cast<size_t>(samples));
+  d3.reserve(samples);
+  d3_cls.reserve(samples);
+  std::array<std::array<double, kB>, 3> a3{};
+  std::array<double, kB> ratio{};
+
+  const long long max_draws = 50LL * samples;
+  int valid = 0;
+  for (long long draw = 0; valid < samples && draw < max_draws; ++draw) {
+    const int i1 = rng.uniform_int(0, n - 1);
+    const int i2 = rng.uniform_int(0, n - 1);
+    const int i3 = rng.uniform_int(0, n - 1);
+    if (i1 == i2 || i1 == i3 || i2 == i3) continue;
+    const Vec3f v21 = q[i2] - q[i1], v31 = q[i3] - q[i1], v23 = q[i2] - q[i3];
+    const float a = v21.norm(), b = v31.norm(), cc = v23.norm();
+    const float s = 0.5f * (a + b + cc);
+    const float area2 = s * (s - a) * (s - b) * (s - cc);  // Heron: squared area
+    if (!(area2 > 0.001f)) continue;
+
+    // Angles at p1 (between 1->2 and 1->3), at p3 and at p2.
+    const int th1 = angle_bin(std::abs(v21.dot(v31)) / (a * b));
+    const int th3 = angle_bin(std::abs(v23.dot(v31)) / (cc * b));
+    const int th2 = angle_bin(std::abs(v23.dot(v21)) / (cc * a));
+
+    const Line l12 = trace(grid, vox[i1], vox[i2]);
+    const Line l13 = trace(grid, vox[i1], vox[i3]);
+    const Line l23 = trace(grid, vox[i2], vox[i3]);
+    d2.push_back(a);
+    d2_cls.push_back(static_cast<uint8_t>(l12.cls));
+    d2.push_back(b);
+    d2_cls.push_back(static_cast<uint8_t>(l13.cls));
+    d2.push_back(cc);
+    d2_cls.push_back(static_cast<uint8_t>(l23.cls));
+    for (const Line* l : {&l12, &l13, &l23})
+      if (l->cls == kMixed) ratio[unit_bin(l->ratio)] += 1;
+
+    const int occ = l12.occupied + l13.occupied + l23.occupied;
+    const int cnt = l12.count + l13.count + l23.count;
+    Cls tri = kMixed;
+    if (occ <= 21)
+      tri = kOff;
+    else if (cnt - occ < 4)
+      tri = kOn;
+    d3.push_back(std::sqrt(std::sqrt(area2)));
+    d3_cls.push_back(static_cast<uint8_t>(tri));
+    // Each angle weighted by the length (in voxels) of the opposite line.
+    a3[tri][th1] += l23.count / 32.0;
+    a3[tri][th2] += l13.count / 32.0;
+    a3[tri][th3] += l12.count / 32.0;
+    ++valid;
+  }
+  if (valid == 0) return out;
+
+  const float max_d2 = *std::max_element(d2.begin(), d2.end());
+  const float max_d3 = *std::max_element(d3.begin(), d3.end());
+  std::array<std::array<double, kB>, 3> h2{}, h3{};
+  for (size_t i = 0; i < d2.size(); ++i) h2[d2_cls[i]][unit_bin(d2[i] / max_d2)] += 1;
+  for (size_t i = 0; i < d3.size(); ++i) h3[d3_cls[i]][unit_bin(d3[i] / max_d3)] += 1;
+
+  // Concatenation and weights as PCL: A3 on/off/mixed, D3 on/off/mixed, D2
+  // on/off/mixed, D2 ratio.
+  const std::array<const std::array<double, kB>*, 10> parts = {&a3[kOn], &a3[kOff], &a3[kMixed], &h3[kOn],
+                                                               &h3[kOff], &h3[kMixed], &h2[kOn], &h2[kOff],
+                                                               &h2[kMixed], &ratio};
+  const std::array<double, 10> weights = {0.5, 0.5, 0.5, 0.5, 0.5, 1.0, 0.5, 2.0, 2.0, 1.0};
+  std::array<double, kEsfBins> h{};
+  double sum = 0;
+  for (int k = 0; k < 10; ++k)
+    for (int j = 0; j < kB; ++j) {
+      h[k * kB + j] = (*parts[k])[j] * weights[k];
+      sum += h[k * kB + j];
+    }
+  if (!(sum > 0)) return out;
+  for (int i = 0; i < kEsfBins; ++i) out[i] = static_cast<float>(h[i] / sum);
+  return out;
+}
+
+}  // namespace pb

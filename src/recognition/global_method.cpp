@@ -1,0 +1,350 @@
+// The global pipeline's methods (cvfh, esf, cesf, ourcvfh): training,
+// matching and initial pose. PCL-free; the PCL parts are behind
+// global_internal.h.
+//
+// Online, per image (THESIS.md "Global pipeline"):
+//  1. describe: Euclidean clusters of the preprocessed scene, then the
+//     method's signatures per cluster (CVFH / OUR-CVFH / CESF: one per stable
+//     region; ESF: one per cluster);
+//  2. match: L2 distance of every scene signature to every model signature;
+//     the top_k pairs overall, ordered by distance, then view, then model
+//     signature, then scene signature (deterministic);
+//  3. initial pose per pair: translation from the centroid difference; two
+//     rotational DoF from aligning the axes (the negated mean normals of the
+//     regions, or the camera-to-centroid directions), the roll about that
+//     axis from the CRH (each distinct peak one hypothesis, up to
+//     crh_max_peaks) or, with skip_crh, from the upright assumption;
+//     OUR-CVFH: from the two semi-global reference frames instead.
+//  Hypothesis: T_cam_model = T_cam_view_aligned * T_view_model, score
+//  1 / (1 + histogram distance).
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <istream>
+#include <ostream>
+#include <tuple>
+
+#include "core/error.h"
+#include "core/random.h"
+#include "core/timer.h"
+#include "recognition/global_esf.h"
+#include "recognition/global_internal.h"
+#include "recognition/method.h"
+#include "recognition/pipeline.h"
+
+namespace pb {
+namespace global {
+
+Mat3 roll_rotation(const Vec3f& view_axis, const Vec3f& scene_axis, double theta) {
+  const Mat3 Rv = rotation_to_z(view_axis.cast<double>());
+  const Mat3 Rs = rotation_to_z(scene_axis.cast<double>());
+  return Rs.transpose() * Eigen::AngleAxisd(theta, Vec3::UnitZ()).toRotationMatrix() * Rv;
+}
+
+double upright_roll(const Vec3f& view_axis, const Vec3f& scene_axis) {
+  const Vec3 up(0, -1, 0);
+  const Vec3 uv = rotation_to_z(view_axis.cast<double>()) * up;
+  const Vec3 us = rotation_to_z(scene_axis.cast<double>()) * up;
+  if (std::hypot(uv.x(), uv.y()) < 1e-6 || std::hypot(us.x(), us.y()) < 1e-6) return 0.0;
+  return std::atan2(us.y(), us.x()) - std::atan2(uv.y(), uv.x());
+}
+
+}  // namespace global
+
+namespace {
+
+using global::Signature;
+
+enum class Kind { kCvfh, kEsf, kCesf, kOurCvfh };
+
+const char* kind_name(Kind k) {
+  switch (k) {
+    case Kind::kCvfh: return "cvfh";
+    case Kind::kEsf: return "esf";
+    case Kind::kCesf: return "cesf";
+    case Kind::kOurCvfh: return "ourcvfh";
+  }
+  return "?";
+}
+
+// Seeds of the ESF samples: training views from the settings' seed, scene
+// clusters from the call's seed; one stream per cloud and region.
+constexpr uint64_t kTrainStream = 0x6C6F62616C545256ull;  // "globalTRV"
+constexpr uint64_t kSceneStream = 0x6C6F62616C534345ull;
+
+Vec3f mean_point(const std::vector<Vec3f>& pts) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const auto& p : pts) c += p.cast<double>();
+  return pts.empty() ? Vec3f::Zero() : Vec3f((c / static_cast<double>(pts.size())).cast<float>());
+}
+
+// The method's signatures of one cloud (a training view or a scene cluster).
+std::vector<Signature> describe(Kind kind, const PointSet& cloud, const GlobalSettings& g, uint64_t seed) {
+  std::vector<Signature> out;
+  switch (kind) {
+    case Kind::kCvfh:
+      return global::cvfh_signatures(cloud, g);
+    case Kind::kOurCvfh:
+      return global::ourcvfh_signatures(cloud, g);
+    case Kind::kEsf: {
+      if (cloud.size() < 3) return out;
+      Rng rng(derive_seed(seed, {0}));
+      Signature s;
+      s.hist = compute_esf(cloud.points, rng, g.esf_samples);
+      s.centroid = mean_point(cloud.points);
+      if (!(s.centroid.norm() > 0)) return out;
+      s.axis = s.centroid.normalized();
+      out.push_back(std::move(s));
+      return out;
+    }
+    case Kind::kCesf: {
+      const auto regions = global::stable_regions(cloud, g);
+      for (size_t r = 0; r < regions.size(); ++r) {
+        Rng rng(derive_seed(seed, {r + 1}));
+        Signature s;
+        s.hist = compute_esf(regions[r].points, rng, g.esf_samples);
+        s.centroid = regions[r].centroid;
+        s.axis = -regions[r].mean_normal;
+        s.from_normal = true;
+        out.push_back(std::move(s));
+      }
+      return out;
+    }
+  }
+  return out;
+}
+
+double l2(const std::vector<float>& a, const std::vector<float>& b) {
+  double s = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    const double d = static_cast<double>(a[i]) - b[i];
+    s += d * d;
+  }
+  return std::sqrt(s);
+}
+
+Mat3 nearest_rotation(const Mat3& M) {
+  Eigen::JacobiSVD<Mat3> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Mat3 U = svd.matrixU();
+  const Mat3 V = svd.matrixV();
+  if ((U * V.transpose()).determinant() < 0) U.col(2) *= -1;
+  return U * V.transpose();
+}
+
+// --- binary (de)serialization helpers ---
+template <typename T>
+void put(std::ostream& o, const T& v) {
+  o.write(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+template <typename T>
+T take(std::istream& in) {
+  T v{};
+  in.read(reinterpret_cast<char*>(&v), sizeof(T));
+  if (!in) throw InputError("", "cache", "truncated global descriptor state");
+  return v;
+}
+void put_floats(std::ostream& o, const std::vector<float>& v) {
+  put<uint32_t>(o, static_cast<uint32_t>(v.size()));
+  if (!v.empty()) o.write(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(float));
+}
+std::vector<float> take_floats(std::istream& in) {
+  const uint32_t n = take<uint32_t>(in);
+  if (n > (1u << 20)) throw InputError("", "cache", "corrupt global descriptor state (histogram size)");
+  std::vector<float> v(n);
+  if (n) in.read(reinterpret_cast<char*>(v.data()), n * sizeof(float));
+  if (!in) throw InputError("", "cache", "truncated global descriptor state");
+  return v;
+}
+void put_pose(std::ostream& o, const Pose& p) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) put<double>(o, p.R(r, c));
+  for (int r = 0; r < 3; ++r) put<double>(o, p.t(r));
+}
+Pose take_pose(std::istream& in) {
+  Pose p;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) p.R(r, c) = take<double>(in);
+  for (int r = 0; r < 3; ++r) p.t(r) = take<double>(in);
+  return p;
+}
+void put_vec(std::ostream& o, const Vec3f& v) {
+  for (int i = 0; i < 3; ++i) put<float>(o, v(i));
+}
+Vec3f take_vec(std::istream& in) {
+  Vec3f v;
+  for (int i = 0; i < 3; ++i) v(i) = take<float>(in);
+  return v;
+}
+
+constexpr char kMagic[8] = {'P', 'B', 'G', 'L', 'O', 'B', 'A', 'L'};
+constexpr uint32_t kVersion = 1;
+
+class GlobalMethod : public Method {
+ public:
+  explicit GlobalMethod(Kind kind) : kind_(kind) {}
+  std::string name() const override { return kind_name(kind_); }
+
+  void train(const std::vector<ViewData>& views, const RecognitionSettings& s) override {
+    sigs_.clear();
+    view_poses_.clear();
+    for (size_t v = 0; v < views.size(); ++v) {
+      view_poses_.push_back(views[v].T_cam_model);
+      auto sigs = describe(kind_, views[v].cloud, s.global, derive_seed(s.seed, {kTrainStream, v}));
+      for (auto& sig : sigs) {
+        sig.source = static_cast<int>(v);
+        sig.crh = global::crh_spectrum(views[v].cloud, sig.axis);
+        sigs_.push_back(std::move(sig));
+      }
+    }
+  }
+
+  void save(std::ostream& out) const override {
+    out.write(kMagic, sizeof(kMagic));
+    put<uint32_t>(out, kVersion);
+    put<uint32_t>(out, static_cast<uint32_t>(kind_));
+    put<uint32_t>(out, static_cast<uint32_t>(view_poses_.size()));
+    for (const auto& p : view_poses_) put_pose(out, p);
+    put<uint32_t>(out, static_cast<uint32_t>(sigs_.size()));
+    for (const auto& s : sigs_) {
+      put<int32_t>(out, s.source);
+      put_floats(out, s.hist);
+      put_vec(out, s.centroid);
+      put_vec(out, s.axis);
+      put<uint8_t>(out, s.from_normal ? 1 : 0);
+      put<uint8_t>(out, s.has_rf ? 1 : 0);
+      put_pose(out, s.T_rf_cam);
+      put_floats(out, s.crh);
+    }
+  }
+
+  void load(std::istream& in) override {
+    char magic[sizeof(kMagic)];
+    in.read(magic, sizeof(magic));
+    if (!in || std::memcmp(magic, kMagic, sizeof(kMagic)) != 0)
+      throw InputError("", "cache", "not a global descriptor state");
+    if (take<uint32_t>(in) != kVersion) throw InputError("", "cache", "global descriptor state of another version");
+    if (take<uint32_t>(in) != static_cast<uint32_t>(kind_))
+      throw InputError("", "cache", std::string("global descriptor state is not ") + kind_name(kind_));
+    std::vector<Pose> poses(take<uint32_t>(in));
+    for (auto& p : poses) p = take_pose(in);
+    const uint32_t n = take<uint32_t>(in);
+    std::vector<Signature> sigs;
+    for (uint32_t i = 0; i < n; ++i) {
+      Signature s;
+      s.source = take<int32_t>(in);
+      if (s.source < 0 || static_cast<size_t>(s.source) >= poses.size())
+        throw InputError("", "cache", "corrupt global descriptor state (view index)");
+      s.hist = take_floats(in);
+      s.centroid = take_vec(in);
+      s.axis = take_vec(in);
+      s.from_normal = take<uint8_t>(in) != 0;
+      s.has_rf = take<uint8_t>(in) != 0;
+      s.T_rf_cam = take_pose(in);
+      s.crh = take_floats(in);
+      sigs.push_back(std::move(s));
+    }
+    view_poses_ = std::move(poses);
+    sigs_ = std::move(sigs);
+  }
+
+  std::vector<Hypothesis> hypothesize(const PointSet& scene, const std::vector<ViewData>& /*views*/,
+                                      const RecognitionSettings& s, uint64_t seed,
+                                      StageTimes& times) const override {
+    const GlobalSettings& g = s.global;
+    std::vector<Hypothesis> hyps;
+
+    // 1. Segmentation and description.
+    Timer timer;
+    const auto clusters =
+        global::euclidean_clusters(scene.points, g.cluster_tolerance_mm, g.cluster_min_points, g.cluster_max_points);
+    std::vector<PointSet> cluster_clouds;
+    std::vector<Signature> scene_sigs;
+    for (size_t c = 0; c < clusters.size(); ++c) {
+      cluster_clouds.push_back(global::subset(scene, clusters[c]));
+      auto sigs = describe(kind_, cluster_clouds.back(), g, derive_seed(seed, {kSceneStream, c}));
+      for (auto& sig : sigs) {
+        sig.source = static_cast<int>(c);
+        scene_sigs.push_back(std::move(sig));
+      }
+    }
+    times.describe += timer.seconds();
+
+    // 2. Matching: every pair, the top_k overall.
+    timer.reset();
+    struct Match {
+      double dist;
+      int view, model, scene;
+    };
+    std::vector<Match> matches;
+    for (size_t i = 0; i < scene_sigs.size(); ++i)
+      for (size_t j = 0; j < sigs_.size(); ++j) {
+        if (sigs_[j].hist.size() != scene_sigs[i].hist.size()) continue;
+        const double d = l2(scene_sigs[i].hist, sigs_[j].hist);
+        if (!std::isfinite(d)) continue;
+        matches.push_back({d, sigs_[j].source, static_cast<int>(j), static_cast<int>(i)});
+      }
+    const auto order = [](const Match& a, const Match& b) {
+      return std::tie(a.dist, a.view, a.model, a.scene) < std::tie(b.dist, b.view, b.model, b.scene);
+    };
+    const size_t k = std::min(matches.size(), static_cast<size_t>(std::max(g.top_k, 1)));
+    std::partial_sort(matches.begin(), matches.begin() + k, matches.end(), order);
+    matches.resize(k);
+    times.match += timer.seconds();
+
+    // 3. Initial poses.
+    timer.reset();
+    std::vector<std::vector<float>> scene_crh(scene_sigs.size());
+    std::vector<char> crh_done(scene_sigs.size(), 0);
+    for (const Match& m : matches) {
+      const Signature& ms = sigs_[m.model];
+      const Signature& ss = scene_sigs[m.scene];
+      const Pose& T_view_model = view_poses_[ms.source];
+      const double score = 1.0 / (1.0 + m.dist);
+      std::vector<Pose> T_cam_view;
+      if (kind_ == Kind::kOurCvfh && ms.has_rf && ss.has_rf) {
+        Pose T = ss.T_rf_cam.inverse() * ms.T_rf_cam;
+        T.R = nearest_rotation(T.R);
+        T_cam_view.push_back(T);
+      } else {
+        std::vector<double> rolls;
+        if (!g.skip_crh) {
+          if (!crh_done[m.scene]) {
+            scene_crh[m.scene] = global::crh_spectrum(cluster_clouds[ss.source], ss.axis);
+            crh_done[m.scene] = 1;
+          }
+          rolls = global::crh_roll_peaks(scene_crh[m.scene], ms.crh, g);
+        }
+        if (rolls.empty()) rolls.push_back(global::upright_roll(ms.axis, ss.axis));
+        for (double theta : rolls) {
+          Pose T;
+          T.R = global::roll_rotation(ms.axis, ss.axis, theta);
+          T.t = ss.centroid.cast<double>() - T.R * ms.centroid.cast<double>();
+          T_cam_view.push_back(T);
+        }
+      }
+      for (const Pose& T : T_cam_view) {
+        Hypothesis h;
+        h.T_cam_model = T * T_view_model;
+        h.view = ms.source;
+        h.score = score;
+        hyps.push_back(h);
+      }
+    }
+    times.initial_pose += timer.seconds();
+    return hyps;
+  }
+
+ private:
+  Kind kind_;
+  std::vector<Signature> sigs_;   // every training view's signatures (source = view)
+  std::vector<Pose> view_poses_;  // T_view_model of each training view
+};
+
+}  // namespace
+
+std::unique_ptr<Method> make_cvfh_method() { return std::make_unique<GlobalMethod>(Kind::kCvfh); }
+std::unique_ptr<Method> make_esf_method() { return std::make_unique<GlobalMethod>(Kind::kEsf); }
+std::unique_ptr<Method> make_cesf_method() { return std::make_unique<GlobalMethod>(Kind::kCesf); }
+std::unique_ptr<Method> make_ourcvfh_method() { return std::make_unique<GlobalMethod>(Kind::kOurCvfh); }
+
+}  // namespace pb

@@ -1,0 +1,111 @@
+// OUR-CVFH signatures with their semi-global unique reference frames, through
+// pcl::OURCVFHEstimation. PCL's implementation hard-codes a 1 cm sigma for its
+// octant weights, so the cloud is passed in metres and the frames converted
+// back to millimetres.
+#include <pcl/features/our_cvfh.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pcl/search/kdtree.h>
+
+#include <cmath>
+
+#include "recognition/global_internal.h"
+
+namespace pb::global {
+
+std::vector<Signature> ourcvfh_signatures(const PointSet& cloud, const GlobalSettings& s) {
+  std::vector<Signature> out;
+  if (!cloud.has_normals()) return out;
+  constexpr float kToM = 0.001f;
+  const size_t n = cloud.points.size();
+  const bool has_c = cloud.curvature.size() == n;
+  pcl::PointCloud<pcl::PointXYZ>::Ptr pts(new pcl::PointCloud<pcl::PointXYZ>);
+  pcl::PointCloud<pcl::Normal>::Ptr nrm(new pcl::PointCloud<pcl::Normal>);
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3f& nv = cloud.normals[i];
+    if (!cloud.points[i].allFinite() || !nv.allFinite() || std::abs(nv.norm() - 1.f) > 0.01f) continue;
+    pcl::PointXYZ p;
+    p.getVector3fMap() = cloud.points[i] * kToM;
+    pcl::Normal q;
+    q.getNormalVector3fMap() = nv;
+    q.curvature = has_c && std::isfinite(cloud.curvature[i]) ? cloud.curvature[i] : 0.f;
+    pts->push_back(p);
+    nrm->push_back(q);
+  }
+  // Guard (PCL issues 1449, 1491): too few points for a region and its frame.
+  if (pts->size() < static_cast<size_t>(std::max(s.cvfh_min_region_points, 10))) return out;
+
+  pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(new pcl::search::KdTree<pcl::PointXYZ>);
+  pcl::OURCVFHEstimation<pcl::PointXYZ, pcl::Normal, pcl::VFHSignature308> est;
+  est.setInputCloud(pts);
+  est.setInputNormals(nrm);
+  est.setSearchMethod(tree);
+  est.setViewPoint(0.f, 0.f, 0.f);
+  est.setEPSAngleThreshold(static_cast<float>(s.cvfh_eps_angle_deg * M_PI / 180.0));
+  est.setCurvatureThreshold(static_cast<float>(s.cvfh_curvature_threshold));
+  est.setClusterTolerance(static_cast<float>(s.cvfh_cluster_tolerance_mm) * kToM);
+  est.setRadiusNormals(static_cast<float>(s.cvfh_normal_radius_mm) * kToM);
+  est.setMinPoints(static_cast<size_t>(std::max(s.cvfh_min_region_points, 1)));
+  est.setNormalizeBins(s.cvfh_normalize_bins);
+  est.setAxisRatio(static_cast<float>(s.ourcvfh_axis_ratio));
+  est.setMinAxisValue(static_cast<float>(s.ourcvfh_min_axis_value));
+  est.setRefineClusters(static_cast<float>(s.ourcvfh_refine_clusters));
+  pcl::PointCloud<pcl::VFHSignature308> sigs;
+  est.compute(sigs);
+
+  std::vector<Eigen::Vector3f, Eigen::aligned_allocator<Eigen::Vector3f>> centroids, normals;
+  est.getCentroidClusters(centroids);
+  est.getCentroidNormalClusters(normals);
+  std::vector<Eigen::Matrix4f, Eigen::aligned_allocator<Eigen::Matrix4f>> transforms;
+  est.getTransforms(transforms);
+  std::vector<bool> valid;
+  est.getValidTransformsVec(valid);
+  std::vector<short> axes_per_cluster;
+  est.getClusterAxes(axes_per_cluster);
+
+  // Signature k belongs to the region whose frames it enumerates (issue 737:
+  // a region can have 1, 2 or 4 frames).
+  std::vector<int> region_of;
+  if (!normals.empty()) {
+    for (size_t r = 0; r < axes_per_cluster.size(); ++r)
+      for (int a = 0; a < axes_per_cluster[r]; ++a) region_of.push_back(static_cast<int>(r));
+  }
+  for (size_t k = 0; k < sigs.size(); ++k) {
+    Signature sig;
+    sig.hist.assign(sigs[k].histogram, sigs[k].histogram + 308);
+    bool finite = true;
+    for (float v : sig.hist) finite = finite && std::isfinite(v);
+    if (!finite) continue;
+    const int r = k < region_of.size() ? region_of[k] : -1;
+    if (r >= 0 && static_cast<size_t>(r) < centroids.size() && static_cast<size_t>(r) < normals.size()) {
+      sig.centroid = centroids[r] / kToM;
+      if (normals[r].allFinite() && normals[r].norm() > 0.5f) {
+        sig.axis = -normals[r].normalized();
+        sig.from_normal = true;
+      } else {
+        sig.axis = sig.centroid.normalized();
+      }
+    } else if (!centroids.empty()) {
+      sig.centroid = centroids.front() / kToM;
+      sig.axis = sig.centroid.normalized();
+    } else {
+      continue;
+    }
+    if (k < transforms.size() && k < valid.size() && valid[k] && transforms[k].allFinite()) {
+      Mat4 T = transforms[k].cast<double>();
+      T.block<3, 1>(0, 3) /= kToM;
+      Pose P = Pose::from_matrix(T);
+      // PCL builds the frame as (x, x cross z, z): a reflection (det -1).
+      // Keep it as is (orthonormalized, sign kept): the composition of a
+      // scene frame with a view frame is a proper rotation again.
+      Eigen::JacobiSVD<Mat3> svd(P.R, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      P.R = svd.matrixU() * svd.matrixV().transpose();
+      sig.T_rf_cam = P;
+      sig.has_rf = true;
+    }
+    out.push_back(std::move(sig));
+  }
+  return out;
+}
+
+}  // namespace pb::global
