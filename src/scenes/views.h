@@ -16,7 +16,9 @@ struct ViewSettings {
   // evenly over a sphere (Fibonacci tessellation).
   int views = 12;
   double elevation_deg = 20.0;   // ring elevation above the horizontal plane
-  double distance_factor = 3.0;  // camera distance = factor * model diameter
+  double side_elevation_deg = 0.0;    // the single side view (views = 1): no top, no bottom
+  double below_elevation_deg = -45.0; // the 4 extra views of views = 12 (from below)
+  double distance_factor = 3.0;  // camera distance = factor * bounding-box diagonal (>= diameter)
   int resolution = 256;          // square image, pixels
   double fov_deg = 30.0;         // field of view, degrees
 };
@@ -27,6 +29,10 @@ struct TrainingView {
   OrganizedCloud cloud;   // from depth, camera frame
   Pose T_cam_model;       // model -> this view's camera
 };
+
+// Unit directions from the model origin to each camera (model frame, z up),
+// in the order render_training_views uses. InputError on bad settings.
+std::vector<Vec3> view_directions(const ViewSettings& settings);
 
 std::vector<TrainingView> render_training_views(const Mesh& mesh, const ViewSettings& settings);
 

@@ -1,0 +1,75 @@
+#include "scenes/views.h"
+
+#include <cmath>
+
+#include "core/error.h"
+#include "core/rotation.h"
+#include "render/renderer.h"
+
+namespace pb {
+
+namespace {
+
+Vec3 direction(double azimuth_deg, double elevation_deg) {
+  const double a = azimuth_deg * M_PI / 180.0, e = elevation_deg * M_PI / 180.0;
+  return {std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e)};
+}
+
+}  // namespace
+
+std::vector<Vec3> view_directions(const ViewSettings& s) {
+  if (s.views < 1) throw InputError("", "views", "must be at least 1, got " + std::to_string(s.views));
+  std::vector<Vec3> dirs;
+  if (s.views == 1) {
+    dirs.push_back(direction(-90.0, s.side_elevation_deg));  // from -y, the model's front
+  } else if (s.views == 8 || s.views == 12) {
+    for (int k = 0; k < 8; ++k) dirs.push_back(direction(45.0 * k, s.elevation_deg));
+    if (s.views == 12)
+      for (int k = 0; k < 4; ++k) dirs.push_back(direction(45.0 + 90.0 * k, s.below_elevation_deg));
+  } else {
+    // Fibonacci sphere: z evenly spaced, golden-angle azimuth steps.
+    const double golden = M_PI * (3.0 - std::sqrt(5.0));
+    for (int k = 0; k < s.views; ++k) {
+      const double z = 1.0 - (2.0 * k + 1.0) / s.views;
+      const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+      dirs.emplace_back(r * std::cos(golden * k), r * std::sin(golden * k), z);
+    }
+  }
+  return dirs;
+}
+
+std::vector<TrainingView> render_training_views(const Mesh& mesh, const ViewSettings& s) {
+  if (mesh.empty()) throw InputError("", "mesh", "empty mesh");
+  if (s.resolution < 8 || s.resolution > 8192)
+    throw InputError("", "resolution", "must be in [8, 8192], got " + std::to_string(s.resolution));
+  if (!(s.fov_deg > 0 && s.fov_deg < 170))
+    throw InputError("", "fov_deg", "must be in (0, 170), got " + std::to_string(s.fov_deg));
+  if (!(s.distance_factor > 0))
+    throw InputError("", "distance_factor", "must be positive, got " + std::to_string(s.distance_factor));
+  const auto dirs = view_directions(s);
+  // The camera looks at the model origin (the bounding box centre of a
+  // registry model); distance from the bounding box diagonal so that the
+  // whole model is in view for distance_factor >= ~1.5.
+  double diameter = mesh.bounds().diagonal().norm();
+  if (!(diameter > 0)) throw InputError("", "mesh", "degenerate mesh");
+  const double dist = s.distance_factor * diameter;
+  const Intrinsics K = Intrinsics::from_fov(s.resolution, s.resolution, s.fov_deg, s.fov_deg);
+  RenderSettings rs;
+  rs.near_mm = std::max(1.0, 0.1 * (dist - diameter));
+  rs.far_mm = dist + 2 * diameter;
+  DepthRenderer renderer(K, rs);
+  std::vector<TrainingView> views;
+  for (const Vec3& d : dirs) {
+    const Pose T_world_cam = look_at(d * dist, Vec3::Zero(), Vec3::UnitZ());
+    TrainingView v;
+    v.K = K;
+    v.T_cam_model = T_world_cam.inverse();
+    const RenderOutput out = renderer.render({RenderItem{&mesh, v.T_cam_model, 0}});
+    v.depth = out.depth;
+    v.cloud = OrganizedCloud::from_depth(v.depth, K);
+    views.push_back(std::move(v));
+  }
+  return views;
+}
+
+}  // namespace pb
