@@ -1,7 +1,29 @@
 // Sensor profiles (THESIS.md Table 2.1) and depth noise models. Every noise
 // model is seeded: the same Rng state gives the same noisy image.
+//
+// Noise models (all in mm, camera frame; `z` is the noise-free rendered depth):
+// - gaussian: z += N(0, sigma_mm) on every valid pixel (the thesis's
+//   synthetic images, sigma 1 mm).
+// - structured_light (Astra-like): disparity d = fx * baseline / z (projector
+//   at +baseline along x, rows are epipolar lines); d += N(0,
+//   disparity_sigma_px); box-averaged over the (2r+1)^2 valid neighbours whose
+//   true disparity is within smoothing_edge_px (the correlation window); then
+//   quantized to disparity_step_px and converted back, z = fx * b / d. So the
+//   error grows with z^2 / (fx b). No depth where the projector cannot see the
+//   surface (shadows: another surface lies between the point and the
+//   projector, found by z-buffering the points in the projector's view, which
+//   is a running minimum of the projector column along each row) and where the
+//   angle between the viewing ray and the normal exceeds max_incidence_deg.
+// - tof (Kinect-One-like): z += N(0, sigma_base + sigma_per_m2 * (z/1000 m)^2);
+//   a pixel next to (8-neighbourhood) a depth jump larger than edge_jump_mm
+//   becomes, with probability flying_fraction, a flying pixel: a depth drawn
+//   uniformly between the foreground and background of that jump (the mixed
+//   return of a pixel straddling an edge), then the noise above. No depth
+//   beyond max_incidence_deg.
+// All models finally drop pixels outside [min_range_mm, max_range_mm].
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -21,10 +43,11 @@ struct GaussianNoise {
 // projector baseline, so the error grows with z^2; local smoothing; no depth
 // in projector shadows and at grazing angles.
 struct StructuredLightNoise {
-  double baseline_mm = 75.0;         // projector-camera baseline along +x
-  double disparity_step_px = 0.125;  // disparity quantization (subpixel step)
-  double disparity_sigma_px = 0.05;  // Gaussian jitter on disparity before quantization
-  int smoothing_radius_px = 1;       // box smoothing of depth over (2r+1)^2 valid neighbours
+  double baseline_mm = 75.0;         // projector-camera baseline along +x (Kinect v1 / Astra: 75 mm)
+  double disparity_step_px = 0.125;  // disparity quantization (1/8 px subpixel step)
+  double disparity_sigma_px = 0.05;  // Gaussian jitter on disparity before smoothing and quantization
+  int smoothing_radius_px = 1;       // box smoothing of disparity over (2r+1)^2 valid neighbours
+  double smoothing_edge_px = 1.0;    // neighbours whose true disparity differs more are not averaged
   double max_incidence_deg = 75.0;   // no depth beyond this angle between ray and normal
   bool shadows = true;               // drop pixels the projector cannot see
 };
@@ -33,7 +56,7 @@ struct StructuredLightNoise {
 // at depth edges, no depth at grazing angles.
 struct TimeOfFlightNoise {
   double sigma_base_mm = 1.5;        // sigma = base + per_m2 * (z/1000)^2
-  double sigma_per_m2_mm = 0.75;
+  double sigma_per_m2_mm = 0.75;     // growth of sigma per squared metre of depth
   double edge_jump_mm = 30.0;        // a depth step larger than this is an edge
   double flying_fraction = 1.0;      // probability that an edge pixel becomes flying
   double max_incidence_deg = 80.0;   // no depth beyond this angle
@@ -47,13 +70,18 @@ struct NoiseSettings {
 };
 
 struct SensorProfile {
-  std::string name;     // synthetic | astra | kinect_one | custom
+  std::string name;     // synthetic | astra | kinect_one | a custom name
   Intrinsics K;
-  double depth_scale = 0.1;  // written to scene_camera.json (png * scale = mm)
-  double min_range_mm = 200;
-  double max_range_mm = 8000;
+  // png * scale = mm in scene_camera.json; max_range_mm must fit a uint16
+  // (max_range_mm <= 65535 * depth_scale).
+  double depth_scale = 0.1;
+  double min_range_mm = 200;   // nearer measurements are dropped (0)
+  double max_range_mm = 6500;  // farther measurements are dropped (0)
   NoiseSettings noise;  // the sensor's default noise model
 };
+
+// Names of the built-in profiles.
+std::vector<std::string> sensor_names();
 
 // Built-in profiles: synthetic (512x512, 30x30 deg, gaussian 1 mm), astra
 // (640x480, 59x46 deg, structured light), kinect_one (512x424, 57x43 deg,
@@ -61,16 +89,34 @@ struct SensorProfile {
 SensorProfile sensor_profile(const std::string& name, const std::string& file = "",
                              const std::string& field = "sensor");
 // A `sensor:` YAML node: either a name or a map {name, width, height, fx, fy,
-// cx, cy, depth_scale, min_range_mm, max_range_mm} (custom intrinsics).
+// cx, cy, depth_scale, min_range_mm, max_range_mm} (custom intrinsics; instead
+// of fx, fy also hfov_deg, vfov_deg; cx, cy default to the image centre). A
+// map naming a built-in profile without intrinsics overrides its ranges and
+// depth_scale. A custom sensor's default noise is gaussian 1 mm.
 SensorProfile parse_sensor(const YamlNode& node);
-// A `noise:` YAML node {model, sigma_mm, baseline_mm, ...}; fields default to
-// `base`.
+// A `noise:` YAML node: a model name, or a map {model, sigma_mm (gaussian);
+// baseline_mm, disparity_step_px, disparity_sigma_px, smoothing_radius_px,
+// smoothing_edge_px, max_incidence_deg, shadows (structured_light);
+// sigma_base_mm, sigma_per_m2_mm, edge_jump_mm, flying_fraction,
+// max_incidence_deg (tof)}; fields default to `base`. A key of another model
+// than the chosen one is an InputError.
 NoiseSettings parse_noise(const YamlNode& node, const NoiseSettings& base);
 
-// Applies the noise model in place. `render` supplies labels and normals
-// (render with RenderSettings::normals = true for the structured light and
-// time of flight models); pixels outside [min, max] range become 0.
+// Applies the noise model in place. `render` supplies the normals (render with
+// RenderSettings::normals = true for the structured light and time of flight
+// models; without them normals are estimated from the depth); pixels outside
+// [min, max] range become 0. Random draws follow the pixel order, so the
+// result depends only on the input and the Rng state.
 void apply_noise(DepthImage& depth, const RenderOutput& render, const SensorProfile& sensor,
                  const NoiseSettings& noise, Rng& rng);
+
+// Pixels of `depth` that a projector at +baseline_mm along the camera's x axis
+// (same orientation and intrinsics) cannot see: 1 = shadowed.
+std::vector<uint8_t> projector_shadow_mask(const DepthImage& depth, const Intrinsics& K,
+                                           double baseline_mm);
+
+// Per-pixel unit normals (camera frame, facing the camera) estimated from the
+// depth by central differences on the same surface; zero where undefined.
+std::vector<Vec3f> estimate_normals(const DepthImage& depth, const Intrinsics& K, double edge_jump_mm = 30.0);
 
 }  // namespace pb

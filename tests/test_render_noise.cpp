@@ -1,0 +1,302 @@
+// Noise models: measured Gaussian sigma, structured-light error growth with
+// depth and projector shadows, time-of-flight flying pixels only at depth
+// edges, grazing angles, ranges, and seeding.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/rotation.h"
+#include "render/sensor.h"
+#include "test_render_util.h"
+
+using namespace pb;
+
+namespace {
+
+struct Scene {
+  Mesh wall, box;
+  std::vector<RenderItem> items;
+};
+
+RenderOutput render_plane(const Intrinsics& K, double z, double tilt_deg, const Vec3& axis = Vec3(0, 1, 0)) {
+  DepthRenderer r(K, RenderSettings{50, 20000, true, true});
+  const Mesh quad = pbtest::make_quad(static_cast<float>(3 * z));
+  Pose T;
+  T.R = axis_angle(axis.normalized(), tilt_deg * M_PI / 180.0);
+  T.t = Vec3(0, 0, z);
+  return r.render({{&quad, T, 1}});
+}
+
+// A 200 x 200 x 100 mm box (front face at z = 750) before a wall at 1200 mm.
+RenderOutput render_box_wall(const Intrinsics& K) {
+  DepthRenderer r(K, RenderSettings{50, 20000, true, true});
+  const Mesh wall = pbtest::make_quad(3000.f);
+  const Mesh box = pbtest::make_box(100, 100, 50);
+  Pose Tw, Tb;
+  Tw.t = Vec3(0, 0, 1200);
+  Tb.t = Vec3(0, 0, 800);
+  return r.render({{&wall, Tw, 1}, {&box, Tb, 2}});
+}
+
+struct Stats {
+  double mean = 0, std = 0, rms = 0;
+  size_t n = 0;
+};
+
+Stats error_stats(const DepthImage& noisy, const DepthImage& truth) {
+  Stats s;
+  double sum = 0, sum2 = 0;
+  for (size_t i = 0; i < noisy.z.size(); ++i)
+    if (noisy.z[i] > 0 && truth.z[i] > 0) {
+      const double e = double(noisy.z[i]) - truth.z[i];
+      sum += e;
+      sum2 += e * e;
+      ++s.n;
+    }
+  s.mean = sum / s.n;
+  s.rms = std::sqrt(sum2 / s.n);
+  s.std = std::sqrt(std::max(0.0, sum2 / s.n - s.mean * s.mean));
+  return s;
+}
+
+DepthImage noisy(const RenderOutput& out, const SensorProfile& sensor, const NoiseSettings& noise, uint64_t seed) {
+  DepthImage d = out.depth;
+  Rng rng(seed);
+  apply_noise(d, out, sensor, noise, rng);
+  return d;
+}
+
+}  // namespace
+
+TEST(RenderNoise, GaussianSigmaWithinFivePercent) {
+  const SensorProfile synth = sensor_profile("synthetic");
+  const RenderOutput out = render_plane(synth.K, 1000, 25);
+  ASSERT_EQ(out.depth.valid_count(), static_cast<size_t>(512 * 512));
+  for (double sigma : {1.0, 2.5}) {
+    NoiseSettings n = synth.noise;
+    n.gaussian.sigma_mm = sigma;
+    const Stats s = error_stats(noisy(out, synth, n, 42), out.depth);
+    std::printf("gaussian sigma %.2f: measured %.4f mm (mean %.4f) over %zu pixels\n", sigma, s.std, s.mean, s.n);
+    EXPECT_EQ(s.n, out.depth.valid_count());
+    EXPECT_NEAR(s.std, sigma, 0.05 * sigma);
+    EXPECT_NEAR(s.mean, 0.0, 0.05 * sigma);
+  }
+}
+
+TEST(RenderNoise, StructuredLightErrorGrowsWithDepth) {
+  const SensorProfile astra = sensor_profile("astra");
+  ASSERT_EQ(astra.noise.model, "structured_light");
+  std::vector<double> rms;
+  for (double z : {800.0, 2500.0}) {
+    const RenderOutput out = render_plane(astra.K, z, 30);
+    const DepthImage d = noisy(out, astra, astra.noise, 7);
+    const Stats s = error_stats(d, out.depth);
+    std::printf("astra z=%.0f: error rms %.3f mm, std %.3f mm, mean %.3f mm, %zu of %zu pixels kept\n", z, s.rms,
+                s.std, s.mean, s.n, out.depth.valid_count());
+    EXPECT_GT(s.n, 0.95 * out.depth.valid_count());  // a plane: no shadows, no grazing
+    rms.push_back(s.rms);
+  }
+  // Error ~ z^2 / (fx b): (2500/800)^2 = 9.8; require clear growth.
+  EXPECT_GT(rms[1], 5.0 * rms[0]);
+  EXPECT_LT(rms[0], 2.0);
+}
+
+TEST(RenderNoise, StructuredLightQuantizesDisparity) {
+  // Without jitter and smoothing, every depth is fx b / (k * step).
+  SensorProfile astra = sensor_profile("astra");
+  NoiseSettings n = astra.noise;
+  n.structured_light.disparity_sigma_px = 0;
+  n.structured_light.smoothing_radius_px = 0;
+  const RenderOutput out = render_plane(astra.K, 1500, 40);
+  const DepthImage d = noisy(out, astra, n, 1);
+  const double fb = astra.K.fx * n.structured_light.baseline_mm;
+  size_t checked = 0;
+  for (size_t i = 0; i < d.z.size(); ++i)
+    if (d.z[i] > 0) {
+      const double k = fb / d.z[i] / n.structured_light.disparity_step_px;
+      EXPECT_NEAR(k, std::round(k), 1e-3);
+      // rounding the disparity moves the depth by at most half a step
+      const double dz = std::abs(fb / out.depth.z[i] - fb / d.z[i]);
+      EXPECT_LE(dz, 0.5 * n.structured_light.disparity_step_px + 1e-6);
+      ++checked;
+    }
+  EXPECT_GT(checked, 100000u);
+}
+
+TEST(RenderNoise, ProjectorShadowsLieLeftOfTheBox) {
+  const SensorProfile astra = sensor_profile("astra");
+  const Intrinsics& K = astra.K;
+  const RenderOutput out = render_box_wall(K);
+  const DepthImage d = noisy(out, astra, astra.noise, 3);
+  const double b = astra.noise.structured_light.baseline_mm;
+  const double expected = K.fx * b * (1.0 / 750.0 - 1.0 / 1200.0);  // disparity difference, px
+  const std::vector<uint8_t> mask = projector_shadow_mask(out.depth, K, b);
+  int rows = 0;
+  double left_sum = 0, mask_sum = 0;
+  int right_max = 0;
+  for (int v = 0; v < K.height; ++v) {
+    // Box columns in this row from the labels.
+    int u0 = -1, u1 = -1;
+    for (int u = 0; u < K.width; ++u)
+      if (out.labels[static_cast<size_t>(v) * K.width + u] == 2) {
+        if (u0 < 0) u0 = u;
+        u1 = u;
+      }
+    if (u0 < 0) {
+      // Rows without the box: the wall is fully lit.
+      for (int u = 0; u < K.width; ++u) EXPECT_EQ(mask[static_cast<size_t>(v) * K.width + u], 0);
+      continue;
+    }
+    ++rows;
+    int left = 0, right = 0, left_mask = 0;
+    for (int u = std::max(0, u0 - 40); u < u0; ++u) {
+      left += d.at(u, v) == 0.f;
+      left_mask += mask[static_cast<size_t>(v) * K.width + u];
+    }
+    for (int u = u1 + 1; u <= std::min(K.width - 1, u1 + 40); ++u) right += d.at(u, v) == 0.f;
+    for (int u = u0; u <= u1; ++u) EXPECT_EQ(mask[static_cast<size_t>(v) * K.width + u], 0);  // the box is lit
+    EXPECT_NEAR(left_mask, expected, 1.0);
+    left_sum += left;
+    mask_sum += left_mask;
+    right_max = std::max(right_max, right);
+  }
+  std::printf("shadow: %d rows, mean width left %.2f px (mask %.2f, expected %.2f), right max %d px\n", rows,
+              left_sum / rows, mask_sum / rows, expected, right_max);
+  EXPECT_GT(rows, 100);
+  EXPECT_NEAR(left_sum / rows, expected, 1.5);
+  EXPECT_EQ(right_max, 0);
+}
+
+TEST(RenderNoise, TimeOfFlightFlyingPixelsOnlyAtDepthEdges) {
+  const SensorProfile kin = sensor_profile("kinect_one");
+  ASSERT_EQ(kin.noise.model, "tof");
+  const Intrinsics& K = kin.K;
+  const TimeOfFlightNoise& t = kin.noise.tof;
+  const RenderOutput out = render_box_wall(K);
+  const DepthImage& truth = out.depth;
+  const DepthImage d = noisy(out, kin, kin.noise, 11);
+  auto sigma = [&](double z) { return t.sigma_base_mm + t.sigma_per_m2_mm * (z / 1000) * (z / 1000); };
+  // An edge pixel has an 8-neighbour across a jump larger than edge_jump_mm.
+  auto edge_distance = [&](int u, int v) {
+    int best = 1000;
+    for (int dv = -3; dv <= 3; ++dv)
+      for (int du = -3; du <= 3; ++du) {
+        const int uu = u + du, vv = v + dv;
+        if (uu < 1 || vv < 1 || uu >= K.width - 1 || vv >= K.height - 1) continue;
+        for (int a = -1; a <= 1; ++a)
+          for (int c = -1; c <= 1; ++c)
+            if (std::abs(truth.at(uu + a, vv + c) - truth.at(uu, vv)) > t.edge_jump_mm)
+              best = std::min(best, std::max(std::abs(du), std::abs(dv)));
+      }
+    return best;
+  };
+  size_t flying = 0, flying_far = 0, edge_pixels = 0;
+  double sum2 = 0;
+  size_t interior = 0;
+  for (int v = 0; v < K.height; ++v)
+    for (int u = 0; u < K.width; ++u) {
+      const float z = d.at(u, v);
+      const float z0 = truth.at(u, v);
+      if (edge_distance(u, v) == 0) ++edge_pixels;
+      if (z <= 0) continue;
+      // Flying: far (> 6 sigma) from every true surface around it.
+      bool far_from_all = true;
+      for (int dv = -2; dv <= 2 && far_from_all; ++dv)
+        for (int du = -2; du <= 2; ++du) {
+          const int uu = std::clamp(u + du, 0, K.width - 1), vv = std::clamp(v + dv, 0, K.height - 1);
+          const float zt = truth.at(uu, vv);
+          if (zt > 0 && std::abs(z - zt) <= 6 * sigma(zt)) {
+            far_from_all = false;
+            break;
+          }
+        }
+      if (far_from_all) {
+        ++flying;
+        if (edge_distance(u, v) > 1) ++flying_far;
+      } else if (edge_distance(u, v) > 3) {
+        const double e = z - z0;
+        sum2 += e * e / (sigma(z0) * sigma(z0));
+        ++interior;
+      }
+    }
+  const double normalized_std = std::sqrt(sum2 / interior);
+  std::printf("tof: %zu edge pixels, %zu flying pixels, %zu farther than 1 px from an edge; interior error / "
+              "sigma = %.4f over %zu pixels\n",
+              edge_pixels, flying, flying_far, normalized_std, interior);
+  EXPECT_EQ(flying_far, 0u);
+  EXPECT_GT(flying, edge_pixels / 2);  // most edge pixels fly (flying_fraction 1, a 450 mm jump)
+  EXPECT_NEAR(normalized_std, 1.0, 0.05);
+}
+
+TEST(RenderNoise, GrazingAnglesHaveNoDepth) {
+  // A plane tilted 70 degrees about x: along the image columns the angle
+  // between ray and normal sweeps across both models' limits (75 and 80 deg).
+  const Vec3 axis(1, 0, 0);
+  const Mat3 R = axis_angle(axis, 70 * M_PI / 180.0);
+  const Vec3 normal = R.col(2);
+  for (const std::string name : {"kinect_one", "astra"}) {
+    const SensorProfile s = sensor_profile(name);
+    const double limit = name == "astra" ? s.noise.structured_light.max_incidence_deg
+                                         : s.noise.tof.max_incidence_deg;
+    const RenderOutput out = render_plane(s.K, 1500, 70, axis);
+    const DepthImage d = noisy(out, s, s.noise, 5);
+    size_t kept = 0, dropped = 0, wrong = 0;
+    for (int v = 0; v < s.K.height; ++v)
+      for (int u = 0; u < s.K.width; ++u) {
+        const double z0 = out.depth.at(u, v);
+        if (z0 <= 0 || z0 < s.min_range_mm || z0 > s.max_range_mm * 0.98) continue;
+        const Vec3 ray = s.K.backproject(u, v, 1.0).normalized();
+        const double incidence = std::acos(std::abs(ray.dot(normal))) * 180.0 / M_PI;
+        const bool has = d.at(u, v) > 0;
+        if (incidence > limit + 0.5) wrong += has, dropped += !has;
+        if (incidence < limit - 0.5) wrong += !has, kept += has;
+      }
+    std::printf("%s: %zu pixels kept below %.0f deg incidence, %zu dropped above, %zu wrong\n", name.c_str(), kept,
+                limit, dropped, wrong);
+    EXPECT_EQ(wrong, 0u) << name;
+    EXPECT_GT(kept, 10000u) << name;
+    EXPECT_GT(dropped, 10000u) << name;
+  }
+}
+
+TEST(RenderNoise, RangeLimitsDropPixels) {
+  SensorProfile kin = sensor_profile("kinect_one");
+  NoiseSettings none;
+  const RenderOutput near = render_plane(kin.K, 300, 0);
+  EXPECT_EQ(noisy(near, kin, none, 1).valid_count(), 0u);  // nearer than 500 mm
+  const RenderOutput mid = render_plane(kin.K, 1000, 0);
+  EXPECT_EQ(noisy(mid, kin, none, 1).z, mid.depth.z);  // no noise, in range: unchanged
+}
+
+TEST(RenderNoise, SameSeedSameImageOtherSeedDifferent) {
+  for (const std::string name : {"synthetic", "astra", "kinect_one"}) {
+    const SensorProfile s = sensor_profile(name);
+    const RenderOutput out = render_box_wall(s.K);
+    const DepthImage a = noisy(out, s, s.noise, 1234);
+    const DepthImage b = noisy(out, s, s.noise, 1234);
+    const DepthImage c = noisy(out, s, s.noise, 1235);
+    EXPECT_EQ(a.z, b.z) << name;
+    size_t differ = 0;
+    for (size_t i = 0; i < a.z.size(); ++i) differ += a.z[i] != c.z[i];
+    // Structured light on a fronto-parallel wall mostly rounds to the same
+    // disparity level whatever the jitter, so fewer pixels change there.
+    EXPECT_GT(differ, a.z.size() / 100) << name;
+    EXPECT_NE(a.z, out.depth.z) << name;
+  }
+}
+
+TEST(RenderNoise, NormalsEstimatedWhenNotRendered) {
+  // Without rendered normals the models estimate them from the depth; the
+  // estimate matches the rendered face normals on a plane.
+  const SensorProfile astra = sensor_profile("astra");
+  const RenderOutput out = render_plane(astra.K, 1200, 35, Vec3(1, 1, 0));
+  const std::vector<Vec3f> est = estimate_normals(out.depth, astra.K);
+  double worst = 0;
+  for (size_t i = 0; i < est.size(); ++i)
+    if (est[i].squaredNorm() > 0) worst = std::max(worst, double((est[i] - out.normals[i]).norm()));
+  EXPECT_LT(worst, 1e-3);
+  RenderOutput no_normals = out;
+  no_normals.normals.clear();
+  EXPECT_EQ(noisy(out, astra, astra.noise, 9).z, noisy(no_normals, astra, astra.noise, 9).z);
+}
