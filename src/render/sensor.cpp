@@ -142,6 +142,18 @@ double fov_deg(const YamlNode& node, const std::string& key) {
   return v;
 }
 
+bool is_builtin(const std::string& name) {
+  const auto names = sensor_names();
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+std::string unknown_sensor(const std::string& name) {
+  std::string list;
+  for (const auto& n : sensor_names()) list += (list.empty() ? "" : ", ") + n;
+  return "unknown sensor '" + name + "' (built in: " + list +
+         "; or give a map with width, height, fx, fy, cx, cy)";
+}
+
 }  // namespace
 
 std::vector<std::string> sensor_names() { return {"synthetic", "astra", "kinect_one"}; }
@@ -171,17 +183,18 @@ SensorProfile sensor_profile(const std::string& name, const std::string& file, c
     s.max_range_mm = 4500;
     s.noise.model = "tof";
   } else {
-    std::string list;
-    for (const auto& n : sensor_names()) list += (list.empty() ? "" : ", ") + n;
-    throw InputError(file, field, "unknown sensor '" + name + "' (built in: " + list +
-                                      "; or give a map with width, height, fx, fy, cx, cy)");
+    throw InputError(file, field, unknown_sensor(name));
   }
   return s;
 }
 
 SensorProfile parse_sensor(const YamlNode& node) {
   if (!node.defined()) node.fail("missing sensor (a name or a map of intrinsics)");
-  if (node.is_scalar()) return sensor_profile(node.as<std::string>(), node.file(), node.path());
+  if (node.is_scalar()) {
+    const std::string name = node.as<std::string>();
+    if (!is_builtin(name)) node.fail(unknown_sensor(name));  // names file, field and line
+    return sensor_profile(name, node.file(), node.path());
+  }
   node.check_keys({"name", "width", "height", "fx", "fy", "cx", "cy", "hfov_deg", "vfov_deg", "depth_scale",
                    "min_range_mm", "max_range_mm"});
   const bool has_intrinsics = node.has("width") || node.has("height") || node.has("fx") || node.has("fy") ||
@@ -189,7 +202,8 @@ SensorProfile parse_sensor(const YamlNode& node) {
   SensorProfile s;
   const std::string name = node.get_or<std::string>("name", "custom");
   if (!has_intrinsics) {
-    s = sensor_profile(name, node.file(), node.path().empty() ? "name" : node.path() + ".name");
+    if (!is_builtin(name)) node["name"].fail(unknown_sensor(name));
+    s = sensor_profile(name, node.file(), node["name"].path());
   } else {
     s.name = name;
     s.noise.model = "gaussian";
