@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "core/types.h"
@@ -57,6 +58,15 @@ class DepthRenderer {
 
   RenderOutput render(const std::vector<RenderItem>& items);
   const Intrinsics& intrinsics() const { return K_; }
+  // Changes the intrinsics of the next renders; the image size must stay the
+  // same (buffers are sized at construction). Lets one context render tiles
+  // of a larger virtual image by shifting the principal point (scenes: the
+  // full silhouette of an object crossing the image border).
+  void set_intrinsics(const Intrinsics& K) {
+    if (K.width != K_.width || K.height != K_.height)
+      throw std::invalid_argument("DepthRenderer::set_intrinsics: the image size must not change");
+    K_ = K;
+  }
 
  private:
   struct Impl;
