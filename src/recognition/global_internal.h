@@ -88,6 +88,12 @@ std::vector<double> crh_roll_peaks(const std::vector<float>& scene_crh, const st
 // spectra, converted to our convention (radians): for tests.
 std::vector<double> pcl_crh_roll_peaks(const std::vector<float>& scene_crh, const std::vector<float>& view_crh);
 
+// --- global_esf_pcl.cpp (PCL) ---
+// pcl::ESFEstimation of the same points, the reference our compute_esf is
+// checked against (tests only: PCL's ESF seeds rand() from the clock, so it
+// is neither reproducible nor thread-safe).
+std::vector<float> pcl_esf(const std::vector<Vec3f>& points);
+
 // --- global_method.cpp ---
 // R_cam_view such that R * view_axis = scene_axis: R_s^T Rz(theta) R_v with
 // R_x = rotation_to_z(x).
