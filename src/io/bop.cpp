@@ -115,8 +115,17 @@ ojson vec3(const Vec3& v) { return ojson::array({v.x(), v.y(), v.z()}); }
 ojson int4(const std::array<int, 4>& a) { return ojson::array({a[0], a[1], a[2], a[3]}); }
 
 void write_json(const std::string& path, const ojson& j) {
-  // One entry per line keeps the files readable and diffable, like BOP's.
-  atomic_write_text(path, j.dump(1) + "\n");
+  // One top-level entry per line (as bop_toolkit writes them): readable,
+  // diffable, compact.
+  std::string out = "{\n";
+  bool first = true;
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (!first) out += ",\n";
+    first = false;
+    out += "  " + ojson(it.key()).dump() + ": " + it.value().dump();
+  }
+  out += "\n}\n";
+  atomic_write_text(path, out);
 }
 
 bool is_digits(const std::string& s) {

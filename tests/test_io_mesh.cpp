@@ -1,0 +1,171 @@
+// Mesh loading (assimp) and binary PLY writing.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+
+#include "core/error.h"
+#include "io/mesh_io.h"
+
+namespace fs = std::filesystem;
+using namespace pb;
+
+namespace {
+
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    std::string tmpl = (fs::temp_directory_path() / "pb_test_mesh_XXXXXX").string();
+    path = mkdtemp(tmpl.data());
+  }
+  ~TempDir() { fs::remove_all(path); }
+  std::string operator/(const std::string& f) const { return (path / f).string(); }
+};
+
+// Every undirected edge used by exactly two faces, once in each direction.
+bool closed_and_oriented(const Mesh& m) {
+  std::map<std::pair<int, int>, int> directed;
+  for (const auto& f : m.faces)
+    for (int k = 0; k < 3; ++k) directed[{f[k], f[(k + 1) % 3]}]++;
+  for (const auto& [e, n] : directed) {
+    if (n != 1) return false;
+    auto it = directed.find({e.second, e.first});
+    if (it == directed.end() || it->second != 1) return false;
+  }
+  return true;
+}
+
+double signed_volume(const Mesh& m) {
+  double v = 0;
+  for (const auto& f : m.faces)
+    v += m.vertices[f[0]].cast<double>().dot(m.vertices[f[1]].cast<double>().cross(m.vertices[f[2]].cast<double>())) / 6;
+  return v;
+}
+
+// An octahedron with odd coordinates (not representable exactly in decimal).
+Mesh octahedron() {
+  Mesh m;
+  const float a = 12.345678f, b = 0.1f, c = 1e-3f;
+  m.vertices = {{a, 0, 0}, {-a, 0, 0}, {0, a + b, 0}, {0, -a, c}, {0, 0, a * 2}, {0, 0, -a}};
+  // +x=0 -x=1 +y=2 -y=3 +z=4 -z=5, outward counter-clockwise.
+  m.faces = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  return m;
+}
+
+template <typename F>
+void expect_mesh_error(F&& f, const std::string& file) {
+  try {
+    f();
+    ADD_FAILURE() << "no InputError for " << file;
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), file);
+    EXPECT_EQ(e.field(), "mesh");
+    EXPECT_NE(std::string(e.what()).find(file), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+
+TEST(MeshIo, PlyRoundTripKeepsVerticesFacesAndOrientation) {
+  TempDir tmp;
+  Mesh m = octahedron();
+  ASSERT_TRUE(closed_and_oriented(m));
+  ASSERT_GT(signed_volume(m), 0);
+  m.compute_vertex_normals();
+  const std::string p = tmp / "obj_000001.ply";
+  write_ply(p, m);
+  EXPECT_FALSE(fs::exists(p + ".tmp"));
+  {
+    std::ifstream in(p, std::ios::binary);
+    std::string head((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(head.rfind("ply\nformat binary_little_endian 1.0\n", 0), 0u);
+    EXPECT_NE(head.find("element vertex 6\n"), std::string::npos);
+    EXPECT_NE(head.find("property float nx\n"), std::string::npos);
+    EXPECT_NE(head.find("element face 8\n"), std::string::npos);
+  }
+  const Mesh r = load_mesh(p);
+  ASSERT_EQ(r.vertices.size(), m.vertices.size());
+  ASSERT_EQ(r.faces.size(), m.faces.size());
+  // Map loaded vertices to the originals by exact position (floats are
+  // stored bit for bit), then compare faces up to a cyclic rotation.
+  std::vector<int> to_orig(r.vertices.size(), -1);
+  for (size_t i = 0; i < r.vertices.size(); ++i)
+    for (size_t j = 0; j < m.vertices.size(); ++j)
+      if (r.vertices[i] == m.vertices[j]) to_orig[i] = static_cast<int>(j);
+  for (int k : to_orig) ASSERT_GE(k, 0);
+  for (const auto& f : r.faces) {
+    const Eigen::Vector3i g(to_orig[f[0]], to_orig[f[1]], to_orig[f[2]]);
+    bool found = false;
+    for (const auto& h : m.faces)
+      for (int s = 0; s < 3; ++s)
+        found = found || (h[s] == g[0] && h[(s + 1) % 3] == g[1] && h[(s + 2) % 3] == g[2]);
+    EXPECT_TRUE(found) << g.transpose();
+  }
+  EXPECT_TRUE(closed_and_oriented(r));
+  EXPECT_NEAR(signed_volume(r), signed_volume(m), 1e-9 * signed_volume(m));
+  EXPECT_EQ(r.vertex_normals.size(), r.vertices.size());
+}
+
+TEST(MeshIo, ObjQuadsAreTriangulatedAndObjectsMerged) {
+  TempDir tmp;
+  const std::string p = tmp / "two_objects.obj";
+  // A unit cube as two OBJ objects (bottom+sides / top), quads, with the
+  // shared corner vertices repeated in each object.
+  std::ofstream(p) << "o lower\n"
+                      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                      "f 1 4 3 2\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n"
+                      "o upper\n"
+                      "v 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                      "f 9 10 11 12\n";
+  const Mesh m = load_mesh(p);
+  EXPECT_EQ(m.vertices.size(), 8u);  // duplicates across objects merged
+  EXPECT_EQ(m.faces.size(), 12u);
+  EXPECT_TRUE(closed_and_oriented(m));
+  EXPECT_NEAR(signed_volume(m), 1.0, 1e-6);
+}
+
+TEST(MeshIo, StlFacetsShareVertices) {
+  TempDir tmp;
+  const std::string p = tmp / "tet.stl";
+  // ASCII STL: per-facet normals and repeated vertices; must weld into a
+  // closed tetrahedron of 4 vertices.
+  const char* tris[4][3] = {{"0 0 0", "0 1 0", "1 0 0"},
+                            {"0 0 0", "1 0 0", "0 0 1"},
+                            {"0 0 0", "0 0 1", "0 1 0"},
+                            {"1 0 0", "0 1 0", "0 0 1"}};
+  std::ofstream out(p);
+  out << "solid t\n";
+  for (auto& t : tris) {
+    out << "facet normal 0 0 0\nouter loop\n";
+    for (auto* v : t) out << "vertex " << v << "\n";
+    out << "endloop\nendfacet\n";
+  }
+  out << "endsolid t\n";
+  out.close();
+  const Mesh m = load_mesh(p);
+  EXPECT_EQ(m.vertices.size(), 4u);
+  EXPECT_EQ(m.faces.size(), 4u);
+  EXPECT_TRUE(closed_and_oriented(m));
+  EXPECT_NEAR(signed_volume(m), 1.0 / 6, 1e-7);
+}
+
+TEST(MeshIo, BadFilesAreInputErrors) {
+  TempDir tmp;
+  const std::string missing = tmp / "missing.obj";
+  expect_mesh_error([&] { load_mesh(missing); }, missing);
+  const std::string empty = tmp / "empty.ply";
+  std::ofstream(empty).close();
+  expect_mesh_error([&] { load_mesh(empty); }, empty);
+  const std::string garbage = tmp / "garbage.ply";
+  std::ofstream(garbage) << "ply\nformat binary_little_endian 1.0\nelement vertex 100\nproperty float x\nend_header\nxx";
+  expect_mesh_error([&] { load_mesh(garbage); }, garbage);
+  const std::string lines = tmp / "lines.obj";  // vertices and a polyline, no face
+  std::ofstream(lines) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2 3\n";
+  expect_mesh_error([&] { load_mesh(lines); }, lines);
+  const std::string folder = tmp / "folder.obj";
+  fs::create_directory(folder);
+  expect_mesh_error([&] { load_mesh(folder); }, folder);
+}
