@@ -10,12 +10,19 @@ struct LocalSettings {
   double keypoint_voxel_mm = 15.0;      // second, coarser voxel grid (Table 4.2)
   double descriptor_radius_mm = 40.0;   // FPFH / SHOT support radius
   double lrf_radius_mm = 40.0;          // local reference frame radius (Hough voting)
-  double match_threshold = 0.25;        // max descriptor distance (squared L2 for SHOT,
-                                        // as PCL's tutorial; scaled per descriptor)
-  int matches_per_keypoint = 1;         // nearest model descriptors kept per scene keypoint
+  double match_threshold = 0.25;        // SHOT: max squared L2 distance between SHOT
+                                        // descriptors (unit L2 norm, so in [0, 2]); PCL's
+                                        // correspondence grouping tutorial uses 0.25
+  double fpfh_match_threshold = 2000;   // FPFH: max squared L2 distance between PCL FPFH
+                                        // histograms (each of the 3 sub-histograms sums to 100)
+  int matches_per_keypoint = 1;         // k: up to k nearest model descriptors (over all
+                                        // views) under the threshold kept per scene keypoint
   double hough_bin_mm = 50.0;           // 3D Hough bin size (Table 4.2)
   int hough_min_votes = 5;              // minimum votes for a hypothesis (thesis: 5)
+  bool hough_interpolation = false;     // spread each vote over the 8 nearest bins (PCL option)
   int max_hypotheses = 10;              // at most this many clusters go on to refinement
+  int threads = 0;                      // OpenMP threads for FPFH / SHOT (0 = all cores);
+                                        // results are identical for any value
 };
 
 void parse_local(const YamlNode& node, LocalSettings& s);

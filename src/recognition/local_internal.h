@@ -1,0 +1,102 @@
+// Internal building blocks of the local pipeline (FPFH, SHOT, 3D Hough
+// voting). PCL-free: each function converts to PCL types inside its own .cpp
+// file, so the PCL compile cost is spread over several small units:
+//   local_keypoints.cpp  keypoints (own voxel grid, PCL-free)
+//   local_fpfh.cpp       FPFH (pcl::FPFHEstimationOMP)
+//   local_shot.cpp       SHOT (pcl::SHOTEstimationOMP)
+//   local_match.cpp      descriptor kd-tree (FLANN, exact search)
+//   local_hough.cpp      BOARD reference frames + pcl::Hough3DGrouping
+//   local_method.cpp     the Method (train, save/load, hypothesize), parse_local
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "core/types.h"
+#include "recognition/cloud.h"
+
+namespace pb::local {
+
+constexpr int kFpfhDim = 33;   // 3 angles x 11 bins
+constexpr int kShotDim = 352;  // 8 azimuth x 2 elevation x 2 radial x 11 bins
+constexpr int kLrfDim = 9;     // x, y, z axes (rows of R_local_cam)
+
+// Indices into `cloud` of one keypoint per occupied voxel of a grid of edge
+// `voxel_mm` (aligned at the origin): the cloud point nearest the centroid of
+// the voxel's points, so keypoints are real points and carry normals. Sorted
+// by voxel key (deterministic).
+std::vector<int> voxel_keypoints(const PointSet& cloud, double voxel_mm);
+
+// Descriptors at `keypoints` (indices into `cloud`) with the whole cloud as
+// search surface and its normals; row-major, keypoints.size() x dim. Rows
+// PCL could not compute (no neighbours, invalid SHOT reference frame) are NaN.
+// threads: OpenMP threads (0 = all cores). The result does not depend on it.
+std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& keypoints,
+                                double radius_mm, int threads);
+std::vector<float> compute_shot(const PointSet& cloud, const std::vector<int>& keypoints,
+                                double radius_mm, int threads);
+
+// BOARD local reference frames (pcl::BOARDLocalReferenceFrameEstimation,
+// holes filled) at `keypoints`, cloud as surface; row-major
+// keypoints.size() x 9 (x, y, z axes); NaN rows for invalid frames.
+std::vector<float> compute_board_lrf(const PointSet& cloud, const std::vector<int>& keypoints,
+                                     double radius_mm);
+
+// True if the row holds no NaN / inf.
+bool finite_row(const float* row, int dim);
+
+// Exact nearest neighbour search over descriptors (squared L2 distances),
+// FLANN single kd-tree index. Queries are const and thread-safe.
+class DescriptorIndex {
+ public:
+  DescriptorIndex();
+  ~DescriptorIndex();
+  DescriptorIndex(const DescriptorIndex&) = delete;
+  DescriptorIndex& operator=(const DescriptorIndex&) = delete;
+  // Indexes `rows` rows of `dim` floats (copied).
+  void build(const std::vector<float>& data, int dim);
+  size_t size() const;
+  // Up to k nearest rows with squared L2 distance < max_sq_dist, nearest
+  // first (ties by row index).
+  void knn(const float* query, int k, float max_sq_dist,
+           std::vector<std::pair<int, float>>& out) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// A correspondence between a model keypoint (of one training view) and a
+// scene keypoint, with its descriptor distance.
+struct Match {
+  int model = -1;
+  int scene = -1;
+  float distance = 0;
+};
+
+// One Hough cluster: its (PCL-RANSAC-filtered, de-duplicated) matches.
+struct HoughCluster {
+  std::vector<Match> matches;
+};
+
+struct HoughParams {
+  double bin_mm = 50.0;     // Hough bin edge
+  double min_votes = 5.0;   // bins with at least this many votes are clusters
+  bool interpolation = false;  // spread each vote over 8 neighbouring bins
+};
+
+// 3D Hough voting (pcl::Hough3DGrouping) of the matches of ONE training view:
+// model keypoints with their LRFs vote for the model keypoint centroid in the
+// scene. Matches whose model or scene LRF is invalid must be removed before.
+std::vector<HoughCluster> hough_grouping(const std::vector<Vec3f>& model_kp,
+                                         const std::vector<float>& model_lrf,
+                                         const std::vector<Vec3f>& scene_kp,
+                                         const std::vector<float>& scene_lrf,
+                                         const std::vector<Match>& matches, const HoughParams& p);
+
+// Least-squares rigid transform (Procrustes / Umeyama, no scale) mapping
+// model[i] onto scene[i]. Needs >= 3 non-collinear pairs; returns false if
+// degenerate.
+bool procrustes(const std::vector<Vec3f>& model, const std::vector<Vec3f>& scene, Pose& T_scene_model);
+
+}  // namespace pb::local
