@@ -15,11 +15,19 @@
 namespace pb {
 
 struct DepthRenderer::Impl {
+  // A face plane in the camera frame: unit normal n, offset d (n.p = d).
+  struct Plane {
+    Vec3 n;
+    double d;
+    bool valid;
+  };
   OSMesaContext ctx = nullptr;
   std::vector<uint8_t> color;     // RGBA, row 0 = bottom (OSMesa default Y_UP)
   std::vector<GLuint> depth;      // glReadPixels GL_UNSIGNED_INT, row 0 = bottom
   std::vector<float> positions;   // scratch: 3 vertices x 3 floats per face
   std::vector<uint8_t> colors;    // scratch: 3 vertices x RGBA per face
+  std::vector<Plane> planes;      // scratch: per global face id
+  std::vector<uint8_t> plane_done;
 };
 
 namespace {
@@ -150,15 +158,10 @@ RenderOutput DepthRenderer::render(const std::vector<RenderItem>& items) {
   out.labels.assign(static_cast<size_t>(W) * H, -1);
   if (settings_.normals) out.normals.assign(static_cast<size_t>(W) * H, Vec3f::Zero());
 
-  // Face planes in the camera frame (unit normal n, offset d: n.p = d),
-  // computed lazily for the faces that are visible.
-  struct Plane {
-    Vec3 n;
-    double d;
-    bool valid;
-  };
-  std::vector<Plane> planes;
-  std::vector<uint8_t> plane_done;
+  // Face planes in the camera frame, computed lazily for the visible faces.
+  using Plane = Impl::Plane;
+  std::vector<Plane>& planes = impl_->planes;
+  std::vector<uint8_t>& plane_done = impl_->plane_done;
   const bool need_planes = settings_.exact_depth || settings_.normals;
   if (need_planes) {
     planes.resize(base.back());
