@@ -43,7 +43,7 @@ struct GaussianNoise {
 // projector baseline, so the error grows with z^2; local smoothing; no depth
 // in projector shadows and at grazing angles.
 struct StructuredLightNoise {
-  double baseline_mm = 75.0;         // projector-camera baseline along +x (Kinect v1 / Astra: 75 mm)
+  double baseline_mm = 75.0;         // projector-camera baseline along +x
   double disparity_step_px = 0.125;  // disparity quantization (1/8 px subpixel step)
   double disparity_sigma_px = 0.05;  // Gaussian jitter on disparity before smoothing and quantization
   int smoothing_radius_px = 1;       // box smoothing of disparity over (2r+1)^2 valid neighbours
