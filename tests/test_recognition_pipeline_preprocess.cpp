@@ -1,0 +1,206 @@
+// Preprocessing (range cut, voxel grid, seeded RANSAC plane removal,
+// normals) and verification (PointIndex, count_inliers).
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cstring>
+
+#include "recognition/preprocess.h"
+#include "recognition/preprocess_internal.h"
+#include "recognition/verify.h"
+#include "test_recognition_pipeline_util.h"
+
+namespace {
+
+using pb::PointSet;
+using pb::Vec3f;
+
+TEST(Voxel, CentroidsPclOrderAndNearestPixel) {
+  PointSet in;
+  // Two points in cell (0,0,0), one in (1,0,0), one in (0,0,1).
+  in.points = {Vec3f(1, 1, 1), Vec3f(3, 3, 3), Vec3f(12, 1, 1), Vec3f(1, 1, 15)};
+  in.pixel = {10, 11, 12, 13};
+  const PointSet out = pb::detail::voxel_downsample(in, 10.0);
+  ASSERT_EQ(out.size(), 3u);
+  // PCL's order: z index, then y, then x.
+  EXPECT_TRUE(out.points[0].isApprox(Vec3f(2, 2, 2)));
+  EXPECT_TRUE(out.points[1].isApprox(Vec3f(12, 1, 1)));
+  EXPECT_TRUE(out.points[2].isApprox(Vec3f(1, 1, 15)));
+  // Both points are equally near the centroid (2,2,2): the smaller pixel wins.
+  EXPECT_EQ(out.pixel[0], 10);
+  EXPECT_EQ(out.pixel[1], 12);
+  EXPECT_EQ(out.pixel[2], 13);
+  // Negative coordinates use floor, as pcl::VoxelGrid: -1 and 1 are in different cells.
+  in.points = {Vec3f(-1, 0, 0), Vec3f(1, 0, 0)};
+  in.pixel = {0, 1};
+  EXPECT_EQ(pb::detail::voxel_downsample(in, 10.0).size(), 2u);
+}
+
+TEST(Ransac, FindsThePlaneDeterministically) {
+  pb::Rng rng(3);
+  std::vector<Vec3f> pts;
+  // A tilted plane z = 0.2 x + 500 with 1 mm noise, 2000 points, plus 500 outliers above it.
+  for (int i = 0; i < 2000; ++i) {
+    const double x = rng.uniform(-300, 300), y = rng.uniform(-300, 300);
+    pts.emplace_back(x, y, 0.2 * x + 500 + rng.normal(0, 1));
+  }
+  for (int i = 0; i < 500; ++i) {
+    const double x = rng.uniform(-50, 50), y = rng.uniform(-50, 50);
+    pts.emplace_back(x, y, 0.2 * x + 500 - rng.uniform(20, 120));
+  }
+  Eigen::Vector4d plane;
+  const auto flags = pb::detail::ransac_plane(pts, 5.0, 100, 42, &plane);
+  int missed = 0, outliers_on = 0;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    if (i < 2000 && !flags[i]) ++missed;
+    if (i >= 2000 && flags[i]) ++outliers_on;
+  }
+  EXPECT_LE(missed, 20);  // 5 sigma of the 1 mm noise: practically all plane points
+  EXPECT_EQ(outliers_on, 0);
+  const pb::Vec3 n_true = pb::Vec3(-0.2, 0, 1).normalized();
+  EXPECT_GT(std::abs(plane.head<3>().dot(n_true)), 0.9999);
+  EXPECT_EQ(flags, pb::detail::ransac_plane(pts, 5.0, 100, 42));
+  // Degenerate input: no crash, no plane.
+  EXPECT_EQ(pb::detail::ransac_plane({Vec3f(0, 0, 1), Vec3f(1, 0, 1)}, 5.0, 100, 1), std::vector<char>(2, 0));
+  const std::vector<Vec3f> line = {Vec3f(0, 0, 1), Vec3f(1, 0, 1), Vec3f(2, 0, 1), Vec3f(3, 0, 1)};
+  EXPECT_EQ(pb::detail::ransac_plane(line, 5.0, 50, 1), std::vector<char>(4, 0));
+}
+
+class TableScenePreprocess : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    mesh_ = new pb::Mesh(pbtest::make_l_block());
+    scene_ = new pbtest::TableScene(pbtest::render_table_scene(*mesh_));
+  }
+  static void TearDownTestSuite() {
+    delete scene_;
+    delete mesh_;
+  }
+  static pb::Mesh* mesh_;
+  static pbtest::TableScene* scene_;
+};
+pb::Mesh* TableScenePreprocess::mesh_ = nullptr;
+pbtest::TableScene* TableScenePreprocess::scene_ = nullptr;
+
+TEST_F(TableScenePreprocess, RemovesTheTableKeepsTheObjectWithOrientedNormals) {
+  const pb::OrganizedCloud cloud = pb::OrganizedCloud::from_depth(scene_->depth, scene_->K);
+  pb::PreprocessSettings s;
+  const PointSet ps = pb::preprocess_scene(cloud, s, 5);
+  ASSERT_GT(ps.size(), 50u);
+  ASSERT_TRUE(ps.has_normals());
+  ASSERT_EQ(ps.curvature.size(), ps.size());
+  ASSERT_EQ(ps.pixel.size(), ps.size());
+  EXPECT_EQ(ps.source_width, scene_->K.width);
+  EXPECT_EQ(ps.source_height, scene_->K.height);
+  // Every remaining point is on the object (within its box grown by the
+  // voxel size and the noise), i.e. the table is gone.
+  const pb::Pose T_model_cam = scene_->T_cam_model.inverse();
+  Eigen::AlignedBox3f box = mesh_->bounds();
+  box.min() -= Vec3f::Constant(12.f);
+  box.max() += Vec3f::Constant(12.f);
+  size_t on_object = 0;
+  for (size_t i = 0; i < ps.size(); ++i) {
+    const Vec3f pm = (T_model_cam.R * ps.points[i].cast<double>() + T_model_cam.t).cast<float>();
+    on_object += box.contains(pm);
+    EXPECT_NEAR(ps.normals[i].norm(), 1.0f, 1e-4f);
+    EXPECT_LE(ps.normals[i].dot(ps.points[i]), 0.f) << "normal " << i << " faces away from the camera";
+    // The pixel of a point is within a voxel of it.
+    const int px = ps.pixel[i];
+    ASSERT_GE(px, 0);
+    ASSERT_LT(px, cloud.width * cloud.height);
+    EXPECT_LT((cloud.points[px] - ps.points[i]).norm(), s.voxel_mm * 1.8f);
+  }
+  EXPECT_GE(on_object, ps.size() * 97 / 100);
+  // Without plane removal the table stays: many more points.
+  pb::PreprocessSettings keep = s;
+  keep.remove_plane = false;
+  EXPECT_GT(pb::preprocess_scene(cloud, keep, 5).size(), 3 * ps.size());
+  // Range cut: everything beyond 1 mm of max range is cut.
+  pb::PreprocessSettings near = s;
+  near.max_range_mm = 300;
+  EXPECT_EQ(pb::preprocess_scene(cloud, near, 5).size(), 0u);
+}
+
+TEST_F(TableScenePreprocess, SameBitsWithOneAndTwoThreads) {
+  const pb::OrganizedCloud cloud = pb::OrganizedCloud::from_depth(scene_->depth, scene_->K);
+  pb::PreprocessSettings s;
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const PointSet a = pb::preprocess_scene(cloud, s, 9);
+  omp_set_num_threads(2);
+  const PointSet b = pb::preprocess_scene(cloud, s, 9);
+  omp_set_num_threads(saved);
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_GT(a.size(), 0u);
+  EXPECT_EQ(0, std::memcmp(a.points.data(), b.points.data(), a.size() * sizeof(Vec3f)));
+  EXPECT_EQ(0, std::memcmp(a.normals.data(), b.normals.data(), a.size() * sizeof(Vec3f)));
+  EXPECT_EQ(0, std::memcmp(a.curvature.data(), b.curvature.data(), a.size() * sizeof(float)));
+  EXPECT_EQ(a.pixel, b.pixel);
+}
+
+TEST(Preprocess, ViewKeepsEverythingAndEmptyInputGivesEmptyOutput) {
+  const pb::Mesh m = pbtest::make_l_block();
+  pbtest::TableSceneOptions o;
+  o.table = false;
+  o.noise_mm = 0;
+  const auto sc = pbtest::render_table_scene(m, o);
+  const pb::OrganizedCloud cloud = pb::OrganizedCloud::from_depth(sc.depth, sc.K);
+  pb::PreprocessSettings s;
+  s.max_range_mm = 200;  // preprocess_view ignores the scene's range cut
+  const PointSet v = pb::preprocess_view(cloud, s, 1);
+  EXPECT_GT(v.size(), 50u);
+  EXPECT_TRUE(v.has_normals());
+
+  pb::DepthImage empty(64, 48);
+  const pb::Intrinsics K = pb::Intrinsics::from_fov(64, 48, 50, 40);
+  const pb::OrganizedCloud ec = pb::OrganizedCloud::from_depth(empty, K);
+  EXPECT_TRUE(pb::preprocess_scene(ec, pb::PreprocessSettings{}, 1).empty());
+  EXPECT_TRUE(pb::preprocess_view(ec, pb::PreprocessSettings{}, 1).empty());
+  // A handful of isolated points: no normal can be estimated, so none survive.
+  pb::DepthImage sparse(64, 48);
+  sparse.at(5, 5) = 800;
+  sparse.at(40, 30) = 900;
+  EXPECT_TRUE(pb::preprocess_scene(pb::OrganizedCloud::from_depth(sparse, K), pb::PreprocessSettings{}, 1).empty());
+}
+
+TEST(Verify, PointIndexMatchesBruteForceAndCountsInliers) {
+  pb::Rng rng(11);
+  std::vector<Vec3f> pts;
+  for (int i = 0; i < 500; ++i)
+    pts.emplace_back(rng.uniform(-100, 100), rng.uniform(-100, 100), rng.uniform(400, 600));
+  const pb::PointIndex index(pts);
+  EXPECT_EQ(index.size(), 500u);
+  for (int q = 0; q < 50; ++q) {
+    const Vec3f p(rng.uniform(-120, 120), rng.uniform(-120, 120), rng.uniform(380, 620));
+    int best = -1;
+    float bd = 1e30f;
+    std::vector<int> within;
+    for (int i = 0; i < 500; ++i) {
+      const float d = (pts[i] - p).squaredNorm();
+      if (d < bd) bd = d, best = i;
+      if (d <= 30.f * 30.f) within.push_back(i);
+    }
+    float d2;
+    EXPECT_EQ(index.nearest(p, &d2), best);
+    EXPECT_NEAR(d2, bd, 1e-2f);
+    std::vector<int> r = index.radius(p, 30.f);
+    std::sort(r.begin(), r.end());
+    EXPECT_EQ(r, within);
+  }
+  // Inliers: the cloud against itself under the identity, then shifted.
+  EXPECT_EQ(pb::count_inliers(pts, pb::Pose::identity(), index, 1.0), 500);
+  pb::Pose far;
+  far.t = pb::Vec3(0, 0, 1000);
+  EXPECT_EQ(pb::count_inliers(pts, far, index, 10.0), 0);
+  pb::Pose small;
+  small.t = pb::Vec3(0.5, 0, 0);
+  EXPECT_EQ(pb::count_inliers(pts, small, index, 1.0), 500);
+
+  const pb::PointIndex empty(std::vector<Vec3f>{});
+  float d2 = 0;
+  EXPECT_EQ(empty.nearest(Vec3f(0, 0, 0), &d2), -1);
+  EXPECT_TRUE(empty.radius(Vec3f(0, 0, 0), 10).empty());
+  EXPECT_EQ(pb::count_inliers(pts, pb::Pose::identity(), empty, 10.0), 0);
+}
+
+}  // namespace
