@@ -77,17 +77,12 @@ struct SceneGenerator::Impl {
   int target = -1;
   std::vector<int> pool;                    // model indices of the distractor pool (without the target)
   Mesh table_mesh, floor_mesh, wall_mesh;
-  Intrinsics K, K_big;
+  Intrinsics K;
   RenderSettings rset;
-  std::unique_ptr<DepthRenderer> renderer, big;
+  std::unique_ptr<DepthRenderer> renderer;
 
   double half_fov_min() const {
     return std::min(std::atan(0.5 * K.width / K.fx), std::atan(0.5 * K.height / K.fy));
-  }
-
-  DepthRenderer& big_renderer() {
-    if (!big) big = std::make_unique<DepthRenderer>(K_big, rset);
-    return *big;
   }
 
   // Places model `mi` in rest pose `ri` with yaw at ground point xy.
@@ -126,9 +121,11 @@ struct SceneGenerator::Impl {
     return r.render(items);
   }
 
-  // Silhouette of one object alone (on a 3x canvas when it crosses the image
-  // border, so px_count_all counts the part outside the image, as BOP does).
-  // Returns false if the object lies entirely outside the image.
+  // Silhouette of one object alone. When it crosses the image border, the
+  // part outside is rendered too (tiles of the image size with shifted
+  // principal points), so px_count_all counts the whole silhouette, as BOP's
+  // calc_gt_info does on an enlarged canvas. Returns false if the object lies
+  // entirely outside the image.
   bool alone(const Placed& p, const Pose& T_cam_world, AloneStats& st) {
     const Pose T = T_cam_world * p.T_world_model;
     double umin = 1e300, umax = -1e300, vmin = 1e300, vmax = -1e300;
@@ -141,30 +138,49 @@ struct SceneGenerator::Impl {
     }
     const int W = K.width, H = K.height;
     if (umax < -0.5 || vmax < -0.5 || umin > W - 0.5 || vmin > H - 0.5) return false;
-    const bool inside = umin >= -0.5 && vmin >= -0.5 && umax <= W - 0.5 && vmax <= H - 0.5;
     st = AloneStats();
-    std::vector<RenderItem> items{{p.mesh, T, 0}};
+    const std::vector<RenderItem> items{{p.mesh, T, 0}};
     int bu0 = 1 << 30, bv0 = 1 << 30, bu1 = -(1 << 30), bv1 = -(1 << 30);
+    auto scan = [&](const RenderOutput& out, int u0, int v0) {
+      for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+          if (out.labels[static_cast<size_t>(y) * W + x] != 0) continue;
+          const int u = x + u0, v = y + v0;
+          ++st.px_all;
+          if (u >= 0 && v >= 0 && u < W && v < H) st.pixels.push_back(v * W + u);
+          bu0 = std::min(bu0, u), bu1 = std::max(bu1, u), bv0 = std::min(bv0, v), bv1 = std::max(bv1, v);
+        }
+    };
+    const bool inside = umin >= -0.5 && vmin >= -0.5 && umax <= W - 0.5 && vmax <= H - 0.5;
     if (inside) {
-      const RenderOutput out = renderer->render(items);
-      for (int v = 0; v < H; ++v)
-        for (int u = 0; u < W; ++u)
-          if (out.labels[static_cast<size_t>(v) * W + u] == 0) {
-            ++st.px_all;
-            st.pixels.push_back(v * W + u);
-            bu0 = std::min(bu0, u), bu1 = std::max(bu1, u), bv0 = std::min(bv0, v), bv1 = std::max(bv1, v);
-          }
+      scan(renderer->render(items), 0, 0);
     } else {
-      const RenderOutput out = big_renderer().render(items);
-      const int BW = K_big.width, BH = K_big.height;
-      for (int y = 0; y < BH; ++y)
-        for (int x = 0; x < BW; ++x)
-          if (out.labels[static_cast<size_t>(y) * BW + x] == 0) {
-            ++st.px_all;
-            const int u = x - W, v = y - H;
-            if (u >= 0 && v >= 0 && u < W && v < H) st.pixels.push_back(v * W + u);
-            bu0 = std::min(bu0, u), bu1 = std::max(bu1, u), bv0 = std::min(bv0, v), bv1 = std::max(bv1, v);
-          }
+      // Pixels whose centres can be covered: [ceil(min - 0.5), floor(max + 0.5)],
+      // limited to 3 image sizes around the image.
+      const int ua = std::max(-W, static_cast<int>(std::floor(umin)) - 1);
+      const int ub = std::min(2 * W - 1, static_cast<int>(std::ceil(umax)) + 1);
+      const int va = std::max(-H, static_cast<int>(std::floor(vmin)) - 1);
+      const int vb = std::min(2 * H - 1, static_cast<int>(std::ceil(vmax)) + 1);
+      for (int v0 = va; v0 <= vb; v0 += H)
+        for (int u0 = ua; u0 <= ub; u0 += W) {
+          Intrinsics Kt = K;
+          Kt.cx -= u0;
+          Kt.cy -= v0;
+          renderer->set_intrinsics(Kt);
+          const RenderOutput out = renderer->render(items);
+          renderer->set_intrinsics(K);
+          // Tiles overlap the requested range only where they extend past
+          // ub / vb: count each pixel once.
+          for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+              if (out.labels[static_cast<size_t>(y) * W + x] != 0) continue;
+              const int u = x + u0, v = y + v0;
+              if (u > ub || v > vb) continue;
+              ++st.px_all;
+              if (u >= 0 && v >= 0 && u < W && v < H) st.pixels.push_back(v * W + u);
+              bu0 = std::min(bu0, u), bu1 = std::max(bu1, u), bv0 = std::min(bv0, v), bv1 = std::max(bv1, v);
+            }
+        }
       std::sort(st.pixels.begin(), st.pixels.end());
     }
     st.bbox = bbox_of(bu0, bv0, bu1, bv1);
@@ -260,11 +276,6 @@ SceneGenerator::SceneGenerator(const SceneSettings& settings) : impl_(std::make_
   I.wall_mesh = make_box(30000, 200, s.warehouse.wall_height_mm);
 
   I.K = s.sensor.K;
-  I.K_big = I.K;
-  I.K_big.width = 3 * I.K.width;
-  I.K_big.height = 3 * I.K.height;
-  I.K_big.cx += I.K.width;
-  I.K_big.cy += I.K.height;
   I.rset.near_mm = 50;
   I.rset.far_mm = 40000;
   I.rset.normals = s.noise.model == "structured_light" || s.noise.model == "tof";
@@ -430,20 +441,25 @@ bool SceneGenerator::Impl::generate_attempt(int im_id, int attempt, GeneratedIma
     placed.push_back(&occl);
   }
 
-  // 4. Other objects, at the ground point seen through a random pixel.
+  // 4. Other objects, scattered around the target (a disc as wide as the
+  // view at the target's distance) with their centre inside the image.
+  const double spread = std::max(3.0 * r_t, dist * std::tan(half_fov_min()));
   const int n_other = pool.empty() ? 0 : rng.uniform_int(s.distractors.min_count, s.distractors.max_count);
   for (int k = 0; k < n_other; ++k) {
     const int mi = pool[rng.uniform_int(0, static_cast<int>(pool.size()) - 1)];
     const int ri = sample_rest_pose(rest[mi], s.distractors.upright_probability, rng);
     bool ok = false;
     for (int tries = 0; tries < 60 && !ok; ++tries) {
-      const double u = rng.uniform(-0.1, 1.1) * K.width;
-      const double v = rng.uniform(-0.1, 1.1) * K.height;
+      const double r = spread * std::sqrt(rng.uniform());
+      const double phi = rng.uniform(0, 2 * M_PI);
       const double yaw = rng.uniform(0, 2 * M_PI);
-      const Vec3 d = T_world_cam.R * Vec3((u - K.cx) / K.fx, (v - K.cy) / K.fy, 1.0);
-      if (d.z() >= -1e-6) continue;
-      const Vec3 hit = eye + d * (-eye.z() / d.z());
-      Placed p = on_ground(mi, ri, yaw, Vec2(hit.x(), hit.y()));
+      Placed p = on_ground(mi, ri, yaw, Vec2(r * std::cos(phi), r * std::sin(phi)));
+      const Vec3 c = T_cam_world * (p.T_world_model.t + Vec3(0, 0, 0));
+      if (c.z() <= rset.near_mm) continue;
+      const auto uv = K.project(c);
+      if (uv.x() < -0.05 * K.width || uv.x() > 1.05 * K.width || uv.y() < -0.05 * K.height ||
+          uv.y() > 1.05 * K.height)
+        continue;
       if (!fits(p, placed)) continue;
       objs.push_back(std::move(p));
       ok = true;
@@ -493,7 +509,7 @@ bool SceneGenerator::Impl::generate_attempt(int im_id, int attempt, GeneratedIma
       return false;
     }
     if (vmax >= s.occlusion.visib_fract.lo) best_h = hi, best_err = std::abs(vmax - goal);
-    for (int it = 0; it < 16 && best_err > 0.01; ++it) {
+    for (int it = 0; it < 12 && best_err > 0.02; ++it) {
       const double mid = 0.5 * (lo + hi);
       set_height(mid);
       const double v = target_visib({&occl});
@@ -597,7 +613,7 @@ GeneratedImage SceneGenerator::generate(int im_id) {
                        " attempts (last: " + why + "); relax the constraints or raise max_attempts");
 }
 
-std::vector<uint8_t> depth_preview_rgb(const DepthImage& depth) {
+std::vector<uint8_t> depth_preview_rgb(const DepthImage& depth, const Intrinsics* K) {
   std::vector<float> valid;
   for (float z : depth.z)
     if (z > 0.f) valid.push_back(z);
@@ -610,18 +626,39 @@ std::vector<uint8_t> depth_preview_rgb(const DepthImage& depth) {
     hi = valid[b];
     if (hi <= lo) hi = lo + 1;
   }
-  // Warm (near) to cool (far).
+  // Warm (near) to cool (far), shaded by the surface normal (light at the
+  // camera) so object outlines stand out.
   static const float keys[5][3] = {{165, 0, 38}, {244, 109, 67}, {254, 224, 144}, {116, 173, 209}, {49, 54, 149}};
+  const int W = depth.width, H = depth.height;
   std::vector<uint8_t> rgb(depth.z.size() * 3, 0);
-  for (size_t i = 0; i < depth.z.size(); ++i) {
-    const float z = depth.z[i];
-    if (!(z > 0.f)) continue;
-    const float t = std::clamp((z - lo) / (hi - lo), 0.f, 1.f) * 4.f;
-    const int k = std::min(3, static_cast<int>(t));
-    const float f = t - k;
-    for (int c = 0; c < 3; ++c)
-      rgb[3 * i + c] = static_cast<uint8_t>(std::lround(keys[k][c] * (1 - f) + keys[k + 1][c] * f));
-  }
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u) {
+      const size_t i = static_cast<size_t>(v) * W + u;
+      const float z = depth.z[i];
+      if (!(z > 0.f)) continue;
+      float shade = 1.f;
+      if (K && u > 0 && v > 0 && u + 1 < W && v + 1 < H) {
+        const float zl = depth.at(u - 1, v), zr = depth.at(u + 1, v), zu = depth.at(u, v - 1), zd = depth.at(u, v + 1);
+        const float jump = 30.f;
+        if (zl > 0 && zr > 0 && zu > 0 && zd > 0 && std::abs(zr - zl) < 2 * jump && std::abs(zd - zu) < 2 * jump) {
+          const Vec3 dx = K->backproject(u + 1, v, zr) - K->backproject(u - 1, v, zl);
+          const Vec3 dy = K->backproject(u, v + 1, zd) - K->backproject(u, v - 1, zu);
+          Vec3 n = dy.cross(dx);
+          const Vec3 ray = K->backproject(u, v, z).normalized();
+          if (n.norm() > 0) {
+            n.normalize();
+            shade = static_cast<float>(0.3 + 0.7 * std::abs(n.dot(ray)));
+          }
+        } else {
+          shade = 0.3f;  // depth edge
+        }
+      }
+      const float t = std::clamp((z - lo) / (hi - lo), 0.f, 1.f) * 4.f;
+      const int k = std::min(3, static_cast<int>(t));
+      const float f = t - k;
+      for (int c = 0; c < 3; ++c)
+        rgb[3 * i + c] = static_cast<uint8_t>(std::lround(shade * (keys[k][c] * (1 - f) + keys[k + 1][c] * f)));
+    }
   return rgb;
 }
 
@@ -674,7 +711,7 @@ GenerateSummary generate_dataset(const SceneSettings& settings, const std::strin
           write_gray8_png((scene_dir / "mask_visib" / (iid + "_" + bop_id(static_cast<int>(k)) + ".png")).string(), W,
                           H, m);
         }
-      if (im == 0) write_rgb8_png((tmp / "depth_preview.png").string(), W, H, depth_preview_rgb(img.depth));
+      if (im == 0) write_rgb8_png((tmp / "depth_preview.png").string(), W, H, depth_preview_rgb(img.depth, &s.sensor.K));
       const double tv = img.info.gt_info.empty() ? 0.0 : img.info.gt_info[0].visib_fract;
       visib_sum += tv;
       visib_min = std::min(visib_min, tv);

@@ -105,7 +105,8 @@ struct GenerateSummary {
 GenerateSummary generate_dataset(const SceneSettings& settings, const std::string& out_dir,
                                  void (*progress)(int done, int total) = nullptr);
 
-// Colour-mapped depth (near = warm, far = cool, black = no depth) as RGB8.
-std::vector<uint8_t> depth_preview_rgb(const DepthImage& depth);
+// Colour-mapped depth (near = warm, far = cool, black = no depth) as RGB8;
+// with intrinsics also shaded by the surface normal.
+std::vector<uint8_t> depth_preview_rgb(const DepthImage& depth, const Intrinsics* K = nullptr);
 
 }  // namespace pb
