@@ -132,6 +132,7 @@ std::string training_key_text(const RecognitionSettings& s) {
   nlohmann::ordered_json k;
   k["cache_version"] = kCacheVersion;
   for (const char* sec : {"descriptor", "views", "preprocess", "local", "global", "ppf", "seed"}) k[sec] = j[sec];
+  k["local"].erase("threads");  // results are identical for any thread count
   return k.dump();
 }
 
@@ -344,6 +345,10 @@ std::shared_ptr<const TrainedModel> train_model(const Mesh& mesh, const Recognit
   m->settings = s;
   if (mesh.empty()) {
     m->empty_reason = "model '" + opt.model_name + "' has no triangles";
+    return m;
+  }
+  if (!(mesh.bounds().diagonal().norm() > 0) || !mesh.bounds().diagonal().allFinite()) {
+    m->empty_reason = "model '" + opt.model_name + "' is degenerate (zero or non-finite extent)";
     return m;
   }
 

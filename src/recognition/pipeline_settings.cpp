@@ -4,6 +4,8 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <utility>
 
 #include "recognition/pipeline.h"
 #include "recognition/pipeline_internal.h"
@@ -30,16 +32,22 @@ std::string read_name(const YamlNode& node, const std::string& key, const std::v
 
 void parse_views(const YamlNode& node, ViewSettings& s) {
   if (!node.defined()) return;
-  node.check_keys({"views", "elevation_deg", "distance_factor", "resolution", "fov_deg"});
+  node.check_keys({"views", "elevation_deg", "side_elevation_deg", "below_elevation_deg", "distance_factor",
+                   "resolution", "fov_deg"});
   s.views = node.get_or<int>("views", s.views);
   if (s.views < 1) node["views"].fail("must be at least 1");
-  node.read("elevation_deg", s.elevation_deg);
-  if (!(std::abs(s.elevation_deg) <= 90)) node["elevation_deg"].fail("must be in [-90, 90]");
+  const std::pair<const char*, double*> angles[] = {{"elevation_deg", &s.elevation_deg},
+                                                     {"side_elevation_deg", &s.side_elevation_deg},
+                                                     {"below_elevation_deg", &s.below_elevation_deg}};
+  for (const auto& [key, v] : angles) {
+    node.read(key, *v);
+    if (!(std::abs(*v) <= 90)) node[key].fail("must be in [-90, 90]");
+  }
   s.distance_factor = node.get_positive("distance_factor", s.distance_factor);
   s.resolution = node.get_or<int>("resolution", s.resolution);
   if (s.resolution < 8 || s.resolution > 4096) node["resolution"].fail("must be in [8, 4096]");
   s.fov_deg = node.get_positive("fov_deg", s.fov_deg);
-  if (s.fov_deg >= 180) node["fov_deg"].fail("must be below 180");
+  if (s.fov_deg >= 170) node["fov_deg"].fail("must be below 170");
 }
 
 }  // namespace
@@ -85,6 +93,8 @@ nlohmann::ordered_json settings_json(const RecognitionSettings& s) {
   j["refinement"] = s.refinement;
   j["views"] = {{"views", s.views.views},
                 {"elevation_deg", s.views.elevation_deg},
+                {"side_elevation_deg", s.views.side_elevation_deg},
+                {"below_elevation_deg", s.views.below_elevation_deg},
                 {"distance_factor", s.views.distance_factor},
                 {"resolution", s.views.resolution},
                 {"fov_deg", s.views.fov_deg}};
@@ -102,10 +112,13 @@ nlohmann::ordered_json settings_json(const RecognitionSettings& s) {
                 {"descriptor_radius_mm", l.descriptor_radius_mm},
                 {"lrf_radius_mm", l.lrf_radius_mm},
                 {"match_threshold", l.match_threshold},
+                {"fpfh_match_threshold", l.fpfh_match_threshold},
                 {"matches_per_keypoint", l.matches_per_keypoint},
                 {"hough_bin_mm", l.hough_bin_mm},
                 {"hough_min_votes", l.hough_min_votes},
-                {"max_hypotheses", l.max_hypotheses}};
+                {"hough_interpolation", l.hough_interpolation},
+                {"max_hypotheses", l.max_hypotheses},
+                {"threads", l.threads}};
   const auto& g = s.global;
   j["global"] = {{"cluster_tolerance_mm", g.cluster_tolerance_mm},
                  {"cluster_min_points", g.cluster_min_points},
@@ -119,7 +132,13 @@ nlohmann::ordered_json settings_json(const RecognitionSettings& s) {
                  {"crh_bins", g.crh_bins},
                  {"crh_peak_threshold", g.crh_peak_threshold},
                  {"crh_max_peaks", g.crh_max_peaks},
-                 {"skip_crh", g.skip_crh}};
+                 {"skip_crh", g.skip_crh},
+                 {"cvfh_normal_radius_mm", g.cvfh_normal_radius_mm},
+                 {"cvfh_normalize_bins", g.cvfh_normalize_bins},
+                 {"crh_peak_distance_deg", g.crh_peak_distance_deg},
+                 {"ourcvfh_axis_ratio", g.ourcvfh_axis_ratio},
+                 {"ourcvfh_min_axis_value", g.ourcvfh_min_axis_value},
+                 {"ourcvfh_refine_clusters", g.ourcvfh_refine_clusters}};
   const auto& f = s.ppf;
   j["ppf"] = {{"model_points", f.model_points},
               {"angle_step_deg", f.angle_step_deg},
@@ -132,11 +151,18 @@ nlohmann::ordered_json settings_json(const RecognitionSettings& s) {
   j["refine"] = {{"max_iterations", r.max_iterations},
                  {"max_correspondence_mm", r.max_correspondence_mm},
                  {"transformation_epsilon", r.transformation_epsilon},
+                 {"rotation_epsilon_deg", r.rotation_epsilon_deg},
                  {"fitness_epsilon", r.fitness_epsilon},
                  {"icp_sample_points", r.icp_sample_points},
                  {"ndt_resolution_mm", r.ndt_resolution_mm},
+                 {"ndt_resolution_fraction", r.ndt_resolution_fraction},
                  {"ndt_step_size_mm", r.ndt_step_size_mm},
-                 {"gicp_correspondence_randomness", r.gicp_correspondence_randomness}};
+                 {"ndt_outlier_ratio", r.ndt_outlier_ratio},
+                 {"ndt_min_points_per_cell", r.ndt_min_points_per_cell},
+                 {"gicp_correspondence_randomness", r.gicp_correspondence_randomness},
+                 {"gicp_covariances_from_normals", r.gicp_covariances_from_normals},
+                 {"crop_margin_mm", r.crop_margin_mm},
+                 {"normal_neighbours", r.normal_neighbours}};
   j["verify"] = {{"inlier_threshold_mm", s.verify.inlier_threshold_mm},
                  {"min_inlier_fraction", s.verify.min_inlier_fraction}};
   j["seed"] = s.seed;
