@@ -203,6 +203,20 @@ TEST(Registry, Diameters) {
   EXPECT_NEAR(diameter("ls5"), std::sqrt(106.0 * 106 + 145 * 145), 0.05);
 }
 
+TEST(Registry, ExactDiameterMatchesBruteForce) {
+  const ModelRegistry reg = ModelRegistry::load_default();
+  for (const auto& n : reg.names()) {
+    if (!reg.available(n)) continue;
+    const Mesh m = reg.load_model(n);
+    if (m.vertices.size() > 5000) continue;  // brute force is O(n^2)
+    EXPECT_NEAR(exact_diameter(m), m.diameter(), 1e-6 * m.diameter()) << n;  // core computes in float
+  }
+  Mesh two;
+  two.vertices = {{0, 0, 0}, {3, 4, 0}};
+  EXPECT_DOUBLE_EQ(exact_diameter(two), 5.0);
+  EXPECT_EQ(exact_diameter(Mesh()), 0.0);
+}
+
 TEST(Registry, DeclaredSymmetriesHoldForGeneratedModels) {
   const ModelRegistry reg = ModelRegistry::load_default();
   for (const char* n : {"milk_carton", "boletus", "box_small", "cylinder", "pallet"}) {

@@ -3,6 +3,7 @@
 // normalized to millimetres, up = +z, origin at the bounding box centre.
 #include "models/registry.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -79,6 +80,35 @@ Vec3 read_vec3(const YamlNode& n) {
 }
 
 }  // namespace
+
+double exact_diameter(const Mesh& mesh) {
+  // Sort by distance r from the bbox centre c, largest first. For any pair,
+  // |a - b| <= r_a + r_b, so once r_i + r_j cannot beat the best distance
+  // found, no later j (smaller r) can either, and once 2 r_i cannot, no
+  // later i can. Exact, and near-linear on real meshes.
+  const size_t n = mesh.vertices.size();
+  if (n < 2) return 0.0;
+  const Vec3 c = mesh.bounds().center().cast<double>();
+  std::vector<std::pair<double, Vec3>> pts(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 p = mesh.vertices[i].cast<double>();
+    pts[i] = {(p - c).norm(), p};
+  }
+  std::sort(pts.begin(), pts.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  double best2 = 0, best = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (2 * pts[i].first < best) break;
+    for (size_t j = i + 1; j < n; ++j) {
+      if (pts[i].first + pts[j].first < best) break;
+      const double d2 = (pts[i].second - pts[j].second).squaredNorm();
+      if (d2 > best2) {
+        best2 = d2;
+        best = std::sqrt(d2);
+      }
+    }
+  }
+  return best;
+}
 
 struct ModelRegistry::Cache {
   std::mutex mutex;
@@ -275,7 +305,7 @@ ModelInfo ModelRegistry::info(const std::string& name, const Mesh& mesh) const {
   ModelInfo i;
   i.obj_id = s.obj_id;
   i.name = s.name;
-  i.diameter = mesh.diameter();
+  i.diameter = exact_diameter(mesh);
   const Eigen::AlignedBox3f b = mesh.bounds();
   i.min = b.min().cast<double>();
   i.size = (b.max() - b.min()).cast<double>();

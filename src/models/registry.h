@@ -32,6 +32,11 @@ struct ModelSpec {
   std::string description;
 };
 
+// The diameter of BOP's models_info (largest distance between two vertices),
+// exact, with a pruned search: the same value as Mesh::diameter() (which is
+// O(n^2)), in milliseconds instead of seconds on a 35k-vertex mesh.
+double exact_diameter(const Mesh& mesh);
+
 class ModelRegistry {
  public:
   // Parses a registry file; InputError naming file and field on any bad entry
