@@ -368,6 +368,8 @@ TEST(Registry, BadEntriesNameTheFileAndTheField) {
       {head + "    source: generated:box\n    symmetries_continuous:\n      - {axis: [0, 0, 1], offst: [0, 0, 0]}\n",
        "models.bad.symmetries_continuous[0].offst"},
       {"model:\n  bad: {}\n", "model"},
+      {"models:\n  obj_000001:\n    obj_id: 1\n    source: generated:box\n", "models.obj_000001"},
+      {"models:\n  '12':\n    obj_id: 1\n    source: generated:box\n", "models.12"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.yaml);

@@ -67,7 +67,9 @@ struct JRef {
   int integer() const {
     if (!j.is_number_integer() && !(j.is_number_float() && std::floor(j.get<double>()) == j.get<double>()))
       throw InputError(file, path, "expected an integer");
-    return static_cast<int>(j.get<double>());
+    const double v = j.get<double>();
+    if (std::abs(v) > 2147483647.0) throw InputError(file, path, "integer out of range");
+    return static_cast<int>(v);
   }
   const json& array(size_t n) const {
     if (!j.is_array()) throw InputError(file, path, "expected a list");

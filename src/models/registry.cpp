@@ -4,6 +4,7 @@
 #include "models/registry.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -135,6 +136,15 @@ ModelRegistry ModelRegistry::load(const std::string& registry_path) {
   for (const std::string& name : models.keys()) {
     if (reg.specs_.count(name)) models[name].fail("duplicate model name '" + name + "'");
     const YamlNode e = models[name];
+    // Names must not read as object ids ("3", "obj_000003"): BopDataset::
+    // resolve_object accepts all three forms.
+    const bool name_ok = !name.empty() && std::isalpha(static_cast<unsigned char>(name[0])) &&
+                         name.rfind("obj_", 0) != 0 &&
+                         std::all_of(name.begin(), name.end(), [](char ch) {
+                           return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-' || ch == '.';
+                         });
+    if (!name_ok)
+      e.fail("model name '" + name + "' must start with a letter, use only letters, digits, _ - . and not start with obj_");
     if (!e.is_map()) e.fail("expected a mapping (obj_id, source, ...)");
     e.check_keys({"obj_id", "source", "scale", "fit_size", "up", "role", "symmetries_discrete",
                   "symmetries_continuous", "description"});
