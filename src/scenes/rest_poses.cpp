@@ -286,7 +286,7 @@ RestPoses compute_rest_poses(const Mesh& mesh, double min_margin_fraction) {
   out.centre_of_mass = com;
   Eigen::AlignedBox3d box;
   for (const auto& v : V) box.extend(v);
-  const double min_margin = std::max(0.5, min_margin_fraction * box.diagonal().norm());
+  const double min_margin = std::max(0.05, min_margin_fraction * box.diagonal().norm());
 
   // Merge coplanar adjacent hull triangles into facets (union-find).
   const int nf = static_cast<int>(H.size());

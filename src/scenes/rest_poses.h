@@ -40,8 +40,9 @@ std::vector<Eigen::Vector3i> convex_hull_3d(const std::vector<Vec3>& points);
 Vec3 centre_of_mass(const Mesh& mesh);
 
 // Rest poses of the mesh. The margin required for a facet to count as stable
-// is `min_margin_fraction` times the mesh diameter (at least 0.5 mm).
-RestPoses compute_rest_poses(const Mesh& mesh, double min_margin_fraction = 0.01);
+// is `min_margin_fraction` times the bounding box diagonal (at least 0.05 mm):
+// small, so that round objects rest on the narrow strips of their side.
+RestPoses compute_rest_poses(const Mesh& mesh, double min_margin_fraction = 0.002);
 
 // Draws a rest pose: the upright one with probability `upright_probability`
 // (if it exists), otherwise one by the facets' probabilities.

@@ -13,7 +13,9 @@ std::string scenario_name(Scenario s) { return s == Scenario::table ? "table" : 
 SceneSettings default_scene_settings(Scenario s) {
   SceneSettings st;
   st.scenario = s;
+  st.distractors.pool = {"milk_carton", "boletus", "box_small", "cylinder"};
   if (s == Scenario::warehouse) {
+    st.distractors.pool = {"pallet", "box_large", "barrel"};
     st.camera.distance_mm = {2000, 5000};
     st.camera.elevation_deg = {5, 30};
     st.distractors.min_count = 0;

@@ -61,6 +61,8 @@ struct SceneCameraSettings {
 struct DistractorSettings {
   // Registry names the other objects are drawn from (with replacement; the
   // target's name is skipped). Procedural models need no ../shared.
+  // table: milk_carton, boletus, box_small, cylinder; warehouse: pallet,
+  // box_large, barrel.
   std::vector<std::string> pool;
   // Number of other objects per image (inclusive). table: 3-8, warehouse: 0-2
   // (so 1 to 3 objects in all).

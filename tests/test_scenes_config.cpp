@@ -1,0 +1,133 @@
+// Scene config parsing: defaults per scenario, ranges, and errors that name
+// the file, the field and the line.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "core/error.h"
+#include "core/yaml.h"
+#include "scenes/scene_config.h"
+
+using namespace pb;
+
+namespace {
+
+SceneSettings parse(const std::string& yaml) {
+  return parse_scene_settings(YamlNode::load_string(yaml, "cfg.yaml"));
+}
+
+// Expects an InputError naming the file and `field`; returns its message.
+std::string error_of(const std::string& yaml, const std::string& field) {
+  try {
+    parse(yaml);
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), "cfg.yaml") << e.what();
+    EXPECT_EQ(e.field(), field) << e.what();
+    return e.what();
+  }
+  ADD_FAILURE() << "no InputError for:\n" << yaml;
+  return "";
+}
+
+}  // namespace
+
+TEST(SceneConfig, DefaultsPerScenario) {
+  const SceneSettings t = parse("scenario: table\n");
+  EXPECT_EQ(t.images, 30);
+  EXPECT_EQ(t.target, "ls5");
+  EXPECT_EQ(t.camera.distance_mm.lo, 600);
+  EXPECT_EQ(t.camera.distance_mm.hi, 1500);
+  EXPECT_EQ(t.camera.elevation_deg.lo, 30);
+  EXPECT_EQ(t.camera.elevation_deg.hi, 70);
+  EXPECT_EQ(t.distractors.min_count, 3);
+  EXPECT_EQ(t.distractors.max_count, 8);
+  EXPECT_EQ(t.sensor.K.width, 512);
+  EXPECT_EQ(t.noise.model, "gaussian");
+  EXPECT_DOUBLE_EQ(t.noise.gaussian.sigma_mm, 1.0);
+  EXPECT_FALSE(t.occlusion.enabled);
+  const SceneSettings w = parse("scenario: warehouse\ndistractors: {pool: [pallet]}\n");
+  EXPECT_EQ(w.camera.distance_mm.lo, 2000);
+  EXPECT_EQ(w.camera.distance_mm.hi, 5000);
+  EXPECT_EQ(w.distractors.min_count, 0);
+  EXPECT_EQ(w.distractors.max_count, 2);
+  EXPECT_EQ(w.warehouse.object_size_mm.lo, 1000);
+  EXPECT_EQ(w.warehouse.object_size_mm.hi, 1500);
+}
+
+TEST(SceneConfig, FullConfig) {
+  const SceneSettings s = parse(R"(
+scenario: table
+seed: 42
+images: 5
+scene_id: 7
+sensor: astra
+noise: {model: gaussian, sigma_mm: 2.5}
+depth_scale: 0.25
+target: milk_carton
+distractors: {pool: [boletus, cylinder], count: [2, 4], upright_probability: 1.0}
+occlusion: [0.5, 0.7]
+camera: {distance_mm: 800, elevation_deg: [40, 50]}
+)");
+  EXPECT_EQ(s.seed, 42u);
+  EXPECT_EQ(s.images, 5);
+  EXPECT_EQ(s.scene_id, 7);
+  EXPECT_EQ(s.sensor.K.width, 640);
+  EXPECT_EQ(s.noise.model, "gaussian");
+  EXPECT_DOUBLE_EQ(s.noise.gaussian.sigma_mm, 2.5);
+  EXPECT_DOUBLE_EQ(s.depth_scale, 0.25);
+  EXPECT_EQ(s.target, "milk_carton");
+  EXPECT_EQ(s.distractors.pool.size(), 2u);
+  EXPECT_EQ(s.distractors.min_count, 2);
+  EXPECT_EQ(s.distractors.max_count, 4);
+  EXPECT_TRUE(s.occlusion.enabled);
+  EXPECT_DOUBLE_EQ(s.occlusion.visib_fract.lo, 0.5);
+  EXPECT_DOUBLE_EQ(s.occlusion.visib_fract.hi, 0.7);
+  EXPECT_DOUBLE_EQ(s.camera.distance_mm.lo, 800);
+  EXPECT_DOUBLE_EQ(s.camera.distance_mm.hi, 800);
+  EXPECT_NE(scene_settings_json(s).find("\"seed\": 42"), std::string::npos);
+}
+
+TEST(SceneConfig, Errors) {
+  std::string m = error_of("scenario: table\ncolour: red\n", "colour");
+  EXPECT_NE(m.find("line 2"), std::string::npos) << m;
+  error_of("scenario: kitchen\n", "scenario");
+  error_of("images: 3\n", "scenario");
+  error_of("scenario: table\nimages: -3\n", "images");
+  error_of("scenario: table\ncamera: {distance_mm: [-600, 1500]}\n", "camera.distance_mm");
+  error_of("scenario: table\ncamera: {distance_mm: [1500, 600]}\n", "camera.distance_mm");
+  error_of("scenario: table\ncamera: {zoom: 2}\n", "camera.zoom");
+  error_of("scenario: table\ntable: {size_mm: -4}\n", "table.size_mm");
+  error_of("scenario: warehouse\nwarehouse: {object_size_mm: [-1, 2]}\ndistractors: {pool: [pallet]}\n",
+           "warehouse.object_size_mm");
+  error_of("scenario: table\nocclusion: [0.4, 1.5]\n", "occlusion");
+  error_of("scenario: table\nocclusion: sometimes\n", "occlusion");
+  error_of("scenario: table\ndistractors: {pool: [], count: [3, 8]}\n", "distractors");
+  error_of("scenario: table\ndistractors: {pool: [boletus], count: [-1, 2]}\n", "distractors.count");
+  error_of("scenario: table\ntarget_upright_probability: 2\n", "target_upright_probability");
+  error_of("scenario: table\nimages: many\n", "images");
+  m = error_of("scenario: table\nsensor: lidar9000\n", "sensor");
+  EXPECT_NE(m.find("lidar9000"), std::string::npos) << m;
+}
+
+TEST(SceneConfig, MalformedYamlNamesTheFile) {
+  const std::string dir = std::filesystem::temp_directory_path() / "posebench_cfg_test";
+  std::filesystem::create_directories(dir);
+  const std::string f = dir + "/broken.yaml";
+  std::ofstream(f) << "scenario: table\ncamera: {distance_mm: [600, 1500\n";
+  try {
+    load_scene_settings(f);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), f);
+    EXPECT_NE(std::string(e.what()).find("line"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(SceneConfig, RegistryRelativeToConfig) {
+  const SceneSettings s = parse_scene_settings(
+      YamlNode::load_string("scenario: table\nregistry: ../models/models.yaml\n", "/a/b/configs/cfg.yaml"));
+  EXPECT_EQ(s.registry, "/a/b/models/models.yaml");
+  EXPECT_EQ(s.name, "cfg");
+}
