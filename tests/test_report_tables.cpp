@@ -1,0 +1,80 @@
+// The reporter's tables: cells computed from records match hand-computed
+// robustness, accuracy and time, and the thesis's values sit beside them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "report/report.h"
+
+namespace {
+
+nlohmann::json rec(const std::string& scene, const std::string& desc, bool ok, double t_err, double r_err,
+                   double time) {
+  nlohmann::json r = {{"scene", scene}, {"descriptor", desc}, {"refinement", "icp"},
+                      {"params", nlohmann::json::object()}, {"added_noise_mm", 0.0},
+                      {"status", ok ? "ok" : "no_hypothesis"}, {"times", {{"total", time}}}};
+  if (ok) r["errors"] = {{"translation_mm", t_err}, {"rotation_1mpq", r_err}, {"rotation_deg", 1.0}};
+  return r;
+}
+
+nlohmann::json experiment() {
+  return {{"name", "t"},
+          {"descriptors", {"cvfh", "fpfh"}},
+          {"refinements", {"icp"}},
+          {"added_noise_mm", {0.0}},
+          {"thresholds", {50.0, 100.0, 0.05}},
+          {"scenes", {{{"name", "table_synthetic"}, {"scenario", "table"}}}},
+          {"report", {{"reference_table", "4.1"}}}};
+}
+
+TEST(Report, CellsMatchHandComputedAggregates) {
+  std::vector<nlohmann::json> records = {
+      rec("table_synthetic", "cvfh", true, 10.0, 0.01, 0.2),   // correct
+      rec("table_synthetic", "cvfh", true, 30.0, 0.03, 0.4),   // correct
+      rec("table_synthetic", "cvfh", true, 60.0, 0.01, 0.3),   // translation too large
+      rec("table_synthetic", "cvfh", false, 0, 0, 0.5),        // no hypothesis
+      rec("table_synthetic", "fpfh", true, 5.0, 0.001, 1.0),   // correct
+  };
+  pb::ReportOptions opt;
+  opt.reference_file = std::string(POSEBENCH_SOURCE_DIR) + "/configs/thesis/reference.yaml";
+  const pb::Report r = pb::build_report(experiment(), records, opt);
+  ASSERT_EQ(r.tables.size(), 1u);
+  const auto& t = r.tables[0];
+  ASSERT_EQ(t.columns, (std::vector<std::string>{"cvfh", "fpfh"}));
+  ASSERT_EQ(t.rows.size(), 4u);
+  EXPECT_EQ(t.rows[0].measure, "robustness");
+  EXPECT_DOUBLE_EQ(t.rows[0].cells[0].value, 0.5);
+  EXPECT_DOUBLE_EQ(t.rows[0].cells[1].value, 1.0);
+  EXPECT_DOUBLE_EQ(t.rows[0].cells[0].reference, 0.43);  // Table 4.1, table synthetic, CVFH
+  EXPECT_DOUBLE_EQ(t.rows[0].cells[1].reference, 0.67);
+  EXPECT_EQ(t.rows[1].measure, "translation_mm");
+  EXPECT_DOUBLE_EQ(t.rows[1].cells[0].value, 20.0);
+  EXPECT_NEAR(t.rows[2].cells[0].value, 0.02, 1e-12);
+  EXPECT_EQ(t.rows[3].measure, "time");
+  EXPECT_NEAR(t.rows[3].cells[0].value, (0.2 + 0.4 + 0.3 + 0.5) / 4, 1e-12);
+  const std::string md = pb::to_markdown(r);
+  EXPECT_NE(md.find("50% (43%)"), std::string::npos) << md;
+  EXPECT_NE(md.find("100% (67%)"), std::string::npos) << md;
+  const std::string csv = pb::to_csv(r);
+  EXPECT_NE(csv.find("table_synthetic,robustness,cvfh,0.5,0.43,4"), std::string::npos) << csv;
+}
+
+TEST(Report, NoiseSweepMakesOnePlotSeriesPerMethod) {
+  auto exp = experiment();
+  exp["added_noise_mm"] = {0.0, 5.0};
+  std::vector<nlohmann::json> records;
+  for (double n : {0.0, 5.0})
+    for (int i = 0; i < 2; ++i) {
+      auto r = rec("table_synthetic", "cvfh", n == 0.0 || i == 0, 10, 0.01, 0.1);
+      r["added_noise_mm"] = n;
+      records.push_back(r);
+    }
+  const pb::Report r = pb::build_report(exp, records, {});
+  ASSERT_EQ(r.plots.size(), 1u);
+  ASSERT_EQ(r.plots[0].series.size(), 1u);
+  EXPECT_EQ(r.plots[0].series[0].x, (std::vector<double>{0.0, 5.0}));
+  EXPECT_EQ(r.plots[0].series[0].robustness, (std::vector<double>{1.0, 0.5}));
+  EXPECT_EQ(r.tables.size(), 2u);  // one table per noise level
+}
+
+}  // namespace
