@@ -10,6 +10,9 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <stdexcept>
+#include <unordered_map>
+#include <utility>
 
 #include <Eigen/Eigenvalues>
 
@@ -58,62 +61,81 @@ PointSet voxel_downsample(const PointSet& in, double leaf_mm) {
   if (!(leaf_mm > 0) || in.points.empty()) return in;
   const size_t n = in.points.size();
   const bool has_n = in.normals.size() == n, has_c = in.curvature.size() == n, has_px = in.pixel.size() == n;
-  struct Key {
-    int64_t x, y, z;
-    uint32_t i;
-  };
-  std::vector<Key> keys;
-  keys.reserve(n);
+  // Cell index per point, packed as 21 bits per axis with z most
+  // significant, so that sorting the packed keys gives pcl::VoxelGrid's
+  // order (z, then y, then x index).
+  constexpr int64_t kOff = int64_t(1) << 20;
   const double inv = 1.0 / leaf_mm;
+  std::vector<uint64_t> key(n, ~uint64_t(0));
   for (size_t i = 0; i < n; ++i) {
     const Vec3f& p = in.points[i];
     if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) continue;
-    keys.push_back({static_cast<int64_t>(std::floor(p.x() * inv)), static_cast<int64_t>(std::floor(p.y() * inv)),
-                    static_cast<int64_t>(std::floor(p.z() * inv)), static_cast<uint32_t>(i)});
+    const double c[3] = {std::floor(p.x() * inv), std::floor(p.y() * inv), std::floor(p.z() * inv)};
+    if (std::abs(c[0]) >= kOff || std::abs(c[1]) >= kOff || std::abs(c[2]) >= kOff)
+      throw std::invalid_argument("voxel grid: leaf " + std::to_string(leaf_mm) + " mm too small for the extent");
+    key[i] = (static_cast<uint64_t>(static_cast<int64_t>(c[2]) + kOff) << 42) |
+             (static_cast<uint64_t>(static_cast<int64_t>(c[1]) + kOff) << 21) |
+             static_cast<uint64_t>(static_cast<int64_t>(c[0]) + kOff);
   }
-  // pcl::VoxelGrid orders its output by the linear cell index i + j*dx +
-  // k*dx*dy, i.e. by z, then y, then x; points in a cell keep input order.
-  std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
-    if (a.z != b.z) return a.z < b.z;
-    if (a.y != b.y) return a.y < b.y;
-    if (a.x != b.x) return a.x < b.x;
-    return a.i < b.i;
-  });
+  // Accumulate per cell in input order (hash map from key to cell slot).
+  struct Cell {
+    Vec3 sum = Vec3::Zero(), nsum = Vec3::Zero();
+    double csum = 0;
+    uint32_t count = 0, first = 0;
+  };
+  std::unordered_map<uint64_t, uint32_t> slot;
+  slot.reserve(n / 8 + 16);
+  std::vector<Cell> cells;
+  std::vector<uint32_t> cell_of(n, ~uint32_t(0));
+  for (size_t i = 0; i < n; ++i) {
+    if (key[i] == ~uint64_t(0)) continue;
+    auto [it, fresh] = slot.emplace(key[i], static_cast<uint32_t>(cells.size()));
+    if (fresh) {
+      cells.emplace_back();
+      cells.back().first = static_cast<uint32_t>(i);
+    }
+    Cell& c = cells[it->second];
+    c.sum += in.points[i].cast<double>();
+    if (has_n) c.nsum += in.normals[i].cast<double>();
+    if (has_c) c.csum += in.curvature[i];
+    ++c.count;
+    cell_of[i] = it->second;
+  }
+  std::vector<Vec3> centroid(cells.size());
+  for (size_t k = 0; k < cells.size(); ++k) centroid[k] = cells[k].sum / static_cast<double>(cells[k].count);
+  // The pixel of a cell: its point nearest to the centroid (smaller pixel on ties).
+  std::vector<int> best_px(cells.size(), -1);
+  if (has_px) {
+    std::vector<double> best_d(cells.size(), std::numeric_limits<double>::infinity());
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t k = cell_of[i];
+      if (k == ~uint32_t(0)) continue;
+      const double d = (in.points[i].cast<double>() - centroid[k]).squaredNorm();
+      const int px = in.pixel[i];
+      if (d < best_d[k] || (d == best_d[k] && px < best_px[k])) {
+        best_d[k] = d;
+        best_px[k] = px;
+      }
+    }
+  }
+  std::vector<std::pair<uint64_t, uint32_t>> order;
+  order.reserve(cells.size());
+  for (const auto& [k, v] : slot) order.emplace_back(k, v);
+  std::sort(order.begin(), order.end());
+
   PointSet out;
   out.source_width = in.source_width;
   out.source_height = in.source_height;
-  for (size_t b = 0; b < keys.size();) {
-    size_t e = b + 1;
-    while (e < keys.size() && keys[e].x == keys[b].x && keys[e].y == keys[b].y && keys[e].z == keys[b].z) ++e;
-    Vec3 c = Vec3::Zero(), nrm = Vec3::Zero();
-    double curv = 0;
-    for (size_t k = b; k < e; ++k) {
-      c += in.points[keys[k].i].cast<double>();
-      if (has_n) nrm += in.normals[keys[k].i].cast<double>();
-      if (has_c) curv += in.curvature[keys[k].i];
-    }
-    const double cnt = static_cast<double>(e - b);
-    c /= cnt;
-    out.points.push_back(c.cast<float>());
+  out.points.reserve(order.size());
+  for (const auto& [k, idx] : order) {
+    const Cell& c = cells[idx];
+    out.points.push_back(centroid[idx].cast<float>());
     if (has_n) {
-      const double l = nrm.norm();
-      out.normals.push_back(l > 0 ? Vec3f((nrm / l).cast<float>()) : in.normals[keys[b].i]);
+      const double l = c.nsum.norm();
+      out.normals.push_back(l > 0 ? Vec3f((c.nsum / l).cast<float>()) : in.normals[c.first]);
     }
-    if (has_c) out.curvature.push_back(static_cast<float>(curv / cnt));
-    if (has_px) {
-      int best_px = -1;
-      double best_d = std::numeric_limits<double>::infinity();
-      for (size_t k = b; k < e; ++k) {
-        const double d = (in.points[keys[k].i].cast<double>() - c).squaredNorm();
-        const int px = in.pixel[keys[k].i];
-        if (d < best_d || (d == best_d && px < best_px)) {
-          best_d = d;
-          best_px = px;
-        }
-      }
-      out.pixel.push_back(best_px);
-    }
-    b = e;
+    if (has_c) out.curvature.push_back(static_cast<float>(c.csum / c.count));
+    if (has_px) out.pixel.push_back(best_px[idx]);
   }
   return out;
 }
