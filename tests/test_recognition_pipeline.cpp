@@ -192,71 +192,106 @@ TEST_F(Pipeline, MismatchedSettingsAreInputErrors) {
   EXPECT_THROW(pb::train_model(*mesh_, small_settings("sift")), pb::InputError);
 }
 
-TEST_F(Pipeline, CacheIsReusedAndCorruptFilesAreRebuilt) {
-  const fs::path dir = fs::temp_directory_path() / ("pb_reco_cache_" + std::to_string(::getpid()));
+fs::path fresh_cache_dir(const std::string& tag) {
+  const fs::path dir = fs::temp_directory_path() / ("pb_reco_cache_" + tag + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
+  return dir;
+}
+
+// Every method's trained state goes through its save / load: a model read
+// back from the cache gives the same hypotheses bit for bit.
+class PipelineCache : public Pipeline, public ::testing::WithParamInterface<std::string> {};
+
+TEST_P(PipelineCache, SecondTrainingComesFromTheCacheWithIdenticalResults) {
+  const fs::path dir = fresh_cache_dir(GetParam());
   pb::TrainOptions opt;
   opt.cache_dir = dir.string();
   opt.model_name = "l block";
-  for (const std::string d : {"fpfh", "cesf"}) {
-    const pb::RecognitionSettings s = small_settings(d);
-    bool cached = true;
-    const auto fresh = pb::train_model(*mesh_, s, opt, &cached);
-    EXPECT_FALSE(cached) << d;
-    const std::string file = pb::trained_model_info(*fresh).cache_file;
-    ASSERT_TRUE(fs::exists(file)) << file;
-    const auto again = pb::train_model(*mesh_, s, opt, &cached);
-    EXPECT_TRUE(cached) << d;
-    EXPECT_EQ(pb::trained_model_info(*again).views, pb::trained_model_info(*fresh).views);
-    EXPECT_EQ(pb::trained_model_info(*again).view_points, pb::trained_model_info(*fresh).view_points);
-    const auto r1 = pb::recognize(scene_->depth, scene_->K, *fresh, s);
-    const auto r2 = pb::recognize(scene_->depth, scene_->K, *again, s);
-    expect_same_result(r1, r2, d + ": fresh vs cached model");
+  const pb::RecognitionSettings s = small_settings(GetParam());
+  bool cached = true;
+  const auto fresh = pb::train_model(*mesh_, s, opt, &cached);
+  EXPECT_FALSE(cached);
+  const std::string file = pb::trained_model_info(*fresh).cache_file;
+  ASSERT_TRUE(fs::exists(file)) << file;
+  const auto again = pb::train_model(*mesh_, s, opt, &cached);
+  EXPECT_TRUE(cached);
+  EXPECT_EQ(pb::trained_model_info(*again).views, pb::trained_model_info(*fresh).views);
+  EXPECT_EQ(pb::trained_model_info(*again).view_points, pb::trained_model_info(*fresh).view_points);
+  expect_same_result(pb::recognize(scene_->depth, scene_->K, *fresh, s),
+                     pb::recognize(scene_->depth, scene_->K, *again, s), GetParam() + ": fresh vs cached model");
+  fs::remove_all(dir);
+}
 
-    // A setting that changes training changes the key (a new file) ...
-    pb::RecognitionSettings s2 = s;
-    s2.preprocess.voxel_mm = 8;
-    pb::train_model(*mesh_, s2, opt, &cached);
-    EXPECT_FALSE(cached);
-    // ... one that does not (refinement, verification) reuses it.
-    s2 = s;
-    s2.refinement = "icp_plane";
-    s2.verify.inlier_threshold_mm = 7;
-    pb::train_model(*mesh_, s2, opt, &cached);
-    EXPECT_TRUE(cached);
-    // A different mesh is a different key.
-    pb::Mesh scaled = *mesh_;
-    for (auto& v : scaled.vertices) v *= 1.1f;
-    pb::train_model(scaled, s, opt, &cached);
-    EXPECT_FALSE(cached);
+INSTANTIATE_TEST_SUITE_P(EveryDescriptor, PipelineCache,
+                         ::testing::Values("fpfh", "shot", "cvfh", "esf", "cesf", "ourcvfh", "ppf"),
+                         [](const auto& info) { return info.param; });
 
-    // Corrupt files are ignored and rebuilt: truncated, a flipped byte, garbage.
-    const auto size = fs::file_size(file);
-    fs::resize_file(file, size / 2);
-    const auto rebuilt = pb::train_model(*mesh_, s, opt, &cached);
-    EXPECT_FALSE(cached);
-    EXPECT_EQ(fs::file_size(file), size);
-    expect_same_result(r1, pb::recognize(scene_->depth, scene_->K, *rebuilt, s), d + ": rebuilt model");
-    {
-      std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
-      f.seekp(static_cast<std::streamoff>(size - 5));
-      char c;
-      f.seekg(static_cast<std::streamoff>(size - 5));
-      f.get(c);
-      f.seekp(static_cast<std::streamoff>(size - 5));
-      f.put(static_cast<char>(c ^ 0x5a));
-    }
-    pb::train_model(*mesh_, s, opt, &cached);
-    EXPECT_FALSE(cached);
-    std::ofstream(file, std::ios::binary | std::ios::trunc) << "not a cache file";
-    pb::train_model(*mesh_, s, opt, &cached);
-    EXPECT_FALSE(cached);
-    pb::train_model(*mesh_, s, opt, &cached);
-    EXPECT_TRUE(cached);
+TEST_F(Pipeline, CacheKeyAndCorruptFiles) {
+  const fs::path dir = fresh_cache_dir("key");
+  pb::TrainOptions opt;
+  opt.cache_dir = (dir / "sub" / "dir").string();  // created on demand
+  opt.model_name = "l/block";                        // sanitized in the file name
+  const pb::RecognitionSettings s = small_settings("fpfh");
+  bool cached = true;
+  const auto fresh = pb::train_model(*mesh_, s, opt, &cached);
+  EXPECT_FALSE(cached);
+  const std::string file = pb::trained_model_info(*fresh).cache_file;
+  ASSERT_TRUE(fs::exists(file)) << file;
+  EXPECT_EQ(fs::path(file).parent_path(), fs::path(opt.cache_dir));
+  const auto r1 = pb::recognize(scene_->depth, scene_->K, *fresh, s);
+
+  // A setting that changes training changes the key (a new file) ...
+  pb::RecognitionSettings s2 = s;
+  s2.preprocess.voxel_mm = 8;
+  pb::train_model(*mesh_, s2, opt, &cached);
+  EXPECT_FALSE(cached);
+  s2 = s;
+  s2.views.views = 6;
+  pb::train_model(*mesh_, s2, opt, &cached);
+  EXPECT_FALSE(cached);
+  // ... one that does not (refinement, verification, thread count) reuses it.
+  s2 = s;
+  s2.refinement = "icp_plane";
+  s2.refine.max_iterations = 10;
+  s2.verify.inlier_threshold_mm = 7;
+  s2.local.threads = 1;
+  pb::train_model(*mesh_, s2, opt, &cached);
+  EXPECT_TRUE(cached);
+  // A different mesh is a different key.
+  pb::Mesh scaled = *mesh_;
+  for (auto& v : scaled.vertices) v *= 1.1f;
+  pb::train_model(scaled, s, opt, &cached);
+  EXPECT_FALSE(cached);
+
+  // Corrupt files are ignored and rebuilt: truncated, a flipped byte, garbage.
+  const auto size = fs::file_size(file);
+  fs::resize_file(file, size / 2);
+  const auto rebuilt = pb::train_model(*mesh_, s, opt, &cached);
+  EXPECT_FALSE(cached);
+  EXPECT_EQ(fs::file_size(file), size);
+  expect_same_result(r1, pb::recognize(scene_->depth, scene_->K, *rebuilt, s), "rebuilt model");
+  {
+    std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekg(static_cast<std::streamoff>(size - 5));
+    char c = 0;
+    f.get(c);
+    f.seekp(static_cast<std::streamoff>(size - 5));
+    f.put(static_cast<char>(c ^ 0x5a));
   }
+  pb::train_model(*mesh_, s, opt, &cached);
+  EXPECT_FALSE(cached);
+  std::ofstream(file, std::ios::binary | std::ios::trunc) << "not a cache file";
+  pb::train_model(*mesh_, s, opt, &cached);
+  EXPECT_FALSE(cached);
+  pb::train_model(*mesh_, s, opt, &cached);
+  EXPECT_TRUE(cached);
   // No temporary files are left behind.
-  for (const auto& e : fs::directory_iterator(dir))
-    EXPECT_EQ(e.path().extension(), ".bin") << e.path();
+  for (const auto& e : fs::directory_iterator(opt.cache_dir)) EXPECT_EQ(e.path().extension(), ".bin") << e.path();
+  // An unwritable cache location is an input error naming it.
+  const fs::path blocker = dir / "a_file";
+  std::ofstream(blocker) << "x";
+  opt.cache_dir = (blocker / "cache").string();
+  EXPECT_THROW(pb::train_model(*mesh_, s, opt), pb::InputError);
   fs::remove_all(dir);
 }
 

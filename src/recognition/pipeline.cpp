@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -437,23 +438,39 @@ RecognitionResult recognize(const DepthImage& depth, const Intrinsics& K, const 
     return res;
   }
 
+  // Hypotheses are refined and verified independently (one random stream
+  // each, one output slot each), in parallel over OpenMP threads: the result
+  // does not depend on the thread count.
+  for (const auto& h : hyps) model.model_cloud(h.view);  // throws for a view index out of range
+  const long nh = static_cast<long>(hyps.size());
+  std::vector<std::exception_ptr> errors(hyps.size());
   timer.reset();
-  for (size_t i = 0; i < hyps.size(); ++i) {
-    Hypothesis& h = hyps[i];
-    const RefineResult r = refine_pose(s.refinement, model.model_cloud(h.view), scene, h.T_cam_model, s.refine,
-                                       derive_seed(s.seed, {kStreamRefine, i}));
-    if (finite_pose(r.T_cam_model)) {
-      h.T_cam_model = r.T_cam_model;
-      h.fitness = r.fitness;
-      h.refined = s.refinement != "none";
+#pragma omp parallel for schedule(dynamic, 1)
+  for (long i = 0; i < nh; ++i) {
+    try {
+      Hypothesis& h = hyps[static_cast<size_t>(i)];
+      const RefineResult r = refine_pose(s.refinement, model.model_cloud(h.view), scene, h.T_cam_model, s.refine,
+                                         derive_seed(s.seed, {kStreamRefine, static_cast<uint64_t>(i)}));
+      if (finite_pose(r.T_cam_model)) {
+        h.T_cam_model = r.T_cam_model;
+        h.fitness = r.fitness;
+        h.refined = s.refinement != "none";
+      }
+    } catch (...) {
+      errors[static_cast<size_t>(i)] = std::current_exception();
     }
   }
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);  // the first failing hypothesis, whatever the thread count
   res.times.refine = timer.seconds();
 
   timer.reset();
   const PointIndex index(scene.points);
-  for (auto& h : hyps)
+#pragma omp parallel for schedule(dynamic, 1)
+  for (long i = 0; i < nh; ++i) {
+    Hypothesis& h = hyps[static_cast<size_t>(i)];
     h.inliers = count_inliers(model.model_cloud(h.view).points, h.T_cam_model, index, s.verify.inlier_threshold_mm);
+  }
   // Most inliers first; ties by score, then view index, then the method's order.
   std::vector<size_t> order(hyps.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -484,6 +501,72 @@ RecognitionResult recognize(const DepthImage& depth, const Intrinsics& K, const 
   res.T_cam_model = best.T_cam_model;
   res.score = best.score;
   res.inliers = best.inliers;
+  return res;
+}
+
+}  // namespace pb
+
+// ---------------------------------------------------------------- refine_from
+// (refine_only.h) Registration alone: the thesis's Table 4.9 and Figure 4.12.
+
+#include "recognition/refine_only.h"
+
+namespace pb {
+
+RecognitionResult refine_from(const DepthImage& depth, const Intrinsics& K, const TrainedModel& model,
+                              const RecognitionSettings& s, const Pose& init) {
+  RecognitionResult res;
+  if (depth.width != K.width || depth.height != K.height ||
+      depth.z.size() != static_cast<size_t>(depth.width) * static_cast<size_t>(depth.height))
+    throw InputError("", "depth", "image size does not match the intrinsics");
+  check_refinement_name(s.refinement, "", "refinement");
+  if (model.views.empty()) {
+    res.message = "empty model: " + model.empty_reason;
+    return res;
+  }
+  Timer timer;
+  const OrganizedCloud cloud = OrganizedCloud::from_depth(depth, K);
+  const PointSet scene = preprocess_scene(cloud, s.preprocess, derive_seed(s.seed, {kStreamScene}));
+  res.times.preprocess = timer.seconds();
+  if (scene.size() < kMinScenePoints) {
+    res.message = "no scene points after filtering";
+    return res;
+  }
+  // The source is the training view seen from the direction closest to the
+  // one `init` implies: the camera -> object ray expressed in the model frame.
+  auto view_dir = [](const Pose& T_cam_model) -> Vec3 {
+    return (T_cam_model.R.transpose() * T_cam_model.t.normalized()).normalized();
+  };
+  const Vec3 d = view_dir(init);
+  int best_view = 0;
+  double best_dot = -2;
+  for (size_t v = 0; v < model.views.size(); ++v) {
+    const double dot = view_dir(model.views[v].T_cam_model).dot(d);
+    if (dot > best_dot) {
+      best_dot = dot;
+      best_view = static_cast<int>(v);
+    }
+  }
+  Hypothesis h;
+  h.T_cam_model = init;
+  h.view = best_view;
+  timer.reset();
+  const RefineResult r = refine_pose(s.refinement, model.model_cloud(h.view), scene, init, s.refine,
+                                     derive_seed(s.seed, {kStreamRefine, 0}));
+  if (finite_pose(r.T_cam_model)) {
+    h.T_cam_model = r.T_cam_model;
+    h.fitness = r.fitness;
+    h.refined = s.refinement != "none";
+  }
+  res.times.refine = timer.seconds();
+  timer.reset();
+  const PointIndex index(scene.points);
+  h.inliers = count_inliers(model.model_cloud(h.view).points, h.T_cam_model, index, s.verify.inlier_threshold_mm);
+  res.times.verify = timer.seconds();
+  res.hypotheses.push_back(h);
+  res.status = "ok";
+  res.T_cam_model = h.T_cam_model;
+  res.inliers = h.inliers;
   return res;
 }
 
