@@ -174,7 +174,7 @@ ExperimentConfig load_experiment(const std::string& path) {
   for (size_t i = 0; i < scenes.size(); ++i) {
     const YamlNode s = scenes.at(i);
     s.check_keys({"name", "generate", "dataset", "split", "scene_ids", "images", "scenario", "generator",
-                  "settings"});
+                  "settings", "refinements"});
     SceneSource src;
     src.generate = resolve(path, s.get_or<std::string>("generate", ""));
     src.dataset = resolve(path, s.get_or<std::string>("dataset", ""));
@@ -193,6 +193,10 @@ ExperimentConfig load_experiment(const std::string& path) {
         "scenario", src.name.rfind("warehouse", 0) == 0 ? std::string("warehouse") : std::string("table"));
     if (src.scenario != "table" && src.scenario != "warehouse")
       s["scenario"].fail("must be 'table' or 'warehouse'");
+    src.refinements = s.get_or<std::vector<std::string>>("refinements", {});
+    for (const auto& r : src.refinements)
+      if (std::find(known_ref.begin(), known_ref.end(), r) == known_ref.end())
+        s["refinements"].fail("unknown refinement '" + r + "'");
     if (s.has("generator")) {
       if (src.generate.empty()) s["generator"].fail("only valid with 'generate'");
       src.generator_overrides = to_json(s["generator"].raw());
@@ -221,6 +225,7 @@ ExperimentConfig load_experiment(const std::string& path) {
     canon["scenes"].push_back({{"name", s.name}, {"generate", s.generate}, {"dataset", s.dataset},
                                {"split", s.split}, {"scene_ids", s.scene_ids}, {"images", s.images},
                                {"scenario", s.scenario}, {"generator", s.generator_overrides},
+                               {"refinements", s.refinements},
                                {"settings", s.settings}});
   canon["report"] = c.report;
   c.canonical = canon;
@@ -252,8 +257,9 @@ std::vector<Trial> expand_trials(const ExperimentConfig& cfg) {
       for (const auto& [im_id, im] : scene.images) {
         if (src.images > 0 && taken >= src.images) break;
         ++taken;
+        const auto& refinements = src.refinements.empty() ? cfg.refinements : src.refinements;
         for (const auto& d : cfg.descriptors)
-          for (const auto& r : cfg.refinements)
+          for (const auto& r : refinements)
             for (const auto& p : points)
               for (double noise : cfg.added_noise_mm) {
                 Trial t;

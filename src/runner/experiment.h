@@ -24,6 +24,9 @@ struct SceneSource {
   std::vector<int> scene_ids;  // empty = all scenes of the split
   int images = 0;              // first N images per scene (0 = all)
   std::string scenario = "";   // table | warehouse: picks the translation threshold
+  // Refinements for this scene set, replacing the experiment's list (the
+  // thesis used ICP point-to-plane in the warehouse, point-to-point on tables).
+  std::vector<std::string> refinements;
   nlohmann::json generator_overrides = nlohmann::json::object();  // e.g. images, seed
   // Recognition settings overrides for this scene (YAML sections, as in
   // `settings`), as in the thesis's per-scenario Tables 4.2 and 4.8.

@@ -1,0 +1,92 @@
+// posebench report results/NAME [--format md,csv,tex] [--plots]
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "cli/command.h"
+#include "core/error.h"
+#include "io/png.h"
+#include "report/report.h"
+#include "runner/store.h"
+
+namespace fs = std::filesystem;
+
+static std::string find_reference() {
+#ifdef POSEBENCH_SOURCE_DIR
+  const fs::path p = fs::path(POSEBENCH_SOURCE_DIR) / "configs/thesis/reference.yaml";
+  if (fs::exists(p)) return p.string();
+#endif
+  if (fs::exists("configs/thesis/reference.yaml")) return "configs/thesis/reference.yaml";
+  return "";
+}
+
+static std::string find_plot_script() {
+#ifdef POSEBENCH_SOURCE_DIR
+  const fs::path p = fs::path(POSEBENCH_SOURCE_DIR) / "scripts/plot.py";
+  if (fs::exists(p)) return p.string();
+#endif
+  return fs::exists("scripts/plot.py") ? "scripts/plot.py" : "";
+}
+
+static pb::cli::Command report_cmd("report", "tables (md, csv, tex) and plots from a results folder", [](int argc, char** argv) {
+  CLI::App app{"Writes REPORT.{md,csv,tex} into the results folder (thesis values beside each cell) and, "
+               "with --plots, PNG plots via scripts/plot.py (matplotlib)."};
+  std::string dir, formats = "md,csv,tex";
+  pb::ReportOptions opt;
+  bool plots = false;
+  app.add_option("results", dir, "results folder of `posebench run`")->required();
+  app.add_option("--format", formats, "comma-separated: md, csv, tex");
+  app.add_flag("--plots", plots, "also write PNG plots");
+  app.add_option("--reference", opt.reference_file, "thesis reference values (YAML)");
+  app.add_option("--table", opt.reference_table, "thesis table id to compare with (e.g. 4.1)");
+  app.add_option("--plot-x", opt.plot_x, "grid path or added_noise_mm to plot against");
+  PB_CLI_PARSE(app, argc, argv);
+  if (opt.reference_file.empty()) opt.reference_file = find_reference();
+
+  const fs::path exp_path = fs::path(dir) / "experiment.json";
+  if (!fs::exists(exp_path)) throw pb::InputError(exp_path.string(), "", "not a posebench results folder");
+  nlohmann::json exp;
+  try {
+    std::ifstream in(exp_path);
+    in >> exp;
+  } catch (const nlohmann::json::exception& e) {
+    throw pb::InputError(exp_path.string(), "", std::string("malformed: ") + e.what());
+  }
+  const auto records = pb::ResultStore::read_records(dir);
+  const pb::Report rep = pb::build_report(exp, records, opt);
+
+  std::stringstream fs_(formats);
+  std::string f;
+  while (std::getline(fs_, f, ',')) {
+    if (f == "md") {
+      const std::string md = "# " + rep.experiment + "\n\n" + pb::to_markdown(rep);
+      pb::atomic_write_text((fs::path(dir) / "report.md").string(), md);
+      std::cout << md;
+    } else if (f == "csv") {
+      pb::atomic_write_text((fs::path(dir) / "report.csv").string(), pb::to_csv(rep));
+    } else if (f == "tex") {
+      pb::atomic_write_text((fs::path(dir) / "report.tex").string(), pb::to_latex(rep));
+    } else {
+      throw pb::InputError("", "--format", "unknown format '" + f + "' (md, csv, tex)");
+    }
+  }
+  if (plots) {
+    const std::string data = (fs::path(dir) / "plots.json").string();
+    pb::atomic_write_text(data, pb::plots_json(rep).dump(2) + "\n");
+    const std::string script = find_plot_script();
+    if (script.empty()) throw pb::InputError("scripts/plot.py", "", "plot script not found");
+    if (rep.plots.empty()) {
+      std::cerr << "posebench report: nothing to plot (no swept variable)\n";
+    } else {
+      const std::string py = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+      const std::string cmd = py + " '" + script + "' '" + data + "' '" + (fs::path(dir) / "plots").string() + "'";
+      if (std::system(cmd.c_str()) != 0) {
+        std::cerr << "posebench report: plotting failed (python3-matplotlib missing?)\n";
+        return 1;
+      }
+    }
+  }
+  return 0;
+});

@@ -1,0 +1,43 @@
+// posebench run EXPERIMENT.yaml [--out results/NAME] [--jobs N]
+#include <unistd.h>
+
+#include <iostream>
+
+#include "cli/command.h"
+#include "runner/runner.h"
+
+static std::string self_path() {
+  char buf[4096];
+  const ssize_t n = readlink("/proc/self/exe", buf, sizeof buf - 1);
+  if (n <= 0) return "posebench";
+  buf[n] = '\0';
+  return buf;
+}
+
+static pb::cli::Command run_cmd("run", "run an experiment (YAML): trials in parallel, resumable", [](int argc, char** argv) {
+  CLI::App app{"Runs every trial of an experiment config and streams one JSON record per trial to "
+               "OUT/records.jsonl. Interrupted runs resume: only missing trials run."};
+  std::string config;
+  pb::RunOptions opt;
+  opt.jobs = 1;
+  app.add_option("config", config, "experiment YAML")->required();
+  app.add_option("--out", opt.out_dir, "results folder (default results/NAME)");
+  app.add_option("--jobs,-j", opt.jobs, "parallel worker processes")->check(CLI::PositiveNumber);
+  app.add_option("--cache", opt.cache_dir, "training cache folder ('' = none)");
+  app.add_option("--scenes", opt.scenes_dir, "where generated scene sets go");
+  app.add_flag("--quiet,-q", opt.quiet, "no progress output");
+  PB_CLI_PARSE(app, argc, argv);
+  opt.binary = self_path();
+  const pb::ExperimentConfig cfg = pb::load_experiment(config);
+  const pb::RunSummary s = pb::run_experiment(cfg, opt);
+  const std::string out = opt.out_dir.empty() ? "results/" + cfg.name : opt.out_dir;
+  std::cout << "experiment " << cfg.name << " (" << cfg.hash << "): " << s.total << " trials, "
+            << s.already_done << " already recorded, " << s.ran << " run now (ok " << s.ok << ", no hypothesis "
+            << s.no_hypothesis << ", error " << s.errors << ", timeout " << s.timeouts << ") in " << s.seconds
+            << " s\nrecords: " << out << "/records.jsonl\n";
+  return 0;
+});
+
+static pb::cli::Command worker_cmd("worker", "(internal) trial worker used by `run`", [](int, char**) {
+  return pb::worker_main();
+});

@@ -1,0 +1,167 @@
+// posebench run: resume after a kill loses and duplicates nothing, results
+// do not depend on --jobs, and bad input is exit 2 with a clear message that
+// leaves existing results untouched.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "cli_test_util.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A small, fast scene set: synthetic sensor, 3 table images, few distractors.
+const char* kSceneConfig = R"(scenario: table
+seed: 77
+images: 3
+sensor: {name: custom, width: 320, height: 320, hfov_deg: 30, vfov_deg: 30}
+noise: {model: gaussian, sigma_mm: 1.0}
+target: ls5
+target_upright_probability: 1.0
+distractors: {pool: [box_small, cylinder], count: [2, 3]}
+occlusion: none
+camera: {distance_mm: [700, 900], elevation_deg: [40, 60]}
+)";
+
+std::string experiment_yaml(const std::string& scene_cfg) {
+  return "name: runtest\nseed: 3\nobject: ls5\nscenes:\n  - name: table_small\n    generate: " + scene_cfg +
+         "\n    scenario: table\ndescriptors: [cvfh, fpfh]\nrefinements: [icp]\n"
+         "added_noise_mm: [0, 3]\nsettings:\n  views: {views: 4}\n";
+}
+
+std::map<std::string, nlohmann::json> comparable(const std::string& dir) {
+  std::map<std::string, nlohmann::json> out;
+  std::ifstream in(dir + "/records.jsonl");
+  std::string line;
+  while (std::getline(in, line)) {
+    auto j = nlohmann::json::parse(line);
+    for (const char* k : {"times", "wall_s", "train_s", "train_from_cache"}) j.erase(k);
+    const std::string key = j["key"];
+    EXPECT_EQ(out.count(key), 0u) << "duplicate record " << key;
+    out[key] = j;
+  }
+  return out;
+}
+
+class RunTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    pbcli::write_file(tmp.path + "/scene.yaml", kSceneConfig);
+    pbcli::write_file(tmp.path + "/exp.yaml", experiment_yaml(tmp.path + "/scene.yaml"));
+  }
+  pbcli::TempDir tmp;
+  std::string common() const { return "--cache '" + tmp.path + "/cache' --scenes '" + tmp.path + "/scenes' -q"; }
+};
+
+TEST_F(RunTest, ResultsDoNotDependOnJobsAndResumeAfterKillLosesNothing) {
+  // Reference: one uninterrupted run with one worker.
+  auto a = pbcli::run("run exp.yaml --out r1 --jobs 1 " + common(), tmp.path);
+  ASSERT_EQ(a.code, 0) << a.err;
+  const auto r1 = comparable(tmp.path + "/r1");
+  ASSERT_EQ(r1.size(), 3u * 2u * 2u);  // images x descriptors x noise levels
+  int ok = 0;
+  for (const auto& [k, v] : r1) ok += v["status"] == "ok";
+  EXPECT_GT(ok, 0);
+
+  // Two workers: the same records (up to timing fields).
+  auto b = pbcli::run("run exp.yaml --out r2 --jobs 2 " + common(), tmp.path);
+  ASSERT_EQ(b.code, 0) << b.err;
+  EXPECT_EQ(comparable(tmp.path + "/r2"), r1);
+
+  // Killed mid-way, then resumed: the same records, none lost or duplicated.
+  const pid_t pid = fork();
+  if (pid == 0) {
+    ASSERT_EQ(chdir(tmp.path.c_str()), 0);
+    const std::string cache = tmp.path + "/cache", scenes = tmp.path + "/scenes";
+    execl(POSEBENCH_BINARY, POSEBENCH_BINARY, "run", "exp.yaml", "--out", "r3", "--jobs", "1", "--cache",
+          cache.c_str(), "--scenes", scenes.c_str(), "-q", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  const std::string rec3 = tmp.path + "/r3/records.jsonl";
+  for (int i = 0; i < 600; ++i) {  // wait for some, not all, records
+    const std::string text = pbcli::slurp(rec3);
+    if (std::count(text.begin(), text.end(), '\n') >= 3) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  kill(pid, SIGKILL);
+  waitpid(pid, nullptr, 0);
+  const size_t partial = comparable(tmp.path + "/r3").size();
+  EXPECT_GE(partial, 1u);
+  EXPECT_LT(partial, r1.size()) << "the run finished before it could be killed";
+  auto c = pbcli::run("run exp.yaml --out r3 --jobs 1 " + common(), tmp.path);
+  ASSERT_EQ(c.code, 0) << c.err;
+  EXPECT_NE(c.out.find("already recorded"), std::string::npos) << c.out;
+  EXPECT_EQ(comparable(tmp.path + "/r3"), r1);
+
+  // A third run does nothing new.
+  auto d = pbcli::run("run exp.yaml --out r3 --jobs 2 " + common(), tmp.path);
+  ASSERT_EQ(d.code, 0) << d.err;
+  EXPECT_NE(d.out.find("0 run now"), std::string::npos) << d.out;
+
+  // The reporter reads it back into a thesis-layout table.
+  auto rep = pbcli::run("report r1 --format md,csv", tmp.path);
+  ASSERT_EQ(rep.code, 0) << rep.err;
+  EXPECT_NE(rep.out.find("| table_small | robustness |"), std::string::npos) << rep.out;
+  EXPECT_TRUE(fs::exists(tmp.path + "/r1/report.csv"));
+
+  // Another experiment into the same folder: exit 2, records untouched.
+  const std::string before = pbcli::slurp(tmp.path + "/r1/records.jsonl");
+  pbcli::write_file(tmp.path + "/other.yaml", experiment_yaml(tmp.path + "/scene.yaml") + "timeout_s: 99\n");
+  auto e = pbcli::run("run other.yaml --out r1 " + common(), tmp.path);
+  EXPECT_EQ(e.code, 2);
+  EXPECT_NE(e.err.find("experiment.json"), std::string::npos) << e.err;
+  EXPECT_NE(e.err.find("another experiment"), std::string::npos) << e.err;
+  EXPECT_EQ(pbcli::slurp(tmp.path + "/r1/records.jsonl"), before);
+}
+
+TEST_F(RunTest, UnknownKeyIsExit2NamingFileLineAndKey) {
+  pbcli::write_file(tmp.path + "/bad.yaml", experiment_yaml(tmp.path + "/scene.yaml") + "descriptorz: [esf]\n");
+  auto r = pbcli::run("run bad.yaml --out rb " + common(), tmp.path);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("bad.yaml"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("descriptorz"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("line 13"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(tmp.path + "/rb/records.jsonl"));
+}
+
+TEST_F(RunTest, UnknownSettingInsideASectionIsExit2) {
+  pbcli::write_file(tmp.path + "/bad.yaml",
+                    experiment_yaml(tmp.path + "/scene.yaml") + "grid:\n  local.hough_binn_mm: [10, 20]\n");
+  auto r = pbcli::run("run bad.yaml --out rb " + common(), tmp.path);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("hough_binn_mm"), std::string::npos) << r.err;
+}
+
+TEST_F(RunTest, MalformedYamlIsExit2) {
+  pbcli::write_file(tmp.path + "/bad.yaml", "name: x\nscenes: [\n");
+  auto r = pbcli::run("run bad.yaml --out rb " + common(), tmp.path);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("bad.yaml"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("malformed YAML"), std::string::npos) << r.err;
+}
+
+TEST_F(RunTest, DatasetThatIsNotBopIsExit2) {
+  fs::create_directories(tmp.path + "/notbop/stuff");
+  pbcli::write_file(tmp.path + "/bad.yaml",
+                    "object: ls5\nscenes:\n  - dataset: " + tmp.path + "/notbop\ndescriptors: [fpfh]\n");
+  auto r = pbcli::run("run bad.yaml --out rb " + common(), tmp.path);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("notbop"), std::string::npos) << r.err;
+}
+
+TEST_F(RunTest, ReportOnAFolderWithoutRecordsIsExit2) {
+  fs::create_directories(tmp.path + "/empty");
+  auto r = pbcli::run("report empty", tmp.path);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("experiment.json"), std::string::npos) << r.err;
+}
+
+}  // namespace
