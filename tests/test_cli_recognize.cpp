@@ -111,7 +111,7 @@ class CliRecognize : public ::testing::Test {
     fs::create_directories(*root_ / "models");
     const pb::Mesh obj = l_block();
     pb::write_ply((*root_ / "models" / "obj_000001.ply").string(), obj);
-    pb::Mesh cyl = box({-30, -30, -40}, {30, 30, 40});  // a second object, never placed
+    pb::Mesh cyl = box({-20, -20, -110}, {20, 20, 110});  // a tall post, never placed
     pb::write_ply((*root_ / "models" / "obj_000002.ply").string(), cyl);
     std::map<int, pb::ModelInfo> models;
     for (int id : {1, 2}) {

@@ -155,6 +155,46 @@ TEST_F(Pipeline, ObjectAbsentIsNoHypothesis) {
   }
 }
 
+// Tiny and degenerate scenes: whatever survives preprocessing, every
+// descriptor returns a result (ok or no_hypothesis) and never throws.
+class PipelineTinyScenes : public Pipeline, public ::testing::WithParamInterface<std::string> {};
+
+TEST_P(PipelineTinyScenes, NeverThrow) {
+  const pb::RecognitionSettings s = small_settings(GetParam());
+  const auto model = pb::train_model(*mesh_, s);
+  const pb::Intrinsics& K = scene_->K;
+  std::vector<std::pair<std::string, pb::DepthImage>> scenes;
+  auto patch = [&](pb::DepthImage& d, int u0, int v0, int w, int h, float z, float slope) {
+    for (int v = v0; v < v0 + h; ++v)
+      for (int u = u0; u < u0 + w; ++u) d.at(u, v) = z + slope * static_cast<float>(u - u0);
+  };
+  pb::DepthImage d(K.width, K.height);
+  patch(d, 150, 110, 2, 2, 800, 0);
+  scenes.emplace_back("2x2 pixels", d);
+  d = pb::DepthImage(K.width, K.height);
+  patch(d, 150, 110, 12, 12, 800, 0);
+  scenes.emplace_back("a 30 mm flat patch", d);
+  d = pb::DepthImage(K.width, K.height);
+  patch(d, 100, 50, 1, 120, 700, 0);
+  scenes.emplace_back("a line", d);
+  d = pb::DepthImage(K.width, K.height);
+  for (int k = 0; k < 6; ++k) patch(d, 20 + 45 * k, 30 + 30 * k, 6, 6, 600 + 50 * k, 2);
+  scenes.emplace_back("scattered small patches", d);
+  d = pb::DepthImage(K.width, K.height);
+  patch(d, 0, 0, K.width, K.height, 900, 0);
+  scenes.emplace_back("a wall filling the image", d);
+  for (const auto& [name, depth] : scenes) {
+    pb::RecognitionResult r;
+    EXPECT_NO_THROW(r = pb::recognize(depth, K, *model, s)) << GetParam() << ": " << name;
+    EXPECT_TRUE(r.status == "ok" || r.status == "no_hypothesis") << r.status;
+    if (r.status == "no_hypothesis") EXPECT_FALSE(r.message.empty()) << name;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryDescriptor, PipelineTinyScenes,
+                         ::testing::Values("fpfh", "shot", "cvfh", "esf", "cesf", "ourcvfh", "ppf"),
+                         [](const auto& info) { return info.param; });
+
 TEST_F(Pipeline, EmptyModelIsNoHypothesis) {
   for (const std::string d : {"fpfh", "esf", "ppf"}) {
     const pb::RecognitionSettings s = small_settings(d);
