@@ -1,7 +1,7 @@
 // posebench render-views and export-pcd.
 #include <gtest/gtest.h>
 
-#include <Eigen/Core>
+#include <Eigen/Dense>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <thread>
 
 #include "cli/command.h"
 #include "core/error.h"
@@ -29,11 +30,13 @@ static pb::cli::Command cmd(
       int images = 0;
       long long seed = -1;
       bool quiet = false;
+      int threads = 0;
       app.add_option("config", config, "scene config (configs/scenes/*.yaml)")->required();
       app.add_option("--out", out, "output folder (default: scenes/NAME, NAME = the config file's stem)");
       app.add_option("--images", images, "override the config's number of images");
       app.add_option("--seed", seed, "override the config's seed");
       app.add_flag("--quiet", quiet, "no progress on stderr");
+      app.add_option("--threads", threads, "worker threads (0 = one per core); the output is the same for any number");
       PB_CLI_PARSE(app, argc, argv);
 
       pb::SceneSettings s = pb::load_scene_settings(config);
@@ -46,8 +49,10 @@ static pb::cli::Command cmd(
         if (seed < 0) throw pb::InputError("", "--seed", "must be non-negative");
         s.seed = static_cast<uint64_t>(seed);
       }
+      if (threads < 0 || threads > 256) throw pb::InputError("", "--threads", "must be in [0, 256]");
+      if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
       if (out.empty()) out = (std::filesystem::path("scenes") / s.name).string();
-      const pb::GenerateSummary sum = pb::generate_dataset(s, out, quiet ? nullptr : print_progress);
+      const pb::GenerateSummary sum = pb::generate_dataset(s, out, quiet ? nullptr : print_progress, threads);
       std::printf("generated %s: %s scenario, sensor %s, %d images, %d objects\n", sum.out_dir.c_str(),
                   pb::scenario_name(s.scenario).c_str(), s.sensor.name.c_str(), sum.images, sum.objects);
       std::printf("target %s: mean visib_fract %.3f (min %.3f)\n", s.target.c_str(), sum.mean_target_visib,

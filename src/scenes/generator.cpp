@@ -1,11 +1,14 @@
 #include "scenes/generator.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <thread>
 
 #include "core/error.h"
 #include "core/random.h"
@@ -211,7 +214,9 @@ SceneGenerator::SceneGenerator(const SceneSettings& settings) : impl_(std::make_
       m.obj_id = spec.obj_id;
       m.mesh = reg.load_model(name);
     } catch (const InputError& e) {
-      throw InputError(s.config_file, field, std::string("model '") + name + "': " + e.what());
+      const std::string what = e.what();
+      throw InputError(s.config_file, field,
+                       what.find(name) != std::string::npos ? what : "model '" + name + "': " + what);
     }
     if (s.scenario == Scenario::warehouse) {
       Rng r(derive_seed(s.seed, {kModelStream, fnv1a(name)}));
@@ -283,6 +288,28 @@ SceneGenerator::SceneGenerator(const SceneSettings& settings) : impl_(std::make_
 }
 
 SceneGenerator::~SceneGenerator() = default;
+
+SceneGenerator::SceneGenerator() : impl_(std::make_unique<Impl>()) {}
+
+std::unique_ptr<SceneGenerator> SceneGenerator::clone() const {
+  std::unique_ptr<SceneGenerator> g(new SceneGenerator());
+  Impl& c = *g->impl_;
+  const Impl& I = *impl_;
+  c.s = I.s;
+  c.models = I.models;
+  c.rest = I.rest;
+  c.hull = I.hull;
+  c.radius = I.radius;
+  c.target = I.target;
+  c.pool = I.pool;
+  c.table_mesh = I.table_mesh;
+  c.floor_mesh = I.floor_mesh;
+  c.wall_mesh = I.wall_mesh;
+  c.K = I.K;
+  c.rset = I.rset;
+  c.renderer = std::make_unique<DepthRenderer>(c.K, c.rset);
+  return g;
+}
 
 const SceneSettings& SceneGenerator::settings() const { return impl_->s; }
 const std::vector<SceneModel>& SceneGenerator::models() const { return impl_->models; }
@@ -663,7 +690,7 @@ std::vector<uint8_t> depth_preview_rgb(const DepthImage& depth, const Intrinsics
 }
 
 GenerateSummary generate_dataset(const SceneSettings& settings, const std::string& out_dir,
-                                 void (*progress)(int done, int total)) {
+                                 void (*progress)(int done, int total), int threads) {
   Timer timer;
   const fs::path out(out_dir);
   if (out.empty() || out.filename() == "." || out.filename() == "..")
@@ -695,12 +722,16 @@ GenerateSummary generate_dataset(const SceneSettings& settings, const std::strin
     write_models_info((tmp / "models" / "models_info.json").string(), infos);
     write_camera_json((tmp / "camera.json").string(), s.sensor.K, s.depth_scale);
 
-    SceneInfo scene;
-    scene.scene_id = s.scene_id;
-    nlohmann::ordered_json trace = nlohmann::ordered_json::array();
-    double visib_sum = 0, visib_min = 1;
-    for (int im = 0; im < s.images; ++im) {
-      GeneratedImage img = gen.generate(im);
+    // Images are independent (own seeds): any number of workers, each with
+    // its own generator (renderer), gives the same files.
+    struct Done {
+      ImageInfo info;
+      nlohmann::ordered_json trace;
+      double target_visib = 0;
+    };
+    std::vector<Done> done(s.images);
+    auto make_image = [&](SceneGenerator& g, int im) {
+      GeneratedImage img = g.generate(im);
       const std::string iid = bop_id(im);
       write_depth_png((scene_dir / "depth" / (iid + ".png")).string(), img.depth, s.depth_scale);
       const int W = img.depth.width, H = img.depth.height;
@@ -712,11 +743,9 @@ GenerateSummary generate_dataset(const SceneSettings& settings, const std::strin
                           H, m);
         }
       if (im == 0) write_rgb8_png((tmp / "depth_preview.png").string(), W, H, depth_preview_rgb(img.depth, &s.sensor.K));
-      const double tv = img.info.gt_info.empty() ? 0.0 : img.info.gt_info[0].visib_fract;
-      visib_sum += tv;
-      visib_min = std::min(visib_min, tv);
-      sum.objects += static_cast<int>(img.info.gt.size());
-      nlohmann::ordered_json t;
+      Done& d = done[im];
+      d.target_visib = img.info.gt_info.empty() ? 0.0 : img.info.gt_info[0].visib_fract;
+      nlohmann::ordered_json& t = d.trace;
       t["im_id"] = im;
       t["attempts"] = img.attempts;
       t["camera_distance_mm"] = img.camera_distance_mm;
@@ -730,10 +759,54 @@ GenerateSummary generate_dataset(const SceneSettings& settings, const std::strin
       t["occluded"] = img.occluded;
       t["occluder_height_mm"] = img.occluder_height_mm;
       t["objects"] = img.names;
-      t["target_visib_fract"] = tv;
-      trace.push_back(t);
-      scene.images[im] = std::move(img.info);
-      if (progress) progress(im + 1, s.images);
+      t["target_visib_fract"] = d.target_visib;
+      d.info = std::move(img.info);
+    };
+    const int workers = std::max(1, std::min(threads, s.images));
+    std::atomic<int> next{0};
+    std::mutex mu;
+    std::exception_ptr error;
+    int finished = 0;
+    auto work = [&](SceneGenerator* g) {
+      try {
+        std::unique_ptr<SceneGenerator> own;
+        if (!g) {
+          own = gen.clone();
+          g = own.get();
+        }
+        for (;;) {
+          {
+            std::lock_guard<std::mutex> lock(mu);
+            if (error) return;
+          }
+          const int im = next++;
+          if (im >= s.images) return;
+          make_image(*g, im);
+          std::lock_guard<std::mutex> lock(mu);
+          ++finished;
+          if (progress) progress(finished, s.images);
+        }
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mu);
+        if (!error) error = std::current_exception();
+      }
+    };
+    std::vector<std::thread> pool;
+    for (int w = 1; w < workers; ++w) pool.emplace_back(work, nullptr);
+    work(&gen);
+    for (auto& t : pool) t.join();
+    if (error) std::rethrow_exception(error);
+
+    SceneInfo scene;
+    scene.scene_id = s.scene_id;
+    nlohmann::ordered_json trace = nlohmann::ordered_json::array();
+    double visib_sum = 0, visib_min = 1;
+    for (int im = 0; im < s.images; ++im) {
+      visib_sum += done[im].target_visib;
+      visib_min = std::min(visib_min, done[im].target_visib);
+      sum.objects += static_cast<int>(done[im].info.gt.size());
+      trace.push_back(std::move(done[im].trace));
+      scene.images[im] = std::move(done[im].info);
     }
     write_scene_json(scene_dir.string(), scene);
 

@@ -1,6 +1,7 @@
 #include "scenes/scene_config.h"
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -26,6 +27,12 @@ SceneSettings default_scene_settings(Scenario s) {
 
 namespace {
 
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
 // Reads a range: a scalar (fixed value) or [lo, hi]. `positive` requires
 // lo > 0, otherwise lo >= `min_value`; hi <= max_value.
 void read_range(const YamlNode& parent, const std::string& key, ValueRange& r, bool positive,
@@ -43,18 +50,18 @@ void read_range(const YamlNode& parent, const std::string& key, ValueRange& r, b
     n.fail("expected a value or a range [lo, hi]");
   }
   if (!(std::isfinite(out.lo) && std::isfinite(out.hi))) n.fail("must be finite");
-  if (positive && !(out.lo > 0)) n.fail("must be positive, got " + std::to_string(out.lo));
+  if (positive && !(out.lo > 0)) n.fail("must be positive, got " + num(out.lo));
   if (!positive && !(out.lo >= min_value))
-    n.fail("must be at least " + std::to_string(min_value) + ", got " + std::to_string(out.lo));
+    n.fail("must be at least " + num(min_value) + ", got " + num(out.lo));
   if (!(out.hi <= max_value))
-    n.fail("must be at most " + std::to_string(max_value) + ", got " + std::to_string(out.hi));
+    n.fail("must be at most " + num(max_value) + ", got " + num(out.hi));
   if (out.lo > out.hi) n.fail("range [lo, hi] with lo > hi");
   r = out;
 }
 
 double read_probability(const YamlNode& parent, const std::string& key, double fallback) {
   const double v = parent.get_or<double>(key, fallback);
-  if (!(v >= 0.0 && v <= 1.0)) parent[key].fail("must be in [0, 1], got " + std::to_string(v));
+  if (!(v >= 0.0 && v <= 1.0)) parent[key].fail("must be in [0, 1], got " + num(v));
   return v;
 }
 
