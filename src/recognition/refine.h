@@ -23,12 +23,18 @@ struct RefineSettings {
   double rotation_epsilon_deg = 0.05;      // rotation part of the transform-change stopping rule
   double fitness_epsilon = 1e-6;           // stop on small change of mean squared error: relative
                                            // change between iterations (ICP, ICP-LM, ICP-plane)
+  bool reciprocal_correspondences = true;  // ICP, ICP-LM, ICP-plane: keep only mutual nearest
+                                           // neighbours (PCL's reciprocal correspondences); makes
+                                           // them robust to surface seen in one cloud only
   int icp_sample_points = 0;               // ICP point-to-point: random subset of source points (0 = all)
-  double ndt_resolution_mm = 20.0;         // NDT grid cell (sized to the object, PCL_NOTES); used as
-                                           // is when ndt_resolution_fraction is 0
-  double ndt_resolution_fraction = 0.0;    // if > 0: NDT cell = this fraction of the model diameter,
-                                           // but at least ndt_resolution_mm
-  double ndt_step_size_mm = 10.0;          // NDT max More-Thuente step
+  double ndt_resolution_mm = 30.0;         // NDT grid cell, at least this (a planar cell needs about
+                                           // 6 scene points: >= 2.5 x the scene voxel; 30 mm for the
+                                           // table's 10 mm voxel)
+  double ndt_resolution_fraction = 0.15;   // NDT grid sized to the object: cell = this fraction of
+                                           // the model cloud's bounding box diagonal, but at least
+                                           // ndt_resolution_mm (0: ndt_resolution_mm alone)
+  double ndt_step_size_mm = 80.0;          // NDT max More-Thuente step (PCL's 6-vector of metres and
+                                           // radians: 80 mm also allows 4.6 degrees per step)
   double ndt_outlier_ratio = 0.55;         // NDT outlier ratio of the Gaussian mixture (PCL default)
   int ndt_min_points_per_cell = 6;         // NDT cells with fewer scene points are ignored (PCL
                                            // default 6, at least 3)

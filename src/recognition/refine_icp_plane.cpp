@@ -46,6 +46,7 @@ Outcome run_icp_plane(const Problem& p, const RefineSettings& s) {
   icp.setTransformationEpsilon(s.transformation_epsilon);
   icp.setTransformationRotationEpsilon(std::cos(s.rotation_epsilon_deg * M_PI / 180.0));
   icp.setEuclideanFitnessEpsilon(s.fitness_epsilon);
+  icp.setUseReciprocalCorrespondences(s.reciprocal_correspondences);
   icp.align(out);
 
   Outcome o;

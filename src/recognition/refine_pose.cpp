@@ -184,7 +184,7 @@ RefineResult refine_pose(const std::string& method, const PointSet& model, const
 void parse_refine(const YamlNode& node, RefineSettings& s) {
   if (!node.defined()) return;
   node.check_keys({"max_iterations", "max_correspondence_mm", "transformation_epsilon",
-                   "rotation_epsilon_deg", "fitness_epsilon", "icp_sample_points",
+                   "rotation_epsilon_deg", "fitness_epsilon", "reciprocal_correspondences", "icp_sample_points",
                    "ndt_resolution_mm", "ndt_resolution_fraction", "ndt_step_size_mm",
                    "ndt_outlier_ratio", "ndt_min_points_per_cell", "gicp_correspondence_randomness",
                    "gicp_covariances_from_normals", "crop_margin_mm", "normal_neighbours"});
@@ -199,6 +199,7 @@ void parse_refine(const YamlNode& node, RefineSettings& s) {
   s.transformation_epsilon = node.get_nonnegative("transformation_epsilon", s.transformation_epsilon);
   s.rotation_epsilon_deg = node.get_nonnegative("rotation_epsilon_deg", s.rotation_epsilon_deg);
   s.fitness_epsilon = node.get_nonnegative("fitness_epsilon", s.fitness_epsilon);
+  node.read("reciprocal_correspondences", s.reciprocal_correspondences);
   positive_int("icp_sample_points", s.icp_sample_points, 0);
   s.ndt_resolution_mm = node.get_positive("ndt_resolution_mm", s.ndt_resolution_mm);
   s.ndt_resolution_fraction = node.get_nonnegative("ndt_resolution_fraction", s.ndt_resolution_fraction);

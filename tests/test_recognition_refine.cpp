@@ -1,0 +1,221 @@
+// Refinement methods (THESIS.md "Registration"; issue 3 "must show"): each
+// method, started from the ground truth perturbed by 10 degrees and 20 mm
+// (random axis and direction, seeded) on 20 generated table images of an
+// asymmetric object, must converge to within 5 mm and 2 degrees in at least
+// 90% of them; NDT is held to what it was measured to reach, minus a margin.
+// Also: determinism (same inputs -> same pose bits), unknown names, empty
+// inputs, YAML parsing.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstring>
+#include <map>
+
+#include "core/error.h"
+#include "core/yaml.h"
+#include "recognition/refine.h"
+#include "test_recognition_refine_scenes.h"
+
+namespace pb {
+namespace {
+
+constexpr int kCases = 20;
+constexpr uint64_t kSeed = 20160601;
+
+class RefineCases : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    if (!cases_.empty()) return;
+    const Mesh object = refine_test::asymmetric_object();
+    for (int i = 0; i < kCases; ++i) cases_.push_back(refine_test::make_case(object, i, kSeed));
+  }
+  static std::vector<refine_test::Case> cases_;
+};
+std::vector<refine_test::Case> RefineCases::cases_;
+
+struct Rate {
+  int ok = 0;
+  double max_t_ok = 0, max_r_ok = 0;
+};
+
+Rate run_method(const std::vector<refine_test::Case>& cases, const std::string& method, const RefineSettings& s) {
+  Rate rate;
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const auto& c = cases[i];
+    const RefineResult r = refine_pose(method, c.model, c.scene, c.init, s, derive_seed(kSeed, {7, i}));
+    const double et = refine_test::translation_error(r.T_cam_model, c.gt);
+    const double er = refine_test::rotation_error_deg(r.T_cam_model, c.gt);
+    const bool ok = et < 5.0 && er < 2.0;
+    std::printf("  %-9s case %2zu: scene %4zu model %4zu  t %6.2f mm  R %5.2f deg  it %2d conv %d fit %6.2f %s\n",
+                method.c_str(), i, c.scene.size(), c.model.size(), et, er, r.iterations, r.converged ? 1 : 0,
+                r.fitness, ok ? "" : "MISS");
+    if (ok) {
+      ++rate.ok;
+      rate.max_t_ok = std::max(rate.max_t_ok, et);
+      rate.max_r_ok = std::max(rate.max_r_ok, er);
+    }
+  }
+  std::printf("%-9s converged within 5 mm / 2 deg: %d of %zu (worst success: %.2f mm, %.2f deg)\n", method.c_str(),
+              rate.ok, cases.size(), rate.max_t_ok, rate.max_r_ok);
+  return rate;
+}
+
+TEST_F(RefineCases, InitialPosesArePerturbed) {
+  ASSERT_EQ(cases_.size(), static_cast<size_t>(kCases));
+  for (const auto& c : cases_) {
+    EXPECT_NEAR(refine_test::translation_error(c.init, c.gt), 20.0, 1e-6);
+    EXPECT_NEAR(refine_test::rotation_error_deg(c.init, c.gt), 10.0, 1e-6);
+    EXPECT_GT(c.scene.size(), 100u);
+    EXPECT_GT(c.model.size(), 100u);
+  }
+  // Without refinement no case is within the thresholds.
+  EXPECT_EQ(run_method(cases_, "none", RefineSettings{}).ok, 0);
+}
+
+TEST_F(RefineCases, IcpConverges) { EXPECT_GE(run_method(cases_, "icp", RefineSettings{}).ok, 18); }
+
+// A random half of the ~1000 model view points (fewer points make the source
+// as sparse as the scene: 100 points gave 9 of 20, 300 gave 16 to 19).
+TEST_F(RefineCases, IcpOnRandomSubsetConverges) {
+  RefineSettings s;
+  s.icp_sample_points = 500;
+  EXPECT_GE(run_method(cases_, "icp", s).ok, 17);
+}
+
+TEST_F(RefineCases, IcpLmConverges) { EXPECT_GE(run_method(cases_, "icp_lm", RefineSettings{}).ok, 18); }
+
+TEST_F(RefineCases, IcpPlaneConverges) { EXPECT_GE(run_method(cases_, "icp_plane", RefineSettings{}).ok, 18); }
+
+TEST_F(RefineCases, GicpConverges) { EXPECT_GE(run_method(cases_, "gicp", RefineSettings{}).ok, 18); }
+
+TEST_F(RefineCases, GicpWithPclCovariancesConverges) {
+  RefineSettings s;
+  s.gicp_covariances_from_normals = false;
+  EXPECT_GE(run_method(cases_, "gicp", s).ok, 18);
+}
+
+TEST_F(RefineCases, NdtConverges) { EXPECT_GE(run_method(cases_, "ndt", RefineSettings{}).ok, 18); }
+
+// The same cases with the model view at the scene's 10 mm voxel: point-to-
+// point ICP is then limited by the sampling (see refine_test::CaseOptions);
+// held to what was measured, minus a margin.
+TEST(Refine, PointToPointWithModelAtSceneVoxel) {
+  const Mesh object = refine_test::asymmetric_object();
+  refine_test::CaseOptions o;
+  o.model_voxel_mm = o.preprocess.voxel_mm;
+  std::vector<refine_test::Case> cases;
+  for (int i = 0; i < kCases; ++i) cases.push_back(refine_test::make_case(object, i, kSeed, o));
+  EXPECT_GE(run_method(cases, "icp", RefineSettings{}).ok, 12);
+  EXPECT_GE(run_method(cases, "icp_plane", RefineSettings{}).ok, 18);
+  EXPECT_GE(run_method(cases, "gicp", RefineSettings{}).ok, 18);
+}
+
+TEST_F(RefineCases, SameInputsGiveSamePoseBits) {
+  RefineSettings sub;
+  sub.icp_sample_points = 100;
+  const std::vector<std::pair<std::string, RefineSettings>> runs = {
+      {"icp", RefineSettings{}}, {"icp", sub},  {"icp_lm", RefineSettings{}}, {"icp_plane", RefineSettings{}},
+      {"gicp", RefineSettings{}}, {"ndt", RefineSettings{}}};
+  for (const auto& [method, s] : runs) {
+    for (size_t i = 0; i < 3; ++i) {
+      const auto& c = cases_[i];
+      const RefineResult a = refine_pose(method, c.model, c.scene, c.init, s, 11);
+      const RefineResult b = refine_pose(method, c.model, c.scene, c.init, s, 11);
+      EXPECT_EQ(std::memcmp(a.T_cam_model.R.data(), b.T_cam_model.R.data(), sizeof(double) * 9), 0) << method;
+      EXPECT_EQ(std::memcmp(a.T_cam_model.t.data(), b.T_cam_model.t.data(), sizeof(double) * 3), 0) << method;
+      EXPECT_EQ(a.iterations, b.iterations) << method;
+    }
+  }
+  // The ICP subset depends on the seed.
+  const auto& c = cases_[0];
+  const RefineResult a = refine_pose("icp", c.model, c.scene, c.init, sub, 11);
+  const RefineResult b = refine_pose("icp", c.model, c.scene, c.init, sub, 12);
+  EXPECT_NE(std::memcmp(a.T_cam_model.t.data(), b.T_cam_model.t.data(), sizeof(double) * 3), 0);
+}
+
+TEST_F(RefineCases, NoneReturnsTheInitialPose) {
+  const auto& c = cases_[0];
+  const RefineResult r = refine_pose("none", c.model, c.scene, c.init, RefineSettings{}, 1);
+  EXPECT_EQ(r.T_cam_model.R, c.init.R);
+  EXPECT_EQ(r.T_cam_model.t, c.init.t);
+  EXPECT_EQ(r.iterations, 0);
+}
+
+TEST(Refine, UnknownMethodIsAnInputError) {
+  PointSet a;
+  a.points.push_back(Vec3f(0, 0, 500));
+  try {
+    refine_pose("icp_magic", a, a, Pose{}, RefineSettings{}, 1);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "refinement");
+    EXPECT_NE(std::string(e.what()).find("icp_magic"), std::string::npos);
+  }
+}
+
+TEST(Refine, EmptyOrFarCloudsReturnTheInitialPose) {
+  PointSet empty, some;
+  for (int i = 0; i < 50; ++i) some.points.push_back(Vec3f(i, 2 * i % 7, 600 + i % 5));
+  Pose init;
+  init.t = Vec3(1, 2, 3);
+  for (const char* m : {"icp", "icp_lm", "icp_plane", "gicp", "ndt"}) {
+    for (const auto& [model, scene] : {std::make_pair(&empty, &some), std::make_pair(&some, &empty)}) {
+      const RefineResult r = refine_pose(m, *model, *scene, init, RefineSettings{}, 1);
+      EXPECT_EQ(r.T_cam_model.t, init.t) << m;
+      EXPECT_FALSE(r.converged) << m;
+    }
+    // Scene far from the model at its initial pose: nothing to register.
+    Pose far = init;
+    far.t = Vec3(5000, 0, 0);
+    const RefineResult r = refine_pose(m, some, some, far, RefineSettings{}, 1);
+    EXPECT_EQ(r.T_cam_model.t, far.t) << m;
+  }
+}
+
+TEST(Refine, ParseReadsEveryFieldAndRejectsBadOnes) {
+  const YamlNode n = YamlNode::load_string(
+      "refine:\n  max_iterations: 25\n  max_correspondence_mm: 15\n  transformation_epsilon: 1e-9\n"
+      "  rotation_epsilon_deg: 0.1\n  fitness_epsilon: 1e-5\n  icp_sample_points: 200\n"
+      "  ndt_resolution_mm: 30\n  ndt_resolution_fraction: 0.2\n  ndt_step_size_mm: 5\n"
+      "  ndt_outlier_ratio: 0.4\n  ndt_min_points_per_cell: 4\n  gicp_correspondence_randomness: 10\n"
+      "  gicp_covariances_from_normals: false\n  crop_margin_mm: 30\n  normal_neighbours: 12\n",
+      "cfg.yaml");
+  RefineSettings s;
+  parse_refine(n["refine"], s);
+  EXPECT_EQ(s.max_iterations, 25);
+  EXPECT_EQ(s.max_correspondence_mm, 15);
+  EXPECT_EQ(s.transformation_epsilon, 1e-9);
+  EXPECT_EQ(s.rotation_epsilon_deg, 0.1);
+  EXPECT_EQ(s.fitness_epsilon, 1e-5);
+  EXPECT_EQ(s.icp_sample_points, 200);
+  EXPECT_EQ(s.ndt_resolution_mm, 30);
+  EXPECT_EQ(s.ndt_resolution_fraction, 0.2);
+  EXPECT_EQ(s.ndt_step_size_mm, 5);
+  EXPECT_EQ(s.ndt_outlier_ratio, 0.4);
+  EXPECT_EQ(s.ndt_min_points_per_cell, 4);
+  EXPECT_EQ(s.gicp_correspondence_randomness, 10);
+  EXPECT_FALSE(s.gicp_covariances_from_normals);
+  EXPECT_EQ(s.crop_margin_mm, 30);
+  EXPECT_EQ(s.normal_neighbours, 12);
+
+  auto fails = [](const std::string& text, const std::string& field) {
+    RefineSettings t;
+    try {
+      parse_refine(YamlNode::load_string(text, "bad.yaml")["refine"], t);
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.file(), "bad.yaml");
+      EXPECT_EQ(e.field(), field) << e.what();
+      return;
+    }
+    ADD_FAILURE() << "no error for " << text;
+  };
+  fails("refine:\n  max_iterationz: 3\n", "refine.max_iterationz");
+  fails("refine:\n  max_iterations: 0\n", "refine.max_iterations");
+  fails("refine:\n  max_correspondence_mm: -1\n", "refine.max_correspondence_mm");
+  fails("refine:\n  ndt_outlier_ratio: 1.5\n", "refine.ndt_outlier_ratio");
+  fails("refine:\n  ndt_min_points_per_cell: 2\n", "refine.ndt_min_points_per_cell");
+  fails("refine:\n  icp_sample_points: many\n", "refine.icp_sample_points");
+}
+
+}  // namespace
+}  // namespace pb
