@@ -110,7 +110,11 @@ std::vector<Region> stable_regions(const PointSet& cloud, const GlobalSettings& 
       const Vec3f ns = (*filtered)[seed].getNormalVector3fMap();
       if (!ns.allFinite()) continue;
       if (tree->radiusSearch(seed, tol, nn, nd) <= 0) continue;
-      for (const auto j : nn) {
+      // As PCL's CVFH, the first neighbour returned is skipped (it assumes
+      // it is the seed itself, which an unsorted search does not promise);
+      // kept so the regions are exactly CVFH's.
+      for (size_t jj = 1; jj < nn.size(); ++jj) {
+        const auto j = nn[jj];
         if (processed[j]) continue;
         const Vec3f nj = (*filtered)[j].getNormalVector3fMap();
         const double dot = ns.dot(nj);

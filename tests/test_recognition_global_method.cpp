@@ -1,0 +1,178 @@
+// The global methods as the pipeline uses them: save/load of the trained
+// state, determinism (same call twice, two threads at once), degenerate
+// input, and the `global:` YAML section.
+#include <gtest/gtest.h>
+
+#include <sstream>
+#include <thread>
+
+#include "core/error.h"
+#include "recognition/global_internal.h"
+#include "test_recognition_global_util.h"
+
+namespace pb {
+namespace {
+
+using namespace testing_global;
+
+std::unique_ptr<Method> make(const std::string& name) {
+  if (name == "cvfh") return make_cvfh_method();
+  if (name == "esf") return make_esf_method();
+  if (name == "cesf") return make_cesf_method();
+  return make_ourcvfh_method();
+}
+
+bool same(const std::vector<Hypothesis>& a, const std::vector<Hypothesis>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i)
+    if (a[i].view != b[i].view || a[i].score != b[i].score || a[i].T_cam_model.R != b[i].T_cam_model.R ||
+        a[i].T_cam_model.t != b[i].T_cam_model.t)
+      return false;
+  return true;
+}
+
+class GlobalMethod : public ::testing::TestWithParam<std::string> {
+ protected:
+  static void SetUpTestSuite() {
+    mesh_ = new Mesh(asymmetric_object());
+    RecognitionSettings s;
+    s.views.views = 8;
+    views_ = new std::vector<ViewData>(training_views(*mesh_, s));
+    PreprocessSettings pre = s.preprocess;
+    pre.remove_plane = false;
+    scene_ = new PointSet(
+        preprocess_scene(render_cloud(*mesh_, camera_pose(60, 30, 5, 650), synthetic_camera(), 1.0, 9), pre, 4));
+  }
+  static void TearDownTestSuite() {
+    delete mesh_;
+    delete views_;
+    delete scene_;
+  }
+  static Mesh* mesh_;
+  static std::vector<ViewData>* views_;
+  static PointSet* scene_;
+};
+Mesh* GlobalMethod::mesh_ = nullptr;
+std::vector<ViewData>* GlobalMethod::views_ = nullptr;
+PointSet* GlobalMethod::scene_ = nullptr;
+
+TEST_P(GlobalMethod, SaveLoadDeterminismThreads) {
+  RecognitionSettings s;
+  s.descriptor = GetParam();
+  auto m = make(GetParam());
+  EXPECT_EQ(m->name(), GetParam());
+  m->train(*views_, s);
+  StageTimes t;
+  const auto h1 = m->hypothesize(*scene_, *views_, s, 11, t);
+  ASSERT_FALSE(h1.empty());
+  EXPECT_LE(h1.size(), static_cast<size_t>(s.global.top_k * s.global.crh_max_peaks));
+  for (const auto& h : h1) {
+    EXPECT_GE(h.view, 0);
+    EXPECT_LT(h.view, static_cast<int>(views_->size()));
+    EXPECT_GT(h.score, 0.0);
+    EXPECT_LT((h.T_cam_model.R * h.T_cam_model.R.transpose() - Mat3::Identity()).norm(), 1e-6);
+    EXPECT_GT(h.T_cam_model.R.determinant(), 0.0);
+  }
+  // Scores never increase along the list (ordered by histogram distance).
+  for (size_t i = 1; i < h1.size(); ++i) EXPECT_LE(h1[i].score, h1[i - 1].score);
+  EXPECT_GT(t.describe, 0.0);
+
+  // Same call again: bit for bit.
+  EXPECT_TRUE(same(h1, m->hypothesize(*scene_, *views_, s, 11, t)));
+
+  // Saved and loaded into a fresh method: the same hypotheses.
+  std::stringstream buf;
+  m->save(buf);
+  auto m2 = make(GetParam());
+  m2->load(buf);
+  EXPECT_TRUE(same(h1, m2->hypothesize(*scene_, *views_, s, 11, t)));
+  // A state of another method is refused with a clear error.
+  std::stringstream buf2(buf.str());
+  auto other = make(GetParam() == "cvfh" ? "esf" : "cvfh");
+  EXPECT_THROW(other->load(buf2), InputError);
+  std::stringstream junk("not a state");
+  EXPECT_THROW(m2->load(junk), InputError);
+
+  // Two threads on the same const method at once.
+  std::vector<Hypothesis> a, b;
+  std::thread ta([&] {
+    StageTimes tt;
+    a = m->hypothesize(*scene_, *views_, s, 11, tt);
+  });
+  std::thread tb([&] {
+    StageTimes tt;
+    b = m->hypothesize(*scene_, *views_, s, 11, tt);
+  });
+  ta.join();
+  tb.join();
+  EXPECT_TRUE(same(h1, a));
+  EXPECT_TRUE(same(h1, b));
+}
+
+TEST_P(GlobalMethod, DegenerateScenesGiveNoHypothesis) {
+  RecognitionSettings s;
+  auto m = make(GetParam());
+  m->train(*views_, s);
+  StageTimes t;
+  EXPECT_TRUE(m->hypothesize(PointSet{}, *views_, s, 1, t).empty());
+  // A handful of points: below the cluster size, no crash.
+  PointSet few;
+  for (int i = 0; i < 5; ++i) {
+    few.points.emplace_back(static_cast<float>(i), 0.f, 500.f);
+    few.normals.emplace_back(0.f, 0.f, -1.f);
+    few.curvature.push_back(0.f);
+  }
+  EXPECT_TRUE(m->hypothesize(few, *views_, s, 1, t).empty());
+  // Points without normals.
+  PointSet bare;
+  for (int i = 0; i < 200; ++i) bare.points.emplace_back(static_cast<float>(i % 20), static_cast<float>(i / 20), 500.f);
+  m->hypothesize(bare, *views_, s, 1, t);  // any outcome but a crash
+  // An untrained method has nothing to match.
+  auto empty = make(GetParam());
+  EXPECT_TRUE(empty->hypothesize(*scene_, *views_, s, 1, t).empty());
+}
+
+INSTANTIATE_TEST_SUITE_P(All, GlobalMethod, ::testing::Values("cvfh", "esf", "cesf", "ourcvfh"));
+
+TEST(GlobalRegions, StableRegionsMatchPclCvfh) {
+  // Our stable regions (CESF) are CVFH's: the same centroids.
+  RecognitionSettings s;
+  const PointSet view = preprocess_view(
+      render_cloud(asymmetric_object(), camera_pose(30, 30, 0, 700), synthetic_camera(), 1.0, 1), s.preprocess, 2);
+  const auto regions = global::stable_regions(view, s.global);
+  const auto sigs = global::cvfh_signatures(view, s.global);
+  ASSERT_GE(regions.size(), 2u);
+  ASSERT_EQ(regions.size(), sigs.size());
+  for (size_t i = 0; i < regions.size(); ++i) {
+    EXPECT_LT((regions[i].centroid - sigs[i].centroid).norm(), 1e-3) << i;
+    EXPECT_LT((-regions[i].mean_normal - sigs[i].axis).norm(), 1e-4) << i;
+  }
+}
+
+TEST(GlobalSettingsYaml, ParsesAndRejects) {
+  GlobalSettings g;
+  parse_global(YamlNode::load_string("top_k: 7\nskip_crh: true\ncrh_max_peaks: 2\nesf_samples: 5000\n", "g.yaml"), g);
+  EXPECT_EQ(g.top_k, 7);
+  EXPECT_TRUE(g.skip_crh);
+  EXPECT_EQ(g.crh_max_peaks, 2);
+  EXPECT_EQ(g.esf_samples, 5000);
+  auto msg = [](const std::string& text) {
+    GlobalSettings x;
+    try {
+      parse_global(YamlNode::load_string(text, "bad.yaml"), x);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(msg("top_kk: 3\n").find("top_kk"), std::string::npos);
+  EXPECT_NE(msg("crh_bins: 36\n").find("crh_bins"), std::string::npos);
+  EXPECT_NE(msg("top_k: 0\n").find("top_k"), std::string::npos);
+  EXPECT_NE(msg("cluster_tolerance_mm: -1\n").find("cluster_tolerance_mm"), std::string::npos);
+  EXPECT_NE(msg("crh_peak_threshold: 2\n").find("crh_peak_threshold"), std::string::npos);
+  EXPECT_NE(msg("cluster_min_points: 100\ncluster_max_points: 10\n").find("cluster_max_points"), std::string::npos);
+  EXPECT_NE(msg("top_k: 0\n").find("bad.yaml"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace pb
