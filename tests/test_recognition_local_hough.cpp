@@ -160,6 +160,7 @@ TEST_P(LocalMethodOnCopy, FindsTransformSaveLoadAndThreads) {
   const PointSet scene = transformed(model, T);
 
   RecognitionSettings s;
+  s.local.descriptor_radius_mm = 40;  // dense surface (4 mm spacing): keep it quick
   std::vector<ViewData> views(1);
   views[0].cloud = model;
   views[0].T_cam_model = Pose::identity();

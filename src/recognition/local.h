@@ -7,22 +7,26 @@
 namespace pb {
 
 struct LocalSettings {
-  double keypoint_voxel_mm = 15.0;      // second, coarser voxel grid (Table 4.2)
-  double descriptor_radius_mm = 40.0;   // FPFH / SHOT support radius
-  double lrf_radius_mm = 40.0;          // local reference frame radius (Hough voting)
-  double match_threshold = 0.25;        // SHOT: max squared L2 distance between SHOT
-                                        // descriptors (unit L2 norm, so in [0, 2]); PCL's
-                                        // correspondence grouping tutorial uses 0.25
-  double fpfh_match_threshold = 2000;   // FPFH: max squared L2 distance between PCL FPFH
+  double keypoint_voxel_mm = 15.0;      // second, coarser voxel grid (Table 4.2); the
+                                        // keypoint is the cloud point nearest each voxel's centroid
+  double descriptor_radius_mm = 60.0;   // FPFH / SHOT support radius (the thesis gives none;
+                                        // on generated table scenes with 10 mm voxels SHOT
+                                        // did clearly better at 60 than at 40, FPFH alike)
+  double lrf_radius_mm = 40.0;          // BOARD local reference frame radius (Hough voting)
+  double match_threshold = 0.5;         // SHOT: max squared L2 distance between SHOT
+                                        // descriptors (unit L2 norm, so in [0, 2]; PCL's
+                                        // tutorial uses 0.25, too strict at 10 mm voxels)
+  double fpfh_match_threshold = 250;    // FPFH: max squared L2 distance between PCL FPFH
                                         // histograms (each of the 3 sub-histograms sums to 100)
   int matches_per_keypoint = 1;         // k: up to k nearest model descriptors (over all
                                         // views) under the threshold kept per scene keypoint
   double hough_bin_mm = 50.0;           // 3D Hough bin size (Table 4.2)
   int hough_min_votes = 5;              // minimum votes for a hypothesis (thesis: 5)
-  bool hough_interpolation = false;     // spread each vote over the 8 nearest bins (PCL option)
+  bool hough_interpolation = false;     // spread each vote over the 8 nearest bins (PCL option;
+                                        // off: one vote per correspondence, as the thesis)
   int max_hypotheses = 10;              // at most this many clusters go on to refinement
-  int threads = 0;                      // OpenMP threads for FPFH / SHOT (0 = all cores);
-                                        // results are identical for any value
+  int threads = 0;                      // OpenMP threads for FPFH / SHOT / matching (0 = all
+                                        // cores); results are identical for any value
 };
 
 void parse_local(const YamlNode& node, LocalSettings& s);

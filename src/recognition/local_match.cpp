@@ -1,6 +1,10 @@
-// Descriptor matching index: FLANN single kd-tree (exact search, squared L2,
-// the same index pcl::KdTreeFLANN builds), over the descriptors of all
-// training views. Searches are const and thread-safe.
+// Descriptor matching index over the descriptors of all training views:
+// exact nearest neighbours under squared L2 distance. Low-dimensional
+// descriptors (FPFH, 33) use a FLANN single kd-tree (the index
+// pcl::KdTreeFLANN builds). For high-dimensional ones (SHOT, 352) a kd-tree
+// visits nearly every leaf (measured: no faster than a linear scan), so they
+// use an exact blocked linear scan. Searches are const and thread-safe, and
+// deterministic (no randomized trees).
 #include <flann/algorithms/dist.h>
 #include <flann/algorithms/kdtree_single_index.h>
 #include <flann/util/matrix.h>
@@ -10,6 +14,10 @@
 #include "recognition/local_internal.h"
 
 namespace pb::local {
+
+namespace {
+constexpr int kMaxKdTreeDim = 64;  // above this: linear scan
+}
 
 struct DescriptorIndex::Impl {
   std::vector<float> data;
@@ -27,6 +35,7 @@ void DescriptorIndex::build(const std::vector<float>& data, int dim) {
   impl_->data = data;
   impl_->dim = dim;
   impl_->rows = data.size() / static_cast<size_t>(dim);
+  if (dim > kMaxKdTreeDim) return;
   flann::Matrix<float> m(impl_->data.data(), impl_->rows, static_cast<size_t>(dim));
   impl_->index.reset(new flann::KDTreeSingleIndex<flann::L2_Simple<float>>(
       m, flann::KDTreeSingleIndexParams(15)));
@@ -38,11 +47,41 @@ size_t DescriptorIndex::size() const { return impl_->rows; }
 void DescriptorIndex::knn(const float* query, int k, float max_sq_dist,
                           std::vector<std::pair<int, float>>& out) const {
   out.clear();
-  if (!impl_->index || k <= 0) return;
+  if (impl_->rows == 0 || k <= 0) return;
   const size_t kk = std::min<size_t>(static_cast<size_t>(k), impl_->rows);
+  const size_t dim = static_cast<size_t>(impl_->dim);
+  if (!impl_->index) {
+    // Exact linear scan; keeps the kk best under the threshold.
+    const float* d = impl_->data.data();
+    for (size_t r = 0; r < impl_->rows; ++r, d += dim) {
+      // Eight fixed partial sums (vectorizable, same order every run).
+      float acc[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+      size_t j = 0;
+      for (; j + 8 <= dim; j += 8)
+        for (int l = 0; l < 8; ++l) {
+          const float t = query[j + l] - d[j + l];
+          acc[l] += t * t;
+        }
+      for (; j < dim; ++j) {
+        const float t = query[j] - d[j];
+        acc[0] += t * t;
+      }
+      const float s = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+      if (!(s < max_sq_dist)) continue;
+      if (out.size() == kk) {
+        if (!(s < out.back().second)) continue;
+        out.pop_back();
+      }
+      const std::pair<int, float> e(static_cast<int>(r), s);
+      out.insert(std::upper_bound(out.begin(), out.end(), e,
+                                  [](const auto& a, const auto& b) { return a.second < b.second; }),
+                 e);
+    }
+    return;
+  }
   std::vector<size_t> idx(kk);
   std::vector<float> dist(kk);
-  flann::Matrix<float> q(const_cast<float*>(query), 1, static_cast<size_t>(impl_->dim));
+  flann::Matrix<float> q(const_cast<float*>(query), 1, dim);
   flann::Matrix<size_t> mi(idx.data(), 1, kk);
   flann::Matrix<float> md(dist.data(), 1, kk);
   flann::SearchParams params(-1, 0.0f, true);

@@ -4,6 +4,9 @@
 // BOARD reference frames, a Procrustes (SVD) pose per cluster. PCL-free: the
 // PCL parts live in local_{fpfh,shot,match,hough}.cpp.
 #include <Eigen/Geometry>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
@@ -50,6 +53,14 @@ void parse_local(const YamlNode& node, LocalSettings& s) {
 namespace {
 
 using namespace local;
+
+int omp_threads(int threads) {
+#ifdef _OPENMP
+  return threads > 0 ? threads : omp_get_num_procs();
+#else
+  return 1;
+#endif
+}
 
 enum class Kind : uint32_t { Fpfh = 1, Shot = 2 };
 
@@ -198,15 +209,19 @@ class LocalMethod : public Method {
     // Match: k nearest model descriptors under the threshold, per view.
     timer.reset();
     const float thr = static_cast<float>(kind_ == Kind::Fpfh ? s.fpfh_match_threshold : s.match_threshold);
+    // One result slot per scene keypoint, merged in keypoint order: the same
+    // matches for any thread count.
+    std::vector<std::vector<std::pair<int, float>>> nn(sc.kp.size());
+    const long nkp = static_cast<long>(sc.kp.size());
+#pragma omp parallel for schedule(dynamic, 16) num_threads(omp_threads(s.threads)) if (nkp > 64)
+    for (long i = 0; i < nkp; ++i)
+      index_.knn(sc.desc.data() + i * dim, s.matches_per_keypoint, thr, nn[static_cast<size_t>(i)]);
     std::vector<std::vector<Match>> per_view(views_.size());
-    std::vector<std::pair<int, float>> nn;
-    for (size_t i = 0; i < sc.kp.size(); ++i) {
-      index_.knn(sc.desc.data() + i * dim, s.matches_per_keypoint, thr, nn);
-      for (const auto& [row, d2] : nn) {
+    for (size_t i = 0; i < nn.size(); ++i)
+      for (const auto& [row, d2] : nn[i]) {
         const auto& [v, k] = row_owner_[row];
         per_view[v].push_back({k, static_cast<int>(i), d2});
       }
-    }
     times.match += timer.seconds();
 
     // Group: 3D Hough voting per training view.
