@@ -41,7 +41,7 @@ TEST(Report, CellsMatchHandComputedAggregates) {
   ASSERT_EQ(r.tables.size(), 1u);
   const auto& t = r.tables[0];
   ASSERT_EQ(t.columns, (std::vector<std::string>{"cvfh", "fpfh"}));
-  ASSERT_EQ(t.rows.size(), 4u);
+  ASSERT_EQ(t.rows.size(), 8u);  // 4 thesis measures + BOP AR and its 3 components
   EXPECT_EQ(t.rows[0].measure, "robustness");
   EXPECT_DOUBLE_EQ(t.rows[0].cells[0].value, 0.5);
   EXPECT_DOUBLE_EQ(t.rows[0].cells[1].value, 1.0);
@@ -52,11 +52,34 @@ TEST(Report, CellsMatchHandComputedAggregates) {
   EXPECT_NEAR(t.rows[2].cells[0].value, 0.02, 1e-12);
   EXPECT_EQ(t.rows[3].measure, "time");
   EXPECT_NEAR(t.rows[3].cells[0].value, (0.2 + 0.4 + 0.3 + 0.5) / 4, 1e-12);
+  EXPECT_EQ(t.rows[4].measure, "bop_ar");
+  EXPECT_DOUBLE_EQ(t.rows[4].cells[0].value, 0.0);  // no BOP errors recorded: nothing recalled
   const std::string md = pb::to_markdown(r);
   EXPECT_NE(md.find("50% (43%)"), std::string::npos) << md;
   EXPECT_NE(md.find("100% (67%)"), std::string::npos) << md;
   const std::string csv = pb::to_csv(r);
   EXPECT_NE(csv.find("table_synthetic,robustness,cvfh,0.5,0.43,4"), std::string::npos) << csv;
+}
+
+TEST(Report, BopAverageRecallFromRecordedErrors) {
+  // One image, diameter 100 mm, MSSD 12 mm: correct for MSSD thresholds
+  // 0.15..0.5 of the diameter (8 of 10); MSPD 7 px at width 640: correct for
+  // 10..50 px (9 of 10); VSD 0.07 for every tau: correct for thresholds
+  // 0.10..0.50 (9 of 10).
+  auto r = rec("table_synthetic", "cvfh", true, 10.0, 0.01, 0.2);
+  r["bop"] = {{"mssd_mm", 12.0}, {"mspd_px", 7.0}, {"vsd", std::vector<double>(10, 0.07)},
+              {"diameter", 100.0}, {"image_width", 640}};
+  const pb::Report rep = pb::build_report(experiment(), {r}, {});
+  const auto& rows = rep.tables.at(0).rows;
+  auto value = [&](const std::string& m) {
+    for (const auto& row : rows)
+      if (row.measure == m) return row.cells[0].value;
+    return -1.0;
+  };
+  EXPECT_NEAR(value("bop_ar_mssd"), 0.8, 1e-12);
+  EXPECT_NEAR(value("bop_ar_mspd"), 0.9, 1e-12);
+  EXPECT_NEAR(value("bop_ar_vsd"), 0.9, 1e-12);
+  EXPECT_NEAR(value("bop_ar"), (0.8 + 0.9 + 0.9) / 3, 1e-12);
 }
 
 TEST(Report, NoiseSweepMakesOnePlotSeriesPerMethod) {

@@ -1,5 +1,8 @@
 // posebench report results/NAME [--format md,csv,tex] [--plots]
+#include <algorithm>
 #include <cstdlib>
+#include <map>
+#include <tuple>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -8,6 +11,7 @@
 #include "cli/command.h"
 #include "core/error.h"
 #include "io/png.h"
+#include "eval/bop_csv.h"
 #include "report/report.h"
 #include "runner/store.h"
 
@@ -70,6 +74,48 @@ static pb::cli::Command report_cmd("report", "tables (md, csv, tex) and plots fr
       pb::atomic_write_text((fs::path(dir) / "report.tex").string(), pb::to_latex(rep));
     } else {
       throw pb::InputError("", "--format", "unknown format '" + f + "' (md, csv, tex)");
+    }
+  }
+  // BOP results CSVs (one per method and scene set, every condition), so the
+  // BOP toolkit itself can score them.
+  {
+    std::map<std::string, std::vector<pb::BopResultRow>> files;
+    for (const auto& r : records) {
+      if (r.value("status", "") != "ok" || !r.contains("estimate")) continue;
+      std::string method = "posebench-" + r.value("descriptor", std::string("x")) + "-" +
+                           r.value("refinement", std::string("x"));
+      const auto params = r.value("params", nlohmann::json::object());
+      const double noise = r.value("added_noise_mm", 0.0);
+      std::string cond;
+      for (auto it = params.begin(); it != params.end(); ++it) cond += "-" + it.key() + "=" + it.value().dump();
+      if (noise > 0) cond += "-noise=" + nlohmann::json(noise).dump();
+      // BOP parses METHOD_DATASET-SPLIT.csv: no '_' in the method, no '_' or
+      // '-' in the dataset name.
+      method += cond;
+      for (char& c : method)
+        if (c == '_' || c == '/' || c == '"' || c == ' ') c = '.';
+      std::string dataset = r.value("scene", std::string("scene"));
+      dataset.erase(std::remove_if(dataset.begin(), dataset.end(), [](char c) { return c == '_' || c == '-'; }),
+                    dataset.end());
+      const std::string name = method + "_" + dataset + "-" + r.value("split", std::string("test")) + ".csv";
+      pb::BopResultRow row;
+      row.scene_id = r.value("scene_id", 0);
+      row.im_id = r.value("im_id", 0);
+      row.obj_id = r.value("obj_id", 0);
+      row.score = r.value("score", 1.0);
+      const auto R = r["estimate"]["R"].get<std::vector<double>>();
+      const auto t = r["estimate"]["t"].get<std::vector<double>>();
+      for (int i = 0; i < 9; ++i) row.T_cam_model.R(i / 3, i % 3) = R.at(i);
+      row.T_cam_model.t = pb::Vec3(t.at(0), t.at(1), t.at(2));
+      row.time_s = r.contains("times") ? r["times"].value("total", -1.0) : -1.0;
+      files[name].push_back(row);
+    }
+    if (!files.empty()) fs::create_directories(fs::path(dir) / "bop");
+    for (auto& [name, rows] : files) {
+      std::sort(rows.begin(), rows.end(), [](const pb::BopResultRow& a, const pb::BopResultRow& b) {
+        return std::tie(a.scene_id, a.im_id, a.obj_id) < std::tie(b.scene_id, b.im_id, b.obj_id);
+      });
+      pb::write_bop_results_csv((fs::path(dir) / "bop" / name).string(), rows);
     }
   }
   if (plots) {

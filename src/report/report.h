@@ -22,6 +22,7 @@ struct ReportRow {
   std::string scenario;   // scene set name (e.g. table_astra)
   std::string measure;    // robustness | translation_mm | rotation_1mpq | time | ...
   std::vector<ReportCell> cells;  // parallel to ReportTable::columns
+  bool detail = false;            // in the CSV only (e.g. the BOP AR components)
 };
 
 struct ReportTable {

@@ -217,6 +217,7 @@ ExperimentConfig load_experiment(const std::string& path) {
   canon["added_noise_mm"] = c.added_noise_mm;
   canon["settings"] = c.settings;
   canon["registration_only"] = c.registration_only;
+  canon["timeout_s"] = c.timeout_s;
   canon["perturb"] = {c.perturb_deg, c.perturb_mm};
   canon["thresholds"] = {c.thresholds.table_translation_mm, c.thresholds.warehouse_translation_mm,
                          c.thresholds.rotation_1mpq};

@@ -9,11 +9,13 @@
 #include "core/random.h"
 #include "core/rotation.h"
 #include "core/timer.h"
+#include "eval/bop_metrics.h"
 #include "eval/errors.h"
 #include "eval/symmetry.h"
 #include "io/bop.h"
 #include "recognition/pipeline.h"
 #include "recognition/refine_only.h"
+#include "render/renderer.h"
 
 namespace pb {
 
@@ -30,6 +32,7 @@ struct WorkerCache {
   std::map<std::string, std::unique_ptr<BopDataset>> datasets;
   std::map<std::string, std::shared_ptr<const TrainedModel>> models;
   std::map<std::string, std::unique_ptr<Mesh>> meshes;
+  std::map<std::string, std::unique_ptr<DepthRenderer>> renderers;  // by intrinsics, for VSD
 };
 static WorkerCache& cache() {
   static WorkerCache c;
@@ -140,6 +143,20 @@ nlohmann::json run_trial(const nlohmann::json& trial, const TrialContext& ctx) {
                          {"translation_mm_plain", e.translation_mm_plain},
                          {"rotation_1mpq_plain", e.rotation_plain}};
         rec["correct"] = thesis_correct(e, thr);
+
+        // The BOP errors (MSSD, MSPD, VSD with bop19 settings) of the estimate.
+        const std::string rkey = std::to_string(im.K.width) + "x" + std::to_string(im.K.height) + ":" +
+                                 nlohmann::json({im.K.fx, im.K.fy, im.K.cx, im.K.cy}).dump();
+        auto& renderer = cache().renderers[rkey];
+        if (!renderer) renderer = std::make_unique<DepthRenderer>(im.K);
+        BopModel bm;
+        bm.mesh = mesh.get();
+        bm.symmetries = syms;
+        bm.diameter = ds.model_info(obj_id).diameter;
+        const DepthImage clean = ds.load_depth(split, scene_id, im);  // without the trial's added noise
+        const BopPoseErrors be = bop_pose_errors(res.T_cam_model, gt->T_cam_model, bm, im.K, {}, &clean, renderer.get());
+        rec["bop"] = {{"mssd_mm", be.mssd_mm}, {"mspd_px", be.mspd_px}, {"vsd", be.vsd},
+                      {"diameter", bm.diameter}, {"image_width", im.K.width}};
       } else {
         rec["correct"] = false;
       }
