@@ -153,6 +153,7 @@ nlohmann::ordered_json settings_json(const RecognitionSettings& s) {
                  {"transformation_epsilon", r.transformation_epsilon},
                  {"rotation_epsilon_deg", r.rotation_epsilon_deg},
                  {"fitness_epsilon", r.fitness_epsilon},
+                 {"reciprocal_correspondences", r.reciprocal_correspondences},
                  {"icp_sample_points", r.icp_sample_points},
                  {"ndt_resolution_mm", r.ndt_resolution_mm},
                  {"ndt_resolution_fraction", r.ndt_resolution_fraction},
