@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <thread>
 
 #include "core/error.h"
 #include "core/random.h"
@@ -199,6 +200,21 @@ TEST_P(LocalMethodOnCopy, FindsTransformSaveLoadAndThreads) {
   std::stringstream cut(bytes.substr(0, bytes.size() / 2));
   auto m3 = local_method(GetParam());
   EXPECT_THROW(m3->load(cut), std::runtime_error);
+
+  // Concurrent calls on one trained method (const, thread-safe): the same
+  // hypotheses as the sequential call.
+  std::vector<Hypothesis> c1, c2;
+  StageTimes t1, t2;
+  std::thread a([&] { c1 = m2->hypothesize(scene, views, s, 1, t1); });
+  std::thread b([&] { c2 = m2->hypothesize(scene, views, s, 1, t2); });
+  a.join();
+  b.join();
+  ASSERT_EQ(c1.size(), h1.size());
+  ASSERT_EQ(c2.size(), h1.size());
+  for (size_t i = 0; i < h1.size(); ++i) {
+    EXPECT_EQ(c1[i].T_cam_model.matrix(), h1[i].T_cam_model.matrix());
+    EXPECT_EQ(c2[i].T_cam_model.matrix(), h1[i].T_cam_model.matrix());
+  }
 
   // Empty scene: no hypothesis, no crash.
   EXPECT_TRUE(m->hypothesize(PointSet{}, views, s, 1, times).empty());
