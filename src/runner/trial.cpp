@@ -71,6 +71,10 @@ nlohmann::json run_trial(const nlohmann::json& trial, const TrialContext& ctx) {
 
     RecognitionSettings s = parse_recognition_settings(
         YamlNode::load_string(trial.at("settings").dump(), "trial " + trial.at("key").get<std::string>()));
+    // Training is seeded by the settings' own seed (default 1), not by the
+    // trial: every trial with the same training settings shares one trained
+    // model (in memory and in the disk cache) instead of training its own.
+    const uint64_t train_seed = s.seed;
     s.seed = seed;
     rec["settings_resolved"] = nlohmann::json::parse(settings_to_json(s));
 
@@ -87,14 +91,16 @@ nlohmann::json run_trial(const nlohmann::json& trial, const TrialContext& ctx) {
       }
 
     Timer train_timer;
-    const std::string train_key = mesh_key + "#" + settings_to_json(s);
+    RecognitionSettings st = s;
+    st.seed = train_seed;
+    const std::string train_key = mesh_key + "#" + settings_to_json(st);
     auto& model = cache().models[train_key];
     bool from_cache = model != nullptr;
     if (!model) {
       TrainOptions opt;
       opt.cache_dir = ctx.cache_dir;
       opt.model_name = ds.model_info(obj_id).name.empty() ? bop_id(obj_id) : ds.model_info(obj_id).name;
-      model = train_model(*mesh, s, opt, &from_cache);
+      model = train_model(*mesh, st, opt, &from_cache);
     }
     rec["train_s"] = train_timer.seconds();
     rec["train_from_cache"] = from_cache;
