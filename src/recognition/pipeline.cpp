@@ -270,7 +270,10 @@ void deserialize(TrainedModel& m, const std::string& payload, const std::string&
   std::unique_ptr<Method> method = make_method(m.descriptor);
   std::istringstream is(state, std::ios::binary);
   method->load(is);
-  if (is.bad()) throw std::runtime_error("method state unreadable");
+  // A state written by another version of the method rarely has exactly
+  // the length this version reads: such a file is stale, not reusable.
+  if (is.bad() || is.fail() || is.peek() != std::char_traits<char>::eof())
+    throw std::runtime_error("method state unreadable or of another version");
   m.views = std::move(views);
   m.method = std::move(method);
 }
