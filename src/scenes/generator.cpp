@@ -129,16 +129,26 @@ struct SceneGenerator::Impl {
   // principal points), so px_count_all counts the whole silhouette, as BOP's
   // calc_gt_info does on an enlarged canvas. Returns false if the object lies
   // entirely outside the image.
-  bool alone(const Placed& p, const Pose& T_cam_world, AloneStats& st) {
+  // Projected bounding box of the object's hull (pixels); false if some
+  // vertex is behind the near plane (never for accepted layouts).
+  bool project_bbox(const Placed& p, const Pose& T_cam_world, double& umin, double& umax, double& vmin,
+                    double& vmax) const {
     const Pose T = T_cam_world * p.T_world_model;
-    double umin = 1e300, umax = -1e300, vmin = 1e300, vmax = -1e300;
+    umin = vmin = 1e300, umax = vmax = -1e300;
     for (const auto& v : hull[p.model]) {
       const Vec3 c = T * v;
-      if (c.z() <= rset.near_mm) return false;  // never happens for accepted layouts
+      if (c.z() <= rset.near_mm) return false;
       const auto uv = K.project(c);
       umin = std::min(umin, uv.x()), umax = std::max(umax, uv.x());
       vmin = std::min(vmin, uv.y()), vmax = std::max(vmax, uv.y());
     }
+    return true;
+  }
+
+  bool alone(const Placed& p, const Pose& T_cam_world, AloneStats& st) {
+    const Pose T = T_cam_world * p.T_world_model;
+    double umin, umax, vmin, vmax;
+    if (!project_bbox(p, T_cam_world, umin, umax, vmin, vmax)) return false;
     const int W = K.width, H = K.height;
     if (umax < -0.5 || vmax < -0.5 || umin > W - 0.5 || vmin > H - 0.5) return false;
     st = AloneStats();
@@ -575,10 +585,60 @@ bool SceneGenerator::Impl::generate_attempt(int im_id, int attempt, GeneratedIma
   img.info.K = K;
   img.info.depth_scale = s.depth_scale;
   img.names.clear();
+  // Silhouettes of each object alone. Objects inside the image whose
+  // projected boxes are disjoint cannot overlap: they are rendered together
+  // (same pixels as one by one, fewer renders).
+  std::vector<AloneStats> alone_stats(objs.size());
+  std::vector<char> present(objs.size(), 0);
+  alone_stats[0] = target_alone;
+  present[0] = 1;
+  std::vector<std::vector<int>> groups;
+  std::vector<std::vector<Eigen::AlignedBox2d>> member_boxes;
+  for (size_t i = 1; i < objs.size(); ++i) {
+    double umin, umax, vmin, vmax;
+    if (!project_bbox(objs[i], T_cam_world, umin, umax, vmin, vmax)) continue;
+    if (umax < -0.5 || vmax < -0.5 || umin > W - 0.5 || vmin > H - 0.5) continue;  // outside the image
+    if (!(umin >= -0.5 && vmin >= -0.5 && umax <= W - 0.5 && vmax <= H - 0.5)) {
+      present[i] = alone(objs[i], T_cam_world, alone_stats[i]);  // crosses the border: tiles
+      continue;
+    }
+    const Eigen::AlignedBox2d box(Eigen::Vector2d(umin - 1, vmin - 1), Eigen::Vector2d(umax + 1, vmax + 1));
+    size_t g = 0;
+    for (; g < groups.size(); ++g)
+      if (std::none_of(member_boxes[g].begin(), member_boxes[g].end(),
+                       [&](const Eigen::AlignedBox2d& b) { return b.intersects(box); }))
+        break;
+    if (g == groups.size()) {
+      groups.emplace_back();
+      member_boxes.emplace_back();
+    }
+    groups[g].push_back(static_cast<int>(i));
+    member_boxes[g].push_back(box);
+  }
+  for (const auto& group : groups) {
+    std::vector<RenderItem> items;
+    for (size_t j = 0; j < group.size(); ++j)
+      items.push_back({objs[group[j]].mesh, T_cam_world * objs[group[j]].T_world_model, static_cast<int>(j)});
+    const RenderOutput out = renderer->render(items);
+    std::vector<std::array<int, 4>> bb(group.size(), {{W, H, -1, -1}});
+    for (int v = 0; v < H; ++v)
+      for (int u = 0; u < W; ++u) {
+        const int32_t l = out.labels[static_cast<size_t>(v) * W + u];
+        if (l < 0 || l >= static_cast<int32_t>(group.size())) continue;
+        AloneStats& st = alone_stats[group[l]];
+        ++st.px_all;
+        st.pixels.push_back(v * W + u);
+        auto& b = bb[l];
+        b[0] = std::min(b[0], u), b[1] = std::min(b[1], v), b[2] = std::max(b[2], u), b[3] = std::max(b[3], v);
+      }
+    for (size_t j = 0; j < group.size(); ++j) {
+      alone_stats[group[j]].bbox = bbox_of(bb[j][0], bb[j][1], bb[j][2], bb[j][3]);
+      present[group[j]] = 1;
+    }
+  }
   for (size_t i = 0; i < objs.size(); ++i) {
-    AloneStats st;
-    if (i == 0) st = target_alone;
-    else if (!alone(objs[i], T_cam_world, st)) continue;
+    if (!present[i]) continue;
+    AloneStats& st = alone_stats[i];
     remap[i] = static_cast<int>(stats.size());
     stats.push_back(std::move(st));
     GtObject gt;
