@@ -27,3 +27,7 @@ export CCACHE_DIR="${CCACHE_DIR:-$HOME/.cache/ccache}"
 JOBS="${POSEBENCH_BUILD_JOBS:-$(nproc)}"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release ${POSEBENCH_CMAKE_ARGS:-} >/dev/null
 cmake --build build -j "$JOBS"
+
+# The project's own models, generated in code, written as meshes (mm) for
+# viewers and other tools; the registry lists every model and its state.
+build/posebench models --write models/generated >/dev/null
