@@ -36,6 +36,7 @@ std::vector<refine_test::Case> RefineCases::cases_;
 struct Rate {
   int ok = 0;
   double max_t_ok = 0, max_r_ok = 0;
+  double sum_t = 0, sum_r = 0;  // over every case
 };
 
 Rate run_method(const std::vector<refine_test::Case>& cases, const std::string& method, const RefineSettings& s) {
@@ -46,6 +47,8 @@ Rate run_method(const std::vector<refine_test::Case>& cases, const std::string& 
     const double et = refine_test::translation_error(r.T_cam_model, c.gt);
     const double er = refine_test::rotation_error_deg(r.T_cam_model, c.gt);
     const bool ok = et < 5.0 && er < 2.0;
+    rate.sum_t += et;
+    rate.sum_r += er;
     std::printf("  %-9s case %2zu: scene %4zu model %4zu  t %6.2f mm  R %5.2f deg  it %2d conv %d fit %6.2f %s\n",
                 method.c_str(), i, c.scene.size(), c.model.size(), et, er, r.iterations, r.converged ? 1 : 0,
                 r.fitness, ok ? "" : "MISS");
@@ -55,8 +58,10 @@ Rate run_method(const std::vector<refine_test::Case>& cases, const std::string& 
       rate.max_r_ok = std::max(rate.max_r_ok, er);
     }
   }
-  std::printf("%-9s converged within 5 mm / 2 deg: %d of %zu (worst success: %.2f mm, %.2f deg)\n", method.c_str(),
-              rate.ok, cases.size(), rate.max_t_ok, rate.max_r_ok);
+  std::printf("%-9s converged within 5 mm / 2 deg: %d of %zu (mean error %.2f mm, %.2f deg; worst success: %.2f mm, "
+              "%.2f deg)\n",
+              method.c_str(), rate.ok, cases.size(), rate.sum_t / cases.size(), rate.sum_r / cases.size(),
+              rate.max_t_ok, rate.max_r_ok);
   return rate;
 }
 

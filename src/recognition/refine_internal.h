@@ -27,7 +27,7 @@ struct Problem {
   std::vector<Vec3f> src_normals;  // unit; filled when the method needs normals
   std::vector<Vec3f> tgt;          // cropped scene points, local frame (m)
   std::vector<Vec3f> tgt_normals;  // unit; filled when the method needs normals
-  double model_diameter_m = 0;     // largest extent of the model cloud (bounding box diagonal)
+  double model_diameter_m = 0;     // extent of the model cloud: its bounding box diagonal in the model frame
 };
 
 struct Outcome {

@@ -84,11 +84,9 @@ RefineResult refine_pose(const std::string& method, const PointSet& model, const
   }
   centre /= static_cast<double>(model.size());
   double radius = 0;
-  Eigen::AlignedBox3d box;
-  for (const auto& p : moved) {
-    radius = std::max(radius, (p - centre).norm());
-    box.extend(p);
-  }
+  for (const auto& p : moved) radius = std::max(radius, (p - centre).norm());
+  Eigen::AlignedBox3d box;  // in the model frame: independent of the initial pose
+  for (const auto& p : model.points) box.extend(p.cast<double>());
   const double margin = s.crop_margin_mm >= 0 ? s.crop_margin_mm : max_corr;
   const double crop_r2 = (radius + margin) * (radius + margin);
 
