@@ -538,22 +538,38 @@ bool SceneGenerator::Impl::generate_attempt(int im_id, int attempt, GeneratedIma
       why = "target too occluded before the occluder";
       return false;
     }
-    double lo = 0, hi = occl_hmax, best_h = -1, best_err = 1e300;
-    set_height(hi);
+    // Visible fraction falls as the occluder grows: find the height where
+    // it meets the goal by regula falsi (Illinois variant) on [0, hmax].
+    double a = 0, fa = v0 - goal, b = occl_hmax, best_h = -1, best_err = 1e300;
+    set_height(b);
     const double vmax = target_visib({&occl});
+    double fb = vmax - goal;
     if (vmax > s.occlusion.visib_fract.hi) {
       why = "occluder too small";
       return false;
     }
-    if (vmax >= s.occlusion.visib_fract.lo) best_h = hi, best_err = std::abs(vmax - goal);
-    for (int it = 0; it < 12 && best_err > 0.02; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      set_height(mid);
-      const double v = target_visib({&occl});
+    auto consider = [&](double h, double v) {
       if (v >= s.occlusion.visib_fract.lo && v <= s.occlusion.visib_fract.hi && std::abs(v - goal) < best_err)
-        best_h = mid, best_err = std::abs(v - goal);
-      if (v > goal) lo = mid;
-      else hi = mid;
+        best_h = h, best_err = std::abs(v - goal);
+    };
+    consider(b, vmax);
+    if (fa <= 0) consider(0.02 * occl_hmax, v0);  // already occluded enough: a token occluder
+    int side = 0;
+    for (int it = 0; it < 12 && best_err > 0.02 && fa > 0 && fb < 0; ++it) {
+      double c = b - fb * (b - a) / (fb - fa);
+      if (!(c > a && c < b)) c = 0.5 * (a + b);
+      set_height(c);
+      const double fc = target_visib({&occl}) - goal;
+      consider(c, fc + goal);
+      if (fc > 0) {
+        a = c, fa = fc;
+        if (side == -1) fb *= 0.5;
+        side = -1;
+      } else {
+        b = c, fb = fc;
+        if (side == 1) fa *= 0.5;
+        side = 1;
+      }
     }
     if (best_h < 0) {
       why = "occluded fraction not reached";
