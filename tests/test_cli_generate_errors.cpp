@@ -105,3 +105,7 @@ TEST(CliGenerateErrors, MissingConfigAndBadOptions) {
   EXPECT_TRUE(fs::exists(tmp.path + "/mine/notes.txt"));
   EXPECT_FALSE(fs::exists(tmp.path + "/mine.partial"));
 }
+
+TEST(CliGenerateErrors, MissingRegistry) {
+  expect_input_error("scenario: table\nregistry: nowhere/models.yaml\n", {"cfg.yaml", "registry", "nowhere/models.yaml"});
+}

@@ -207,7 +207,14 @@ SceneGenerator::SceneGenerator(const SceneSettings& settings) : impl_(std::make_
   Impl& I = *impl_;
   I.s = settings;
   const SceneSettings& s = I.s;
-  const ModelRegistry reg = s.registry.empty() ? ModelRegistry::load_default() : ModelRegistry::load(s.registry);
+  const ModelRegistry reg = [&] {
+    if (s.registry.empty()) return ModelRegistry::load_default();
+    try {
+      return ModelRegistry::load(s.registry);
+    } catch (const InputError& e) {
+      throw InputError(s.config_file, "registry", e.what());
+    }
+  }();
 
   // Target first, then the pool, each name once.
   std::vector<std::pair<std::string, std::string>> names{{s.target, "target"}};
