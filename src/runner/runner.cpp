@@ -81,6 +81,13 @@ void prepare_scenes(ExperimentConfig& cfg, const RunOptions& opt) {
     nlohmann::json gen = yaml_to_json_file(src.generate);
     for (auto it = src.generator_overrides.begin(); it != src.generator_overrides.end(); ++it)
       gen[it.key()] = it.value();
+    // The copy lives in scenes_dir: make a relative registry path absolute
+    // against the original config's folder.
+    if (gen.contains("registry") && gen["registry"].is_string() &&
+        fs::path(gen["registry"].get<std::string>()).is_relative())
+      gen["registry"] = fs::absolute(fs::path(src.generate).parent_path() / gen["registry"].get<std::string>())
+                            .lexically_normal()
+                            .string();
     const std::string h = hash_hex(gen.dump()).substr(0, 8);
     const fs::path dir = fs::path(opt.scenes_dir) / (src.name + "_" + h);
     src.dataset = dir.string();
