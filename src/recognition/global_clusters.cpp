@@ -131,6 +131,7 @@ std::vector<Region> stable_regions(const PointSet& cloud, const GlobalSettings& 
     for (int k : queue) {
       const auto& p = (*filtered)[k];
       r.points.push_back(p.getVector3fMap());
+      r.normals.push_back(p.getNormalVector3fMap());
       c += p.getVector3fMap().cast<double>();
       nsum += p.getNormalVector3fMap().cast<double>();
     }

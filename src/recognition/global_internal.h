@@ -49,6 +49,7 @@ PointSet subset(const PointSet& cloud, const std::vector<int>& indices);
 // cvfh_min_region_points points are kept.
 struct Region {
   std::vector<Vec3f> points;
+  std::vector<Vec3f> normals;          // the recomputed normals of the points
   Vec3f centroid = Vec3f::Zero();
   Vec3f mean_normal = Vec3f::UnitZ();  // unit, toward the camera
 };

@@ -7,6 +7,7 @@
 #include <pcl/point_types.h>
 #include <pcl/search/kdtree.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "recognition/global_internal.h"
@@ -35,6 +36,53 @@ std::vector<Signature> ourcvfh_signatures(const PointSet& cloud, const GlobalSet
   // Guard (PCL issues 1449, 1491): too few points for a region and its frame.
   if (pts->size() < static_cast<size_t>(std::max(s.cvfh_min_region_points, 10))) return out;
 
+  // Guard (PCL issues 1449, 1491): OUR-CVFH keeps, of each stable region,
+  // the points whose normal is within refine_clusters x eps of the region's
+  // mean normal; when that leaves very few points (1 or 2, or points all
+  // equally far from their centroid) its frame is NaN and PCL indexes out of
+  // bounds (reproduced: tests/test_recognition_global_method.cpp).
+  // The same regions are found here first (same algorithm, same metre-scaled
+  // input); if one would be degenerate, every region point is kept instead.
+  float refine = static_cast<float>(s.ourcvfh_refine_clusters);
+  {
+    PointSet scaled;
+    for (size_t i = 0; i < pts->size(); ++i) {
+      scaled.points.push_back((*pts)[i].getVector3fMap());
+      scaled.normals.push_back((*nrm)[i].getNormalVector3fMap());
+      scaled.curvature.push_back((*nrm)[i].curvature);
+    }
+    GlobalSettings gm = s;
+    gm.cvfh_cluster_tolerance_mm = s.cvfh_cluster_tolerance_mm * kToM;
+    gm.cvfh_normal_radius_mm = s.cvfh_normal_radius_mm * kToM;
+    const double eps = s.cvfh_eps_angle_deg * M_PI / 180.0;
+    for (const Region& r : stable_regions(scaled, gm)) {
+      std::vector<Vec3f> kept;
+      for (size_t k = 0; k < r.points.size(); ++k) {
+        const double dot = std::clamp(static_cast<double>(r.mean_normal.dot(r.normals[k])), -1.0, 1.0);
+        if (std::abs(std::acos(dot)) < eps * refine) kept.push_back(r.points[k]);
+      }
+      // Fewer than 5 (not 3): a margin for points at the angle threshold,
+      // where float sums may round differently from PCL's.
+      bool degenerate = kept.size() < 5;
+      if (!degenerate) {
+        Eigen::Vector3d c = Eigen::Vector3d::Zero();
+        for (const auto& p : kept) c += p.cast<double>();
+        c /= static_cast<double>(kept.size());
+        double dmin = 1e30, dmax = 0;
+        for (const auto& p : kept) {
+          const double d = (p.cast<double>() - c).norm();
+          dmin = std::min(dmin, d);
+          dmax = std::max(dmax, d);
+        }
+        degenerate = !(dmax - dmin > 1e-6);
+      }
+      if (degenerate) {
+        refine = static_cast<float>(M_PI / eps) + 1.f;  // every region point passes
+        break;
+      }
+    }
+  }
+
   pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(new pcl::search::KdTree<pcl::PointXYZ>);
   pcl::OURCVFHEstimation<pcl::PointXYZ, pcl::Normal, pcl::VFHSignature308> est;
   est.setInputCloud(pts);
@@ -49,7 +97,7 @@ std::vector<Signature> ourcvfh_signatures(const PointSet& cloud, const GlobalSet
   est.setNormalizeBins(s.cvfh_normalize_bins);
   est.setAxisRatio(static_cast<float>(s.ourcvfh_axis_ratio));
   est.setMinAxisValue(static_cast<float>(s.ourcvfh_min_axis_value));
-  est.setRefineClusters(static_cast<float>(s.ourcvfh_refine_clusters));
+  est.setRefineClusters(refine);
   pcl::PointCloud<pcl::VFHSignature308> sigs;
   est.compute(sigs);
 
