@@ -113,7 +113,15 @@ class CliRecognize : public ::testing::Test {
     pb::write_ply((*root_ / "models" / "obj_000001.ply").string(), obj);
     pb::Mesh cyl = box({-20, -20, -110}, {20, 20, 110});  // a tall post, never placed
     pb::write_ply((*root_ / "models" / "obj_000002.ply").string(), cyl);
+    // A well-formed model file without geometry: an empty model.
+    std::ofstream(*root_ / "models" / "obj_000003.ply")
+        << "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\n"
+           "element face 0\nproperty list uchar int vertex_indices\nend_header\n";
     std::map<int, pb::ModelInfo> models;
+    models[3].obj_id = 3;
+    models[3].name = "empty";
+    models[3].diameter = 100;  // what models_info claims; the file has no geometry
+    models[3].size = pb::Vec3(50, 50, 50);
     for (int id : {1, 2}) {
       const pb::Mesh& m = id == 1 ? obj : cyl;
       pb::ModelInfo info;
@@ -239,6 +247,12 @@ TEST_F(CliRecognize, NoPointsAndAbsentObjectExitZeroWithNoHypothesis) {
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["status"], "no_hypothesis") << r.out;
   EXPECT_EQ(j["ground_truth_instances"], 0);
+  // An empty model.
+  const CmdResult e = run(base(0, "empty") + " --method fpfh --json");
+  ASSERT_EQ(e.code, 0) << e.out;
+  const auto je = nlohmann::json::parse(e.out);
+  EXPECT_EQ(je["status"], "no_hypothesis") << e.out;
+  EXPECT_NE(je["message"].get<std::string>().find("empty model"), std::string::npos) << e.out;
 }
 
 TEST_F(CliRecognize, BadInputExitsTwoNamingTheField) {
@@ -258,6 +272,16 @@ TEST_F(CliRecognize, BadInputExitsTwoNamingTheField) {
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("bad.yaml"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("preprocess.voxel_size"), std::string::npos) << r.out;
+  // A broken model file stays an input error.
+  fs::copy_file(*root_ / "models" / "obj_000002.ply", *root_ / "models" / "obj_000002.ply.bak",
+                fs::copy_options::overwrite_existing);
+  // (Not a truncated PLY header: assimp 5.2 never returns on one.)
+  std::ofstream(*root_ / "models" / "obj_000002.ply", std::ios::trunc) << "this is not a mesh\n";
+  r = run(base(0, "post") + " --method fpfh");
+  fs::copy_file(*root_ / "models" / "obj_000002.ply.bak", *root_ / "models" / "obj_000002.ply",
+                fs::copy_options::overwrite_existing);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("obj_000002.ply"), std::string::npos) << r.out;
   r = run("recognize --dataset /nonexistent/x --scene 1 --image 0 --object 1");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("/nonexistent/x"), std::string::npos) << r.out;

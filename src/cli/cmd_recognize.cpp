@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <limits>
@@ -112,6 +113,27 @@ void write_overlay(const std::string& path, const pb::DepthImage& depth, const p
   pb::write_rgb8_png(path, w, h, rgb);
 }
 
+// True if `path` is a PLY file whose header declares zero vertices or zero
+// faces (assimp refuses such files).
+bool ply_declares_no_geometry(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  if (!std::getline(in, line) || line.rfind("ply", 0) != 0) return false;
+  long vertices = -1, faces = -1;
+  for (int n = 0; n < 200 && std::getline(in, line); ++n) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line == "end_header") return vertices == 0 || faces == 0;
+    std::istringstream ss(line);
+    std::string word, kind;
+    long count = -1;
+    if (ss >> word >> kind >> count && word == "element") {
+      if (kind == "vertex") vertices = count;
+      if (kind == "face") faces = count;
+    }
+  }
+  return false;
+}
+
 nlohmann::ordered_json times_json(const pb::StageTimes& t) {
   return {{"preprocess", t.preprocess}, {"describe", t.describe}, {"match", t.match},
           {"group", t.group},           {"initial_pose", t.initial_pose}, {"refine", t.refine},
@@ -179,7 +201,14 @@ static pb::cli::Command recognize_cmd(
         im.K.width = depth.width;
         im.K.height = depth.height;
       }
-      const pb::Mesh mesh = ds.load_model(obj_id);
+      pb::Mesh mesh;
+      try {
+        mesh = ds.load_model(obj_id);
+      } catch (const pb::InputError&) {
+        // A well-formed PLY without vertices or faces is an empty model (the
+        // result says so); a missing or broken file stays an input error.
+        if (!ply_declares_no_geometry(ds.model_path(obj_id))) throw;
+      }
       const std::string model_name = info.name.empty() ? "obj_" + pb::bop_id(obj_id) : info.name;
 
       pb::Timer train_timer;
