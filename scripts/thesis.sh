@@ -12,13 +12,14 @@
 # interruption (or after adding an experiment) does only what is missing.
 #
 # Environment: POSEBENCH (the binary, default build/posebench), JOBS (worker
-# processes, default 2). Workers run single-threaded (OMP_NUM_THREADS=1) so
-# that N jobs use N cores, and under nice.
+# processes, default 2), NICE (niceness of the runs, default 0). Workers run
+# single-threaded (OMP_NUM_THREADS=1) so that N jobs use N cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PB=${POSEBENCH:-build/posebench}
 JOBS=${JOBS:-2}
+NICE=${NICE:-0}
 ONLY=""
 README_ONLY=0
 while [ $# -gt 0 ]; do
@@ -52,7 +53,7 @@ if [ "$README_ONLY" = 0 ]; then
     selected "$e" || continue
     echo "== $e: $(date '+%F %T')" >&2
     t0=$(date +%s.%N)
-    OMP_NUM_THREADS=1 nice -n 5 "$PB" run "configs/thesis/$e.yaml" --out "$RAW/$e" --jobs "$JOBS" \
+    OMP_NUM_THREADS=1 nice -n "$NICE" "$PB" run "configs/thesis/$e.yaml" --out "$RAW/$e" --jobs "$JOBS" \
       --cache cache --scenes scenes > "$RAW/$e.run.txt" 2> "$RAW/$e.progress.txt" ||
       { echo "thesis.sh: $e failed:" >&2; tail -5 "$RAW/$e.progress.txt" >&2; exit 1; }
     cat "$RAW/$e.run.txt" >&2
