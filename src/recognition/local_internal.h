@@ -60,6 +60,11 @@ class DescriptorIndex {
   // first (ties by row index).
   void knn(const float* query, int k, float max_sq_dist,
            std::vector<std::pair<int, float>>& out) const;
+  // The same for `n` consecutive queries (row-major, n x dim); out[i] gets
+  // query i's result, identical to knn(query i). The linear scan streams the
+  // indexed rows once per block of queries (cache blocking).
+  void knn_block(const float* queries, int n, int k, float max_sq_dist,
+                 std::vector<std::pair<int, float>>* out) const;
 
  private:
   struct Impl;

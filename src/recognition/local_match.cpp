@@ -44,6 +44,57 @@ void DescriptorIndex::build(const std::vector<float>& data, int dim) {
 
 size_t DescriptorIndex::size() const { return impl_->rows; }
 
+namespace {
+
+// Squared L2 distance with eight fixed partial sums (vectorizable; the same
+// summation order every run, whatever the blocking).
+inline float sq_dist(const float* a, const float* b, size_t dim) {
+  float acc[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  size_t j = 0;
+  for (; j + 8 <= dim; j += 8)
+    for (int l = 0; l < 8; ++l) {
+      const float t = a[j + l] - b[j + l];
+      acc[l] += t * t;
+    }
+  for (; j < dim; ++j) {
+    const float t = a[j] - b[j];
+    acc[0] += t * t;
+  }
+  return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+}
+
+// Keeps the kk smallest (distance, then row) of the candidates offered, in
+// ascending order; rows arrive ascending, so equal distances keep the lower row.
+inline void offer(std::vector<std::pair<int, float>>& out, size_t kk, int row, float s) {
+  if (out.size() == kk) {
+    if (!(s < out.back().second)) return;
+    out.pop_back();
+  }
+  const std::pair<int, float> e(row, s);
+  out.insert(std::upper_bound(out.begin(), out.end(), e,
+                              [](const auto& a, const auto& b) { return a.second < b.second; }),
+             e);
+}
+
+}  // namespace
+
+void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq_dist,
+                                std::vector<std::pair<int, float>>* out) const {
+  const size_t dim = static_cast<size_t>(impl_->dim);
+  if (impl_->index || impl_->rows == 0 || k <= 0) {
+    for (int i = 0; i < n; ++i) knn(queries + static_cast<size_t>(i) * dim, k, max_sq_dist, out[i]);
+    return;
+  }
+  const size_t kk = std::min<size_t>(static_cast<size_t>(k), impl_->rows);
+  for (int i = 0; i < n; ++i) out[i].clear();
+  const float* d = impl_->data.data();
+  for (size_t r = 0; r < impl_->rows; ++r, d += dim)
+    for (int i = 0; i < n; ++i) {
+      const float s = sq_dist(queries + static_cast<size_t>(i) * dim, d, dim);
+      if (s < max_sq_dist) offer(out[i], kk, static_cast<int>(r), s);
+    }
+}
+
 void DescriptorIndex::knn(const float* query, int k, float max_sq_dist,
                           std::vector<std::pair<int, float>>& out) const {
   out.clear();
@@ -54,28 +105,8 @@ void DescriptorIndex::knn(const float* query, int k, float max_sq_dist,
     // Exact linear scan; keeps the kk best under the threshold.
     const float* d = impl_->data.data();
     for (size_t r = 0; r < impl_->rows; ++r, d += dim) {
-      // Eight fixed partial sums (vectorizable, same order every run).
-      float acc[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-      size_t j = 0;
-      for (; j + 8 <= dim; j += 8)
-        for (int l = 0; l < 8; ++l) {
-          const float t = query[j + l] - d[j + l];
-          acc[l] += t * t;
-        }
-      for (; j < dim; ++j) {
-        const float t = query[j] - d[j];
-        acc[0] += t * t;
-      }
-      const float s = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
-      if (!(s < max_sq_dist)) continue;
-      if (out.size() == kk) {
-        if (!(s < out.back().second)) continue;
-        out.pop_back();
-      }
-      const std::pair<int, float> e(static_cast<int>(r), s);
-      out.insert(std::upper_bound(out.begin(), out.end(), e,
-                                  [](const auto& a, const auto& b) { return a.second < b.second; }),
-                 e);
+      const float s = sq_dist(query, d, dim);
+      if (s < max_sq_dist) offer(out, kk, static_cast<int>(r), s);
     }
     return;
   }

@@ -211,11 +211,17 @@ class LocalMethod : public Method {
     const float thr = static_cast<float>(kind_ == Kind::Fpfh ? s.fpfh_match_threshold : s.match_threshold);
     // One result slot per scene keypoint, merged in keypoint order: the same
     // matches for any thread count.
+    // Blocks of kMatchBlock queries: each indexed row is read once per block.
+    constexpr int kMatchBlock = 32;
     std::vector<std::vector<std::pair<int, float>>> nn(sc.kp.size());
-    const long nkp = static_cast<long>(sc.kp.size());
-#pragma omp parallel for schedule(dynamic, 16) num_threads(omp_threads(s.threads)) if (nkp > 64)
-    for (long i = 0; i < nkp; ++i)
-      index_.knn(sc.desc.data() + i * dim, s.matches_per_keypoint, thr, nn[static_cast<size_t>(i)]);
+    const int nkp = static_cast<int>(sc.kp.size());
+    const int nblocks = (nkp + kMatchBlock - 1) / kMatchBlock;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(omp_threads(s.threads)) if (nblocks > 1)
+    for (int b = 0; b < nblocks; ++b) {
+      const int first = b * kMatchBlock, count = std::min(kMatchBlock, nkp - first);
+      index_.knn_block(sc.desc.data() + static_cast<size_t>(first) * dim, count, s.matches_per_keypoint, thr,
+                       nn.data() + first);
+    }
     std::vector<std::vector<Match>> per_view(views_.size());
     for (size_t i = 0; i < nn.size(); ++i)
       for (const auto& [row, d2] : nn[i]) {
