@@ -184,6 +184,8 @@ class LocalMethod : public Method {
   }
 
   std::vector<Hypothesis> hypothesize(const PointSet& scene, const std::vector<ViewData>& views,
+                                      // No random choice here: the only one, PCL's RANSAC
+                                      // inside Hough3DGrouping, uses its fixed seed.
                                       const RecognitionSettings& rs, uint64_t /*seed*/,
                                       StageTimes& times) const override {
     const LocalSettings& s = rs.local;
