@@ -162,6 +162,10 @@ TEST(MeshIo, BadFilesAreInputErrors) {
   const std::string garbage = tmp / "garbage.ply";
   std::ofstream(garbage) << "ply\nformat binary_little_endian 1.0\nelement vertex 100\nproperty float x\nend_header\nxx";
   expect_mesh_error([&] { load_mesh(garbage); }, garbage);
+  // A PLY header cut off before end_header made assimp loop forever.
+  const std::string truncated = tmp / "truncated.ply";
+  std::ofstream(truncated) << "ply\nformat ascii 1.0\nelement vertex 3\n";
+  expect_mesh_error([&] { load_mesh(truncated); }, truncated);
   const std::string lines = tmp / "lines.obj";  // vertices and a polyline, no face
   std::ofstream(lines) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2 3\n";
   expect_mesh_error([&] { load_mesh(lines); }, lines);

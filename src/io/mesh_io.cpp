@@ -2,6 +2,8 @@
 #include "io/mesh_io.h"
 
 #include <assimp/Importer.hpp>
+#include <algorithm>
+#include <cctype>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
@@ -87,6 +89,19 @@ Mesh load_mesh(const std::string& path) {
     if (!probe) throw InputError(path, "mesh", "mesh file is not readable");
   }
   if (st.st_size == 0) throw InputError(path, "mesh", "mesh file is empty");
+  {
+    // assimp loops forever on a PLY whose header never ends: check it first.
+    std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : "";
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext == ".ply") {
+      std::ifstream in(path, std::ios::binary);
+      std::string head(static_cast<size_t>(std::min<long long>(st.st_size, 1 << 16)), '\0');
+      in.read(&head[0], static_cast<std::streamsize>(head.size()));
+      if (head.compare(0, 3, "ply") != 0) throw InputError(path, "mesh", "not a PLY file (no 'ply' magic)");
+      if (head.find("end_header") == std::string::npos)
+        throw InputError(path, "mesh", "truncated PLY: the header has no 'end_header'");
+    }
+  }
 
   Assimp::Importer importer;
   // Drop point and line primitives; keep triangles only.

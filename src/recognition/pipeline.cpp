@@ -64,6 +64,11 @@ class TrainedModel {
     return model_frame[static_cast<size_t>(view)];
   }
 
+  // The cloud verification counts inliers on (VerifySettings::inlier_model).
+  const PointSet& verify_cloud(int view, const VerifySettings& v) const {
+    return v.inlier_model == "merged" ? merged : model_cloud(view);
+  }
+
   void derive_model_frame() {
     model_frame.clear();
     PointSet all;
@@ -472,7 +477,8 @@ RecognitionResult recognize(const DepthImage& depth, const Intrinsics& K, const 
 #pragma omp parallel for schedule(dynamic, 1)
   for (long i = 0; i < nh; ++i) {
     Hypothesis& h = hyps[static_cast<size_t>(i)];
-    h.inliers = count_inliers(model.model_cloud(h.view).points, h.T_cam_model, index, s.verify.inlier_threshold_mm);
+    h.inliers = count_inliers(model.verify_cloud(h.view, s.verify).points, h.T_cam_model, index,
+                              s.verify.inlier_threshold_mm);
   }
   // Most inliers first; ties by score, then view index, then the method's order.
   std::vector<size_t> order(hyps.size());
@@ -489,7 +495,7 @@ RecognitionResult recognize(const DepthImage& depth, const Intrinsics& K, const 
   res.times.verify = timer.seconds();
 
   const Hypothesis& best = res.hypotheses.front();
-  const size_t model_points = model.model_cloud(best.view).size();
+  const size_t model_points = model.verify_cloud(best.view, s.verify).size();
   if (best.inliers < 1) {
     res.message = "no hypothesis has an inlier within " + std::to_string(s.verify.inlier_threshold_mm) + " mm";
     return res;
@@ -564,7 +570,8 @@ RecognitionResult refine_from(const DepthImage& depth, const Intrinsics& K, cons
   res.times.refine = timer.seconds();
   timer.reset();
   const PointIndex index(scene.points);
-  h.inliers = count_inliers(model.model_cloud(h.view).points, h.T_cam_model, index, s.verify.inlier_threshold_mm);
+  h.inliers = count_inliers(model.verify_cloud(h.view, s.verify).points, h.T_cam_model, index,
+                            s.verify.inlier_threshold_mm);
   res.times.verify = timer.seconds();
   res.hypotheses.push_back(h);
   res.status = "ok";

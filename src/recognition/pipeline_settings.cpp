@@ -165,7 +165,8 @@ nlohmann::ordered_json settings_json(const RecognitionSettings& s) {
                  {"crop_margin_mm", r.crop_margin_mm},
                  {"normal_neighbours", r.normal_neighbours}};
   j["verify"] = {{"inlier_threshold_mm", s.verify.inlier_threshold_mm},
-                 {"min_inlier_fraction", s.verify.min_inlier_fraction}};
+                 {"min_inlier_fraction", s.verify.min_inlier_fraction},
+                 {"inlier_model", s.verify.inlier_model}};
   j["seed"] = s.seed;
   return j;
 }

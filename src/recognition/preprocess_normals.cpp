@@ -15,6 +15,17 @@
 
 #include "recognition/preprocess_internal.h"
 
+#include <pcl/console/print.h>
+
+namespace {
+// PCL's warnings (OUR-CVFH's "both axes are equally easy/difficult to
+// disambiguate", CVFH's "no clusters were found", PPF's degenerate pairs)
+// would flood stderr and the runner's worker log; errors still print.
+struct QuietPcl {
+  QuietPcl() { pcl::console::setVerbosityLevel(pcl::console::L_ERROR); }
+} quiet_pcl;
+}  // namespace
+
 namespace pb::detail {
 
 void estimate_normals(PointSet& ps, double radius_mm) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "core/types.h"
@@ -17,6 +18,12 @@ struct VerifySettings {
   // model points are inliers (0 = the thesis: the most inliers wins, as long
   // as it has one); below it the result is "no_hypothesis".
   double min_inlier_fraction = 0.0;
+  // Which model cloud the inliers are counted on. "view" (the thesis): the
+  // training view the hypothesis came from, so hypotheses from views with
+  // more points have an edge. "merged": every view merged in the model frame
+  // (voxelized), the same cloud for every hypothesis, so counts compare
+  // fairly across views (a flipped pose from a larger view no longer wins).
+  std::string inlier_model = "view";
 };
 
 void parse_verify(const YamlNode& node, VerifySettings& s);
