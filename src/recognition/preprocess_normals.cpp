@@ -18,11 +18,12 @@
 #include <pcl/console/print.h>
 
 namespace {
-// PCL's warnings (OUR-CVFH's "both axes are equally easy/difficult to
-// disambiguate", CVFH's "no clusters were found", PPF's degenerate pairs)
-// would flood stderr and the runner's worker log; errors still print.
+// PCL's messages (OUR-CVFH's "both axes are equally easy/difficult to
+// disambiguate", CVFH's "no clusters were found", the RANSAC inside Hough
+// grouping's "no samples could be selected") would flood stderr and the
+// runner's worker log. Every PCL result is checked by its caller instead.
 struct QuietPcl {
-  QuietPcl() { pcl::console::setVerbosityLevel(pcl::console::L_ERROR); }
+  QuietPcl() { pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS); }
 } quiet_pcl;
 }  // namespace
 
