@@ -155,6 +155,7 @@ TEST_F(RunTest, DatasetThatIsNotBopIsExit2) {
   auto r = pbcli::run("run bad.yaml --out rb " + common(), tmp.path);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("notbop"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(tmp.path + "/rb")) << "a failed run must not leave a results folder";
 }
 
 TEST_F(RunTest, ReportOnAFolderWithoutRecordsIsExit2) {

@@ -182,10 +182,12 @@ RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
   RunSummary sum;
   Timer timer;
   const std::string out = opt.out_dir.empty() ? "results/" + cfg.name : opt.out_dir;
-  // Guard the folder before doing anything expensive.
-  ResultStore store(out, cfg.canonical, cfg.hash);
+  // Guard the folder before doing anything expensive, but create it only
+  // once the scenes and trials are known to be valid.
+  ResultStore::check(out, cfg.hash);
   prepare_scenes(cfg, opt);
   const std::vector<Trial> trials = expand_trials(cfg);
+  ResultStore store(out, cfg.canonical, cfg.hash);
   sum.total = trials.size();
 
   std::deque<long> pending;

@@ -53,8 +53,7 @@ std::vector<nlohmann::json> ResultStore::read_records(const std::string& dir) {
   return parse_records(path, &valid);
 }
 
-ResultStore::ResultStore(const std::string& dir, const nlohmann::json& experiment, const std::string& hash)
-    : dir_(dir) {
+void ResultStore::check(const std::string& dir, const std::string& hash) {
   const fs::path exp_path = fs::path(dir) / "experiment.json";
   if (fs::exists(exp_path)) {
     std::ifstream in(exp_path);
@@ -74,6 +73,12 @@ ResultStore::ResultStore(const std::string& dir, const nlohmann::json& experimen
     throw InputError((fs::path(dir) / "records.jsonl").string(), "",
                      "records without experiment.json: not a folder of this experiment");
   }
+}
+
+ResultStore::ResultStore(const std::string& dir, const nlohmann::json& experiment, const std::string& hash)
+    : dir_(dir) {
+  check(dir, hash);
+  const fs::path exp_path = fs::path(dir) / "experiment.json";
   fs::create_directories(dir);
   if (!fs::exists(exp_path)) {
     nlohmann::json e = experiment;

@@ -20,6 +20,10 @@ class ResultStore {
   // throws InputError naming it and leaves everything untouched.
   ResultStore(const std::string& dir, const nlohmann::json& experiment, const std::string& hash);
 
+  // The guard alone, read-only: throws the same InputError as the
+  // constructor if DIR belongs to another experiment; creates nothing.
+  static void check(const std::string& dir, const std::string& hash);
+
   bool has(const std::string& key) const;
   size_t size() const { return records_.size(); }
   void append(const nlohmann::json& record);  // thread-safe; durable on return
