@@ -1,5 +1,7 @@
 #include "core/yaml.h"
 
+#include <cerrno>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
@@ -105,6 +107,32 @@ double YamlNode::get_nonnegative(const std::string& key, double fallback) const 
   const double v = get_or<double>(key, fallback);
   if (!(v >= 0)) (*this)[key].fail("must be non-negative, got " + std::to_string(v));
   return v;
+}
+
+nlohmann::json yaml_to_json(const YAML::Node& n) {
+  if (n.IsMap()) {
+    nlohmann::json j = nlohmann::json::object();
+    for (const auto& kv : n) j[kv.first.as<std::string>()] = yaml_to_json(kv.second);
+    return j;
+  }
+  if (n.IsSequence()) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const auto& e : n) j.push_back(yaml_to_json(e));
+    return j;
+  }
+  if (!n.IsDefined() || n.IsNull()) return nullptr;
+  const std::string s = n.Scalar();
+  if (n.Tag() == "!") return s;  // quoted
+  if (s == "true" || s == "True" || s == "TRUE") return true;
+  if (s == "false" || s == "False" || s == "FALSE") return false;
+  if (s.empty()) return s;
+  char* end = nullptr;
+  errno = 0;
+  const long long iv = std::strtoll(s.c_str(), &end, 10);
+  if (*end == '\0' && errno == 0) return iv;
+  const double dv = std::strtod(s.c_str(), &end);
+  if (*end == '\0') return dv;
+  return s;
 }
 
 }  // namespace pb

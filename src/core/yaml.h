@@ -3,6 +3,7 @@
 // InputError (exit code 2).
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>
 
 #include <set>
@@ -65,5 +66,11 @@ class YamlNode {
   YAML::Node node_;
   std::string file_, path_;
 };
+
+// YAML -> JSON, the project's one conversion. Scalars are typed as YAML 1.2's
+// core schema reads them: true/false (also True, TRUE, False, FALSE), null
+// (~, null, empty), integers, floats; anything else, and every quoted
+// scalar, is a string. Maps keep their keys, sequences their order.
+nlohmann::json yaml_to_json(const YAML::Node& node);
 
 }  // namespace pb
