@@ -13,7 +13,7 @@
 #include "../tests/test_recognition_refine_scenes.h"
 #include "recognition/method.h"
 #include "recognition/pipeline.h"
-#include "recognition/refine.h"
+#include "recognition/refine/refine.h"
 
 namespace pb {
 namespace {

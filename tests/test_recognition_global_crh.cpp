@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "recognition/global_internal.h"
+#include "recognition/global/internal.h"
 #include "test_recognition_global_util.h"
 
 namespace pb {

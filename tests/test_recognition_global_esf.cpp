@@ -9,8 +9,8 @@
 #include <thread>
 
 #include "core/random.h"
-#include "recognition/global_esf.h"
-#include "recognition/global_internal.h"
+#include "recognition/global/esf.h"
+#include "recognition/global/internal.h"
 
 namespace pb {
 namespace {

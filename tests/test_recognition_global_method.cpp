@@ -7,7 +7,7 @@
 #include <thread>
 
 #include "core/error.h"
-#include "recognition/global_internal.h"
+#include "recognition/global/internal.h"
 #include "test_recognition_global_data.h"
 #include "test_recognition_global_util.h"
 

@@ -12,8 +12,8 @@
 #include <map>
 
 #include "core/timer.h"
-#include "recognition/refine.h"
-#include "recognition/verify.h"
+#include "recognition/refine/refine.h"
+#include "recognition/verify/verify.h"
 #include "test_recognition_global_util.h"
 
 namespace pb {

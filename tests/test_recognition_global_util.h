@@ -11,7 +11,7 @@
 #include "models/procedural.h"
 #include "recognition/method.h"
 #include "recognition/pipeline.h"
-#include "recognition/preprocess.h"
+#include "recognition/preprocess/preprocess.h"
 #include "render/renderer.h"
 #include "scenes/views.h"
 

@@ -12,8 +12,8 @@
 #include "core/random.h"
 #include "core/rotation.h"
 #include "core/yaml.h"
-#include "recognition/local.h"
-#include "recognition/local_internal.h"
+#include "recognition/local/local.h"
+#include "recognition/local/internal.h"
 #include "recognition/method.h"
 #include "recognition/pipeline.h"
 

@@ -5,9 +5,9 @@
 
 #include <cstring>
 
-#include "recognition/preprocess.h"
-#include "recognition/preprocess_internal.h"
-#include "recognition/verify.h"
+#include "recognition/preprocess/preprocess.h"
+#include "recognition/preprocess/internal.h"
+#include "recognition/verify/verify.h"
 #include "test_recognition_pipeline_util.h"
 
 namespace {

@@ -13,7 +13,7 @@
 
 #include "core/error.h"
 #include "core/yaml.h"
-#include "recognition/refine.h"
+#include "recognition/refine/refine.h"
 #include "test_recognition_refine_scenes.h"
 
 namespace pb {

@@ -19,7 +19,7 @@
 #include "core/types.h"
 #include "models/procedural.h"
 #include "recognition/cloud.h"
-#include "recognition/preprocess.h"
+#include "recognition/preprocess/preprocess.h"
 #include "render/renderer.h"
 
 namespace pb {

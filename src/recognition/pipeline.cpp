@@ -23,8 +23,8 @@
 #include "core/random.h"
 #include "core/timer.h"
 #include "recognition/method.h"
-#include "recognition/pipeline_internal.h"
-#include "recognition/preprocess_internal.h"
+#include "recognition/settings_internal.h"
+#include "recognition/preprocess/internal.h"
 
 namespace pb {
 

@@ -14,12 +14,12 @@
 #include "core/types.h"
 #include "core/yaml.h"
 #include "recognition/cloud.h"
-#include "recognition/global.h"
-#include "recognition/local.h"
-#include "recognition/ppf.h"
-#include "recognition/preprocess.h"
-#include "recognition/refine.h"
-#include "recognition/verify.h"
+#include "recognition/global/global.h"
+#include "recognition/local/local.h"
+#include "recognition/ppf/ppf.h"
+#include "recognition/preprocess/preprocess.h"
+#include "recognition/refine/refine.h"
+#include "recognition/verify/verify.h"
 #include "scenes/views.h"
 
 namespace pb {

@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "recognition/global_internal.h"
+#include "recognition/global/internal.h"
 
 namespace pb::global {
 

@@ -1,7 +1,7 @@
 // parse_ppf: the `ppf:` YAML section (PpfSettings, ppf.h). Kept apart from
 // ppf_method.cpp so that settings parsing compiles without PCL.
 #include "core/error.h"
-#include "recognition/ppf.h"
+#include "recognition/ppf/ppf.h"
 
 namespace pb {
 

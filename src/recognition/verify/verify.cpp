@@ -1,6 +1,6 @@
 // Verification (thesis 3.1): inliers are model points whose nearest scene
 // point lies within a threshold. PointIndex wraps pcl::KdTreeFLANN.
-#include "recognition/verify.h"
+#include "recognition/verify/verify.h"
 
 #include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_cloud.h>

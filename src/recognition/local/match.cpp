@@ -11,7 +11,7 @@
 
 #include <algorithm>
 
-#include "recognition/local_internal.h"
+#include "recognition/local/internal.h"
 
 namespace pb::local {
 

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "core/types.h"
-#include "recognition/refine.h"
+#include "recognition/refine/refine.h"
 
 namespace pb {
 namespace refine_detail {

@@ -4,7 +4,7 @@
 // pcl::SACSegmentation) so that each output point keeps its source pixel and
 // every random choice draws from pb::Rng; normals go through PCL
 // (preprocess_normals.cpp).
-#include "recognition/preprocess.h"
+#include "recognition/preprocess/preprocess.h"
 
 #include <algorithm>
 #include <cmath>
@@ -17,7 +17,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "core/random.h"
-#include "recognition/preprocess_internal.h"
+#include "recognition/preprocess/internal.h"
 
 namespace pb {
 

@@ -11,7 +11,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "recognition/refine_internal.h"
+#include "recognition/refine/internal.h"
 
 namespace pb {
 namespace refine_detail {

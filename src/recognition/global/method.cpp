@@ -27,8 +27,8 @@
 #include "core/error.h"
 #include "core/random.h"
 #include "core/timer.h"
-#include "recognition/global_esf.h"
-#include "recognition/global_internal.h"
+#include "recognition/global/esf.h"
+#include "recognition/global/internal.h"
 #include "recognition/method.h"
 #include "recognition/pipeline.h"
 

@@ -13,7 +13,7 @@
 #include <omp.h>
 #endif
 
-#include "recognition/preprocess_internal.h"
+#include "recognition/preprocess/internal.h"
 
 #include <pcl/console/print.h>
 

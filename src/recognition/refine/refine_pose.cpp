@@ -11,8 +11,8 @@
 #include <limits>
 
 #include "core/error.h"
-#include "recognition/refine.h"
-#include "recognition/refine_internal.h"
+#include "recognition/refine/refine.h"
+#include "recognition/refine/internal.h"
 
 namespace pb {
 

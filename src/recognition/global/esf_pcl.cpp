@@ -4,7 +4,7 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
-#include "recognition/global_internal.h"
+#include "recognition/global/internal.h"
 
 namespace pb::global {
 

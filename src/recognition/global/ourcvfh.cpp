@@ -10,7 +10,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "recognition/global_internal.h"
+#include "recognition/global/internal.h"
 
 namespace pb::global {
 

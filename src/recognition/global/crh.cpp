@@ -9,7 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "recognition/global_internal.h"
+#include "recognition/global/internal.h"
 
 namespace pb::global {
 

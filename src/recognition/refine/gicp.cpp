@@ -9,7 +9,7 @@
 
 #include <cmath>
 
-#include "recognition/refine_internal.h"
+#include "recognition/refine/internal.h"
 
 namespace pb {
 namespace refine_detail {

@@ -9,7 +9,7 @@
 
 #include <limits>
 
-#include "recognition/local_internal.h"
+#include "recognition/local/internal.h"
 
 namespace pb::local {
 

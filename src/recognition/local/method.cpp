@@ -16,8 +16,8 @@
 #include <string>
 
 #include "core/timer.h"
-#include "recognition/local.h"
-#include "recognition/local_internal.h"
+#include "recognition/local/local.h"
+#include "recognition/local/internal.h"
 #include "recognition/method.h"
 #include "recognition/pipeline.h"
 

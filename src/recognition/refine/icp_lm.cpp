@@ -1,51 +1,34 @@
-// ICP point-to-point (pcl::IterativeClosestPoint, SVD per iteration), on an
-// optional random subset of the source points (thesis: "random subset of
-// source points"), drawn from pb::Rng. Frame and units: refine_internal.h.
+// ICP with Levenberg-Marquardt (pcl::IterativeClosestPointNonLinear: the
+// point-to-point error minimised by LM over a 6-DoF warp instead of the
+// closed-form SVD). Frame and units: refine_internal.h.
 #include <pcl/point_types.h>
-#include <pcl/registration/icp.h>
+#include <pcl/registration/icp_nl.h>
 
-#include <algorithm>
 #include <cmath>
-#include <numeric>
 
-#include "core/random.h"
-#include "recognition/refine_internal.h"
+#include "recognition/refine/internal.h"
 
 namespace pb {
 namespace refine_detail {
 
 namespace {
 
-// Exposes the iteration count (protected in PCL).
-class Icp : public pcl::IterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> {
+class IcpLm : public pcl::IterativeClosestPointNonLinear<pcl::PointXYZ, pcl::PointXYZ> {
  public:
   int iterations() const { return nr_iterations_; }
 };
 
 }  // namespace
 
-Outcome run_icp(const Problem& p, const RefineSettings& s, uint64_t seed) {
+Outcome run_icp_lm(const Problem& p, const RefineSettings& s) {
   using Cloud = pcl::PointCloud<pcl::PointXYZ>;
-  // Source subset: the first k of a seeded Fisher-Yates shuffle, in index order.
-  std::vector<size_t> idx(p.src.size());
-  std::iota(idx.begin(), idx.end(), size_t(0));
-  if (s.icp_sample_points > 0 && static_cast<size_t>(s.icp_sample_points) < idx.size()) {
-    Rng rng(seed);
-    const size_t k = static_cast<size_t>(s.icp_sample_points);
-    for (size_t i = 0; i < k; ++i) {
-      const size_t j = i + static_cast<size_t>(rng.uniform_int(0, static_cast<int>(idx.size() - i - 1)));
-      std::swap(idx[i], idx[j]);
-    }
-    idx.resize(k);
-    std::sort(idx.begin(), idx.end());
-  }
   Cloud::Ptr src(new Cloud), tgt(new Cloud), out(new Cloud);
-  src->resize(idx.size());
-  for (size_t i = 0; i < idx.size(); ++i) (*src)[i].getVector3fMap() = p.src[idx[i]];
+  src->resize(p.src.size());
+  for (size_t i = 0; i < p.src.size(); ++i) (*src)[i].getVector3fMap() = p.src[i];
   tgt->resize(p.tgt.size());
   for (size_t i = 0; i < p.tgt.size(); ++i) (*tgt)[i].getVector3fMap() = p.tgt[i];
 
-  Icp icp;
+  IcpLm icp;
   icp.setInputSource(src);
   icp.setInputTarget(tgt);
   icp.setMaximumIterations(s.max_iterations);

@@ -1,7 +1,7 @@
 // The `global:` YAML section (GlobalSettings, global.h).
 #include <string>
 
-#include "recognition/global.h"
+#include "recognition/global/global.h"
 
 namespace pb {
 

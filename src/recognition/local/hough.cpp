@@ -14,7 +14,7 @@
 #include <limits>
 #include <set>
 
-#include "recognition/local_internal.h"
+#include "recognition/local/internal.h"
 
 namespace pb::local {
 

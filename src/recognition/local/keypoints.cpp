@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "recognition/local_internal.h"
+#include "recognition/local/internal.h"
 
 namespace pb::local {
 

@@ -9,7 +9,7 @@
 
 #include "core/types.h"
 #include "recognition/cloud.h"
-#include "recognition/global.h"
+#include "recognition/global/global.h"
 
 namespace pb::global {
 

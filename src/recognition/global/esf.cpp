@@ -1,6 +1,6 @@
 // Our ESF (see global_esf.h). No global state: the occupancy grid and every
 // histogram live on this call's stack/heap, randomness comes from `rng`.
-#include "recognition/global_esf.h"
+#include "recognition/global/esf.h"
 
 #include <algorithm>
 #include <array>

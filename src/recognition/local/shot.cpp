@@ -10,7 +10,7 @@
 
 #include <limits>
 
-#include "recognition/local_internal.h"
+#include "recognition/local/internal.h"
 
 namespace pb::local {
 

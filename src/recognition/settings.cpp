@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "recognition/pipeline.h"
-#include "recognition/pipeline_internal.h"
+#include "recognition/settings_internal.h"
 
 namespace pb {
 
