@@ -1,20 +1,18 @@
-// Internal interface between the pipeline (pipeline.cpp) and the descriptor
-// methods. PCL-free: implementations convert inside their .cpp files.
-// Methods are created by name through make_method (registry in
-// pipeline.cpp); each descriptor's factory is declared here.
+// The descriptor methods' interface, between the pipeline (pipeline.cpp,
+// training.cpp) and the stage folders local/, global/, ppf/. PCL-free:
+// implementations convert inside their .cpp files. A method is built by
+// name through the registry (registry.h) with only its own settings section.
 #pragma once
 
-#include <iosfwd>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "core/binary_io.h"
 #include "core/types.h"
 #include "recognition/cloud.h"
 
 namespace pb {
-
-struct RecognitionSettings;
 
 // One preprocessed training view, in its own camera frame.
 struct ViewData {
@@ -27,27 +25,31 @@ class Method {
   virtual ~Method() = default;
   virtual std::string name() const = 0;
   // Offline: describe the training views; keep what hypothesize needs.
-  virtual void train(const std::vector<ViewData>& views, const RecognitionSettings& s) = 0;
-  // Binary (de)serialization of the trained state for the on-disk cache.
-  virtual void save(std::ostream& out) const = 0;
-  virtual void load(std::istream& in) = 0;
+  // Random choices draw from `seed` (the settings' seed).
+  virtual void train(const std::vector<ViewData>& views, uint64_t seed) = 0;
+  // The trained state for the on-disk cache; load throws BinaryError (or
+  // InputError) on anything it cannot read back exactly.
+  virtual void save(BinaryWriter& out) const = 0;
+  virtual void load(BinaryReader& in) = 0;
   // Online: preprocessed scene (plane removed, normals) -> hypotheses of
   // T_cam_model, best first (Hypothesis::view set). Fills times.describe,
   // match, group, initial_pose. Must be const and thread-safe; random
   // choices draw from `seed`.
   virtual std::vector<Hypothesis> hypothesize(const PointSet& scene, const std::vector<ViewData>& views,
-                                              const RecognitionSettings& s, uint64_t seed,
-                                              StageTimes& times) const = 0;
+                                              uint64_t seed, StageTimes& times) const = 0;
 };
 
-std::unique_ptr<Method> make_method(const std::string& name);  // InputError for unknown names
+struct LocalSettings;
+struct GlobalSettings;
+struct PpfSettings;
 
-std::unique_ptr<Method> make_fpfh_method();
-std::unique_ptr<Method> make_shot_method();
-std::unique_ptr<Method> make_cvfh_method();
-std::unique_ptr<Method> make_esf_method();
-std::unique_ptr<Method> make_cesf_method();
-std::unique_ptr<Method> make_ourcvfh_method();
-std::unique_ptr<Method> make_ppf_method();
+// The factories the registry (registry.cpp) lists; each gets its section.
+std::unique_ptr<Method> make_fpfh_method(const LocalSettings& s);
+std::unique_ptr<Method> make_shot_method(const LocalSettings& s);
+std::unique_ptr<Method> make_cvfh_method(const GlobalSettings& s);
+std::unique_ptr<Method> make_esf_method(const GlobalSettings& s);
+std::unique_ptr<Method> make_cesf_method(const GlobalSettings& s);
+std::unique_ptr<Method> make_ourcvfh_method(const GlobalSettings& s);
+std::unique_ptr<Method> make_ppf_method(const PpfSettings& s);
 
 }  // namespace pb

@@ -1,10 +1,12 @@
-// recognize(scene, model, settings) -> Result: the one call per image that
-// every descriptor x refinement combination goes through. PCL-free header.
-//
-// Stage settings live in their stage headers (preprocess.h, local.h,
-// global.h, ppf.h, refine.h, verify.h); each is one struct whose defaults are
-// the thesis's values, mirrored one to one by a YAML section of the same
-// name (see parse_recognition_settings).
+// The recognition pipeline, top of the data path (PCL-free header):
+//   train_model   training views (rendered by the caller, scenes/views.h)
+//                 -> preprocess/ -> the descriptor method (local/, global/,
+//                 ppf/) -> a trained model, cached on disk;
+//   recognize     depth image -> preprocess/ -> method hypotheses -> refine/
+//                 -> verify/ -> the best pose;
+//   refine_from   registration alone from a given initial pose.
+// Methods are selected by name (registry.h); settings.h has one settings
+// struct per stage, each mirrored by a YAML section.
 #pragma once
 
 #include <memory>
@@ -12,52 +14,23 @@
 #include <vector>
 
 #include "core/types.h"
-#include "core/yaml.h"
 #include "recognition/cloud.h"
-#include "recognition/global/global.h"
-#include "recognition/local/local.h"
-#include "recognition/ppf/ppf.h"
-#include "recognition/preprocess/preprocess.h"
-#include "recognition/refine/refine.h"
-#include "recognition/verify/verify.h"
-#include "scenes/views.h"
+#include "recognition/settings.h"
 
 namespace pb {
 
-struct RecognitionSettings {
-  std::string descriptor = "fpfh";   // fpfh shot cvfh esf cesf ourcvfh ppf
-  std::string refinement = "icp";    // none icp icp_lm icp_plane gicp ndt
-  ViewSettings views;                // training views of the model
-  PreprocessSettings preprocess;
-  LocalSettings local;
-  GlobalSettings global;
-  PpfSettings ppf;
-  RefineSettings refine;
-  VerifySettings verify;
-  uint64_t seed = 1;                 // seeds every random choice of the call
-};
-
-// Reads the YAML sections (descriptor, refinement, views, preprocess, local,
-// global, ppf, refine, verify, seed) over `base`; unknown keys are errors.
-RecognitionSettings parse_recognition_settings(const YamlNode& node, RecognitionSettings base = {});
-// Every field, for the trial records and the cache key.
-std::string settings_to_json(const RecognitionSettings& s);
-
-std::vector<std::string> descriptor_names();
-std::vector<std::string> refinement_names();
-
 // A model trained for one descriptor: its preprocessed, described training
-// views. Opaque; built by train_model, cached on disk.
+// views. Opaque; built by train_model.
 class TrainedModel;
 
 struct TrainOptions {
-  std::string cache_dir;   // "" = no cache; else DIR/<key>.bin, key = hash of
-                           // model mesh, views and every training setting
-  std::string model_name;  // for messages and the cache key
+  std::string cache_dir;   // "" = no cache; else DIR/<model>-<descriptor>-<key>.bin, key = FNV-1a of the
+                           // training views (as data) and the settings training reads
 };
-std::shared_ptr<const TrainedModel> train_model(const Mesh& mesh, const RecognitionSettings& s,
-                                                const TrainOptions& opt = {},
-                                                bool* from_cache = nullptr);
+// Never throws for empty input: a model without views is empty (recognize
+// then answers no_hypothesis with the reason).
+std::shared_ptr<const TrainedModel> train_model(const TrainingViews& views, const RecognitionSettings& s,
+                                                const TrainOptions& opt = {}, bool* from_cache = nullptr);
 
 // What a trained model holds (for messages, tests and benchmarks).
 struct TrainedModelInfo {
@@ -85,5 +58,14 @@ struct RecognitionResult {
 // object-free scenes: status says "no_hypothesis" with a message.
 RecognitionResult recognize(const DepthImage& depth, const Intrinsics& K, const TrainedModel& model,
                             const RecognitionSettings& s);
+
+// Registration alone (THESIS.md Table 4.9, Figure 4.12): skip description
+// and matching, refine `init` (T_cam_model) with the configured refinement
+// method, verify and accept it as recognize() does (status no_hypothesis
+// when it has no inlier). The model view used as the registration source is
+// the training view whose viewing direction is closest to the one `init`
+// implies.
+RecognitionResult refine_from(const DepthImage& depth, const Intrinsics& K, const TrainedModel& model,
+                              const RecognitionSettings& s, const Pose& init);
 
 }  // namespace pb

@@ -72,4 +72,17 @@ std::vector<TrainingView> render_training_views(const Mesh& mesh, const ViewSett
   return views;
 }
 
+TrainingViews training_views(const Mesh& mesh, const ViewSettings& settings, const std::string& model_name) {
+  TrainingViews t;
+  t.model_name = model_name;
+  if (mesh.empty()) {
+    t.empty_reason = "model '" + model_name + "' has no triangles";
+  } else if (!(mesh.bounds().diagonal().norm() > 0) || !mesh.bounds().diagonal().allFinite()) {
+    t.empty_reason = "model '" + model_name + "' is degenerate (zero or non-finite extent)";
+  } else {
+    t.views = render_training_views(mesh, settings);
+  }
+  return t;
+}
+
 }  // namespace pb

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/settings_fields.h"
 #include "core/types.h"
 
 namespace pb {
@@ -21,13 +22,20 @@ struct ViewSettings {
   double distance_factor = 3.0;  // camera distance = factor * bounding-box diagonal (>= diameter)
   int resolution = 256;          // square image, pixels
   double fov_deg = 30.0;         // field of view, degrees
-};
 
-struct TrainingView {
-  Intrinsics K;
-  DepthImage depth;       // mm, 0 where the model is not
-  OrganizedCloud cloud;   // from depth, camera frame
-  Pose T_cam_model;       // model -> this view's camera
+  template <class S, class F>
+  static void fields(S& s, F& f) {
+    f("views", s.views, fields::at_least(1));
+    f("elevation_deg", s.elevation_deg, fields::in_range(-90, 90));
+    f("side_elevation_deg", s.side_elevation_deg, fields::in_range(-90, 90));
+    f("below_elevation_deg", s.below_elevation_deg, fields::in_range(-90, 90));
+    f("distance_factor", s.distance_factor, fields::positive());
+    f("resolution", s.resolution, fields::in_range(8, 4096));
+    f("fov_deg", s.fov_deg, fields::positive());
+  }
+  void validate(const YamlNode& node) const {
+    if (fov_deg >= 170) node["fov_deg"].fail("must be below 170");
+  }
 };
 
 // Unit directions from the model origin to each camera (model frame, z up),
@@ -35,5 +43,9 @@ struct TrainingView {
 std::vector<Vec3> view_directions(const ViewSettings& settings);
 
 std::vector<TrainingView> render_training_views(const Mesh& mesh, const ViewSettings& settings);
+
+// The training views recognition learns from (train_model): rendered, or
+// none with the reason when the mesh is empty or degenerate.
+TrainingViews training_views(const Mesh& mesh, const ViewSettings& settings, const std::string& model_name);
 
 }  // namespace pb

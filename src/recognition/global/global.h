@@ -2,7 +2,7 @@
 // "Global pipeline".
 #pragma once
 
-#include "core/yaml.h"
+#include "core/settings_fields.h"
 
 namespace pb {
 
@@ -16,7 +16,6 @@ struct GlobalSettings {
   int cvfh_min_region_points = 20;      // "sufficiently large" stable region (also CESF)
   int esf_samples = 20000;              // ESF random triples (PCL's value)
   int top_k = 5;                        // hypotheses passed to refinement (thesis: 5)
-  int crh_bins = 90;                    // CRH bins (4 degrees)
   double crh_peak_threshold = 0.3;      // distinct CRH peaks above this fraction of the max
   int crh_max_peaks = 3;                // at most this many roll hypotheses per match
   bool skip_crh = false;                // assume the object upright: roll from the view (Table 4.4)
@@ -27,8 +26,30 @@ struct GlobalSettings {
   double ourcvfh_axis_ratio = 0.8;      // OUR-CVFH: axes this similarly hard to disambiguate -> several frames
   double ourcvfh_min_axis_value = 0.925;  // OUR-CVFH: above this, all 4 axis combinations are kept
   double ourcvfh_refine_clusters = 1.0; // OUR-CVFH: region points within this x eps angle of the mean normal
-};
+  // (CRH has 90 bins of 4 degrees: pcl::CRHEstimation's fixed size.)
 
-void parse_global(const YamlNode& node, GlobalSettings& s);
+  template <class S, class F>
+  static void fields(S& s, F& f) {
+    f("cluster_tolerance_mm", s.cluster_tolerance_mm, fields::positive());
+    f("cluster_min_points", s.cluster_min_points, fields::at_least(1));
+    f("cluster_max_points", s.cluster_max_points, fields::at_least(1));
+    f("cvfh_eps_angle_deg", s.cvfh_eps_angle_deg, fields::positive(180, " degrees"));
+    f("cvfh_curvature_threshold", s.cvfh_curvature_threshold, fields::positive());
+    f("cvfh_cluster_tolerance_mm", s.cvfh_cluster_tolerance_mm, fields::positive());
+    f("cvfh_min_region_points", s.cvfh_min_region_points, fields::at_least(3));
+    f("esf_samples", s.esf_samples, fields::at_least(1));
+    f("top_k", s.top_k, fields::at_least(1));
+    f("crh_peak_threshold", s.crh_peak_threshold, fields::in_range(0, 1));
+    f("crh_max_peaks", s.crh_max_peaks, fields::at_least(1));
+    f("skip_crh", s.skip_crh);
+    f("cvfh_normal_radius_mm", s.cvfh_normal_radius_mm, fields::positive());
+    f("cvfh_normalize_bins", s.cvfh_normalize_bins);
+    f("crh_peak_distance_deg", s.crh_peak_distance_deg, fields::nonnegative(180, " degrees"));
+    f("ourcvfh_axis_ratio", s.ourcvfh_axis_ratio, fields::positive(1));
+    f("ourcvfh_min_axis_value", s.ourcvfh_min_axis_value, fields::positive(1));
+    f("ourcvfh_refine_clusters", s.ourcvfh_refine_clusters, fields::positive());
+  }
+  void validate(const YamlNode& node) const;  // cluster_max_points >= cluster_min_points
+};
 
 }  // namespace pb

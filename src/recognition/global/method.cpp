@@ -1,6 +1,6 @@
 // The global pipeline's methods (cvfh, esf, cesf, ourcvfh): training,
 // matching and initial pose. PCL-free; the PCL parts are behind
-// global_internal.h.
+// internal.h.
 //
 // Online, per image (THESIS.md "Global pipeline"):
 //  1. describe: Euclidean clusters of the preprocessed scene, then the
@@ -20,8 +20,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <istream>
-#include <ostream>
 #include <tuple>
 
 #include "core/error.h"
@@ -30,7 +28,6 @@
 #include "recognition/global/esf.h"
 #include "recognition/global/internal.h"
 #include "recognition/method.h"
-#include "recognition/pipeline.h"
 
 namespace pb {
 namespace global {
@@ -131,65 +128,20 @@ Mat3 nearest_rotation(const Mat3& M) {
   return U * V.transpose();
 }
 
-// --- binary (de)serialization helpers ---
-template <typename T>
-void put(std::ostream& o, const T& v) {
-  o.write(reinterpret_cast<const char*>(&v), sizeof(T));
-}
-template <typename T>
-T take(std::istream& in) {
-  T v{};
-  in.read(reinterpret_cast<char*>(&v), sizeof(T));
-  if (!in) throw InputError("", "cache", "truncated global descriptor state");
-  return v;
-}
-void put_floats(std::ostream& o, const std::vector<float>& v) {
-  put<uint32_t>(o, static_cast<uint32_t>(v.size()));
-  if (!v.empty()) o.write(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(float));
-}
-std::vector<float> take_floats(std::istream& in) {
-  const uint32_t n = take<uint32_t>(in);
-  if (n > (1u << 20)) throw InputError("", "cache", "corrupt global descriptor state (histogram size)");
-  std::vector<float> v(n);
-  if (n) in.read(reinterpret_cast<char*>(v.data()), n * sizeof(float));
-  if (!in) throw InputError("", "cache", "truncated global descriptor state");
-  return v;
-}
-void put_pose(std::ostream& o, const Pose& p) {
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) put<double>(o, p.R(r, c));
-  for (int r = 0; r < 3; ++r) put<double>(o, p.t(r));
-}
-Pose take_pose(std::istream& in) {
-  Pose p;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) p.R(r, c) = take<double>(in);
-  for (int r = 0; r < 3; ++r) p.t(r) = take<double>(in);
-  return p;
-}
-void put_vec(std::ostream& o, const Vec3f& v) {
-  for (int i = 0; i < 3; ++i) put<float>(o, v(i));
-}
-Vec3f take_vec(std::istream& in) {
-  Vec3f v;
-  for (int i = 0; i < 3; ++i) v(i) = take<float>(in);
-  return v;
-}
-
 constexpr char kMagic[8] = {'P', 'B', 'G', 'L', 'O', 'B', 'A', 'L'};
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;
 
 class GlobalMethod : public Method {
  public:
-  explicit GlobalMethod(Kind kind) : kind_(kind) {}
+  GlobalMethod(Kind kind, const GlobalSettings& g) : kind_(kind), g_(g) {}
   std::string name() const override { return kind_name(kind_); }
 
-  void train(const std::vector<ViewData>& views, const RecognitionSettings& s) override {
+  void train(const std::vector<ViewData>& views, uint64_t seed) override {
     sigs_.clear();
     view_poses_.clear();
     for (size_t v = 0; v < views.size(); ++v) {
       view_poses_.push_back(views[v].T_cam_model);
-      auto sigs = describe(kind_, views[v].cloud, s.global, derive_seed(s.seed, {kTrainStream, v}));
+      auto sigs = describe(kind_, views[v].cloud, g_, derive_seed(seed, {kTrainStream, v}));
       for (auto& sig : sigs) {
         sig.source = static_cast<int>(v);
         sig.crh = global::crh_spectrum(views[v].cloud, sig.axis);
@@ -198,49 +150,47 @@ class GlobalMethod : public Method {
     }
   }
 
-  void save(std::ostream& out) const override {
-    out.write(kMagic, sizeof(kMagic));
-    put<uint32_t>(out, kVersion);
-    put<uint32_t>(out, static_cast<uint32_t>(kind_));
-    put<uint32_t>(out, static_cast<uint32_t>(view_poses_.size()));
-    for (const auto& p : view_poses_) put_pose(out, p);
-    put<uint32_t>(out, static_cast<uint32_t>(sigs_.size()));
+  void save(BinaryWriter& out) const override {
+    out.raw(kMagic, sizeof(kMagic));
+    out.pod<uint32_t>(kVersion);
+    out.pod<uint32_t>(static_cast<uint32_t>(kind_));
+    out.pod<uint64_t>(view_poses_.size());
+    for (const auto& p : view_poses_) out.pose(p);
+    out.pod<uint64_t>(sigs_.size());
     for (const auto& s : sigs_) {
-      put<int32_t>(out, s.source);
-      put_floats(out, s.hist);
-      put_vec(out, s.centroid);
-      put_vec(out, s.axis);
-      put<uint8_t>(out, s.from_normal ? 1 : 0);
-      put<uint8_t>(out, s.has_rf ? 1 : 0);
-      put_pose(out, s.T_rf_cam);
-      put_floats(out, s.crh);
+      out.pod<int32_t>(s.source);
+      out.vec(s.hist);
+      out.points({s.centroid, s.axis});
+      out.pod<uint8_t>(s.from_normal ? 1 : 0);
+      out.pod<uint8_t>(s.has_rf ? 1 : 0);
+      out.pose(s.T_rf_cam);
+      out.vec(s.crh);
     }
   }
 
-  void load(std::istream& in) override {
-    char magic[sizeof(kMagic)];
-    in.read(magic, sizeof(magic));
-    if (!in || std::memcmp(magic, kMagic, sizeof(kMagic)) != 0)
-      throw InputError("", "cache", "not a global descriptor state");
-    if (take<uint32_t>(in) != kVersion) throw InputError("", "cache", "global descriptor state of another version");
-    if (take<uint32_t>(in) != static_cast<uint32_t>(kind_))
-      throw InputError("", "cache", std::string("global descriptor state is not ") + kind_name(kind_));
-    std::vector<Pose> poses(take<uint32_t>(in));
-    for (auto& p : poses) p = take_pose(in);
-    const uint32_t n = take<uint32_t>(in);
+  void load(BinaryReader& in) override {
+    in.expect(kMagic, sizeof(kMagic), "global descriptor state");
+    if (in.pod<uint32_t>() != kVersion) in.fail("of another version");
+    if (in.pod<uint32_t>() != static_cast<uint32_t>(kind_)) in.fail(std::string("not ") + kind_name(kind_));
+    const uint64_t nv = in.pod<uint64_t>();
+    if (nv > 100000) in.fail("corrupt view count");
+    std::vector<Pose> poses(nv);
+    for (auto& p : poses) p = in.pose();
+    const uint64_t n = in.pod<uint64_t>();
     std::vector<Signature> sigs;
-    for (uint32_t i = 0; i < n; ++i) {
+    for (uint64_t i = 0; i < n; ++i) {
       Signature s;
-      s.source = take<int32_t>(in);
-      if (s.source < 0 || static_cast<size_t>(s.source) >= poses.size())
-        throw InputError("", "cache", "corrupt global descriptor state (view index)");
-      s.hist = take_floats(in);
-      s.centroid = take_vec(in);
-      s.axis = take_vec(in);
-      s.from_normal = take<uint8_t>(in) != 0;
-      s.has_rf = take<uint8_t>(in) != 0;
-      s.T_rf_cam = take_pose(in);
-      s.crh = take_floats(in);
+      s.source = in.pod<int32_t>();
+      if (s.source < 0 || static_cast<size_t>(s.source) >= poses.size()) in.fail("corrupt view index");
+      s.hist = in.vec<float>();
+      const std::vector<Vec3f> ca = in.points();
+      if (ca.size() != 2) in.fail("corrupt signature");
+      s.centroid = ca[0];
+      s.axis = ca[1];
+      s.from_normal = in.pod<uint8_t>() != 0;
+      s.has_rf = in.pod<uint8_t>() != 0;
+      s.T_rf_cam = in.pose();
+      s.crh = in.vec<float>();
       sigs.push_back(std::move(s));
     }
     view_poses_ = std::move(poses);
@@ -248,9 +198,8 @@ class GlobalMethod : public Method {
   }
 
   std::vector<Hypothesis> hypothesize(const PointSet& scene, const std::vector<ViewData>& /*views*/,
-                                      const RecognitionSettings& s, uint64_t seed,
-                                      StageTimes& times) const override {
-    const GlobalSettings& g = s.global;
+                                      uint64_t seed, StageTimes& times) const override {
+    const GlobalSettings& g = g_;
     std::vector<Hypothesis> hyps;
 
     // 1. Segmentation and description.
@@ -336,15 +285,16 @@ class GlobalMethod : public Method {
 
  private:
   Kind kind_;
+  GlobalSettings g_;
   std::vector<Signature> sigs_;   // every training view's signatures (source = view)
   std::vector<Pose> view_poses_;  // T_view_model of each training view
 };
 
 }  // namespace
 
-std::unique_ptr<Method> make_cvfh_method() { return std::make_unique<GlobalMethod>(Kind::kCvfh); }
-std::unique_ptr<Method> make_esf_method() { return std::make_unique<GlobalMethod>(Kind::kEsf); }
-std::unique_ptr<Method> make_cesf_method() { return std::make_unique<GlobalMethod>(Kind::kCesf); }
-std::unique_ptr<Method> make_ourcvfh_method() { return std::make_unique<GlobalMethod>(Kind::kOurCvfh); }
+std::unique_ptr<Method> make_cvfh_method(const GlobalSettings& g) { return std::make_unique<GlobalMethod>(Kind::kCvfh, g); }
+std::unique_ptr<Method> make_esf_method(const GlobalSettings& g) { return std::make_unique<GlobalMethod>(Kind::kEsf, g); }
+std::unique_ptr<Method> make_cesf_method(const GlobalSettings& g) { return std::make_unique<GlobalMethod>(Kind::kCesf, g); }
+std::unique_ptr<Method> make_ourcvfh_method(const GlobalSettings& g) { return std::make_unique<GlobalMethod>(Kind::kOurCvfh, g); }
 
 }  // namespace pb

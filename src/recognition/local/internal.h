@@ -1,12 +1,12 @@
 // Internal building blocks of the local pipeline (FPFH, SHOT, 3D Hough
 // voting). PCL-free: each function converts to PCL types inside its own .cpp
 // file, so the PCL compile cost is spread over several small units:
-//   local_keypoints.cpp  keypoints (own voxel grid, PCL-free)
-//   local_fpfh.cpp       FPFH (pcl::FPFHEstimationOMP)
-//   local_shot.cpp       SHOT (pcl::SHOTEstimationOMP)
-//   local_match.cpp      descriptor kd-tree (FLANN, exact search)
-//   local_hough.cpp      BOARD reference frames + pcl::Hough3DGrouping
-//   local_method.cpp     the Method (train, save/load, hypothesize), parse_local
+//   keypoints.cpp  keypoints (the shared voxel grid, PCL-free)
+//   fpfh.cpp       FPFH (pcl::FPFHEstimationOMP)
+//   shot.cpp       SHOT (pcl::SHOTEstimationOMP)
+//   match.cpp      descriptor kd-tree (FLANN, exact search)
+//   hough.cpp      BOARD reference frames + pcl::Hough3DGrouping
+//   method.cpp     the Method (train, save/load, hypothesize)
 #pragma once
 
 #include <memory>

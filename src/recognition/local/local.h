@@ -2,7 +2,7 @@
 // pipeline"; defaults are the table synthetic values of Table 4.2.
 #pragma once
 
-#include "core/yaml.h"
+#include "core/settings_fields.h"
 
 namespace pb {
 
@@ -27,8 +27,21 @@ struct LocalSettings {
   int max_hypotheses = 10;              // at most this many clusters go on to refinement
   int threads = 0;                      // OpenMP threads for FPFH / SHOT / matching (0 = all
                                         // cores); results are identical for any value
-};
 
-void parse_local(const YamlNode& node, LocalSettings& s);
+  template <class S, class F>
+  static void fields(S& s, F& f) {
+    f("keypoint_voxel_mm", s.keypoint_voxel_mm, fields::positive());
+    f("descriptor_radius_mm", s.descriptor_radius_mm, fields::positive());
+    f("lrf_radius_mm", s.lrf_radius_mm, fields::positive());
+    f("match_threshold", s.match_threshold, fields::positive());
+    f("fpfh_match_threshold", s.fpfh_match_threshold, fields::positive());
+    f("matches_per_keypoint", s.matches_per_keypoint, fields::at_least(1));
+    f("hough_bin_mm", s.hough_bin_mm, fields::positive());
+    f("hough_min_votes", s.hough_min_votes, fields::at_least(1));
+    f("hough_interpolation", s.hough_interpolation);
+    f("max_hypotheses", s.max_hypotheses, fields::at_least(1));
+    f("threads", s.threads, fields::at_least(0));
+  }
+};
 
 }  // namespace pb

@@ -10,8 +10,6 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
-#include <istream>
-#include <ostream>
 #include <stdexcept>
 #include <string>
 
@@ -19,36 +17,9 @@
 #include "recognition/local/local.h"
 #include "recognition/local/internal.h"
 #include "recognition/method.h"
-#include "recognition/pipeline.h"
 
 namespace pb {
 
-// ---------------------------------------------------------------------------
-// Settings
-
-void parse_local(const YamlNode& node, LocalSettings& s) {
-  if (!node.defined()) return;
-  node.check_keys({"keypoint_voxel_mm", "descriptor_radius_mm", "lrf_radius_mm", "match_threshold",
-                   "fpfh_match_threshold", "matches_per_keypoint", "hough_bin_mm", "hough_min_votes",
-                   "hough_interpolation", "max_hypotheses", "threads"});
-  s.keypoint_voxel_mm = node.get_positive("keypoint_voxel_mm", s.keypoint_voxel_mm);
-  s.descriptor_radius_mm = node.get_positive("descriptor_radius_mm", s.descriptor_radius_mm);
-  s.lrf_radius_mm = node.get_positive("lrf_radius_mm", s.lrf_radius_mm);
-  s.match_threshold = node.get_positive("match_threshold", s.match_threshold);
-  s.fpfh_match_threshold = node.get_positive("fpfh_match_threshold", s.fpfh_match_threshold);
-  s.hough_bin_mm = node.get_positive("hough_bin_mm", s.hough_bin_mm);
-  node.read("hough_interpolation", s.hough_interpolation);
-  auto read_int = [&](const char* key, int& v, int lo) {
-    if (!node.has(key)) return;
-    const int x = node.get<int>(key);
-    if (x < lo) node[key].fail("must be >= " + std::to_string(lo));
-    v = x;
-  };
-  read_int("matches_per_keypoint", s.matches_per_keypoint, 1);
-  read_int("hough_min_votes", s.hough_min_votes, 1);
-  read_int("max_hypotheses", s.max_hypotheses, 1);
-  read_int("threads", s.threads, 0);
-}
 
 namespace {
 
@@ -94,44 +65,16 @@ Described keep_valid(const PointSet& cloud, const std::vector<int>& idx, const s
   return d;
 }
 
-// Binary helpers (host byte order: the cache is machine-local).
-template <typename T>
-void put(std::ostream& out, const T& v) {
-  out.write(reinterpret_cast<const char*>(&v), sizeof(T));
-}
-template <typename T>
-void put_vec(std::ostream& out, const std::vector<T>& v) {
-  const uint64_t n = v.size();
-  put(out, n);
-  if (n) out.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T)));
-}
-template <typename T>
-T get(std::istream& in) {
-  T v{};
-  in.read(reinterpret_cast<char*>(&v), sizeof(T));
-  if (!in) throw std::runtime_error("local method cache: truncated stream");
-  return v;
-}
-template <typename T>
-std::vector<T> get_vec(std::istream& in, uint64_t max_n) {
-  const uint64_t n = get<uint64_t>(in);
-  if (n > max_n) throw std::runtime_error("local method cache: corrupt array size");
-  std::vector<T> v(n);
-  if (n) in.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T)));
-  if (!in) throw std::runtime_error("local method cache: truncated stream");
-  return v;
-}
-
 constexpr char kMagic[8] = {'P', 'B', 'L', 'O', 'C', 'A', 'L', '1'};
 
 class LocalMethod : public Method {
  public:
-  explicit LocalMethod(Kind kind) : kind_(kind) {}
+  LocalMethod(Kind kind, const LocalSettings& s) : kind_(kind), s_(s) {}
 
   std::string name() const override { return kind_ == Kind::Fpfh ? "fpfh" : "shot"; }
 
-  void train(const std::vector<ViewData>& views, const RecognitionSettings& rs) override {
-    const LocalSettings& s = rs.local;
+  void train(const std::vector<ViewData>& views, uint64_t /*seed: no random choice*/) override {
+    const LocalSettings& s = s_;
     views_.clear();
     for (const ViewData& v : views) {
       const std::vector<int> idx = voxel_keypoints(v.cloud, s.keypoint_voxel_mm);
@@ -142,42 +85,32 @@ class LocalMethod : public Method {
     build_index();
   }
 
-  void save(std::ostream& out) const override {
-    out.write(kMagic, sizeof(kMagic));
-    put<uint32_t>(out, static_cast<uint32_t>(kind_));
-    put<uint32_t>(out, static_cast<uint32_t>(dim_of(kind_)));
-    put<uint64_t>(out, views_.size());
+  void save(BinaryWriter& out) const override {
+    out.raw(kMagic, sizeof(kMagic));
+    out.pod<uint32_t>(static_cast<uint32_t>(kind_));
+    out.pod<uint32_t>(static_cast<uint32_t>(dim_of(kind_)));
+    out.pod<uint64_t>(views_.size());
     for (const Described& d : views_) {
-      std::vector<float> kp;
-      kp.reserve(d.kp.size() * 3);
-      for (const Vec3f& p : d.kp) kp.insert(kp.end(), {p.x(), p.y(), p.z()});
-      put_vec(out, kp);
-      put_vec(out, d.desc);
-      put_vec(out, d.lrf);
+      out.points(d.kp);
+      out.vec(d.desc);
+      out.vec(d.lrf);
     }
   }
 
-  void load(std::istream& in) override {
-    char magic[sizeof(kMagic)];
-    in.read(magic, sizeof(magic));
-    if (!in || std::memcmp(magic, kMagic, sizeof(kMagic)) != 0)
-      throw std::runtime_error("local method cache: bad magic");
-    if (get<uint32_t>(in) != static_cast<uint32_t>(kind_))
-      throw std::runtime_error("local method cache: stored for another descriptor");
-    const int dim = static_cast<int>(get<uint32_t>(in));
-    if (dim != dim_of(kind_)) throw std::runtime_error("local method cache: descriptor size mismatch");
-    const uint64_t nv = get<uint64_t>(in);
-    if (nv > 100000) throw std::runtime_error("local method cache: corrupt view count");
-    constexpr uint64_t kMax = uint64_t(1) << 32;
+  void load(BinaryReader& in) override {
+    in.expect(kMagic, sizeof(kMagic), "local method state");
+    if (in.pod<uint32_t>() != static_cast<uint32_t>(kind_)) in.fail("stored for another descriptor");
+    const int dim = static_cast<int>(in.pod<uint32_t>());
+    if (dim != dim_of(kind_)) in.fail("descriptor size mismatch");
+    const uint64_t nv = in.pod<uint64_t>();
+    if (nv > 100000) in.fail("corrupt view count");
     std::vector<Described> views(nv);
     for (Described& d : views) {
-      const std::vector<float> kp = get_vec<float>(in, kMax);
-      d.desc = get_vec<float>(in, kMax);
-      d.lrf = get_vec<float>(in, kMax);
-      const size_t n = kp.size() / 3;
-      if (kp.size() != n * 3 || d.desc.size() != n * dim || d.lrf.size() != n * kLrfDim)
-        throw std::runtime_error("local method cache: inconsistent array sizes");
-      for (size_t i = 0; i < n; ++i) d.kp.emplace_back(kp[3 * i], kp[3 * i + 1], kp[3 * i + 2]);
+      d.kp = in.points();
+      d.desc = in.vec<float>();
+      d.lrf = in.vec<float>();
+      const size_t n = d.kp.size();
+      if (d.desc.size() != n * dim || d.lrf.size() != n * kLrfDim) in.fail("inconsistent array sizes");
     }
     views_ = std::move(views);
     build_index();
@@ -186,9 +119,8 @@ class LocalMethod : public Method {
   std::vector<Hypothesis> hypothesize(const PointSet& scene, const std::vector<ViewData>& views,
                                       // No random choice here: the only one, PCL's RANSAC
                                       // inside Hough3DGrouping, uses its fixed seed.
-                                      const RecognitionSettings& rs, uint64_t /*seed*/,
-                                      StageTimes& times) const override {
-    const LocalSettings& s = rs.local;
+                                      uint64_t /*seed*/, StageTimes& times) const override {
+    const LocalSettings& s = s_;
     std::vector<Hypothesis> out;
     if (views.size() != views_.size())
       throw std::invalid_argument("local method: " + std::to_string(views.size()) +
@@ -288,6 +220,7 @@ class LocalMethod : public Method {
   }
 
   Kind kind_;
+  LocalSettings s_;
   std::vector<Described> views_;
   std::vector<std::pair<int, int>> row_owner_;  // index row -> (view, keypoint)
   DescriptorIndex index_;
@@ -317,7 +250,7 @@ bool procrustes(const std::vector<Vec3f>& model, const std::vector<Vec3f>& scene
 
 }  // namespace local
 
-std::unique_ptr<Method> make_fpfh_method() { return std::make_unique<LocalMethod>(Kind::Fpfh); }
-std::unique_ptr<Method> make_shot_method() { return std::make_unique<LocalMethod>(Kind::Shot); }
+std::unique_ptr<Method> make_fpfh_method(const LocalSettings& s) { return std::make_unique<LocalMethod>(Kind::Fpfh, s); }
+std::unique_ptr<Method> make_shot_method(const LocalSettings& s) { return std::make_unique<LocalMethod>(Kind::Shot, s); }
 
 }  // namespace pb

@@ -1,7 +1,7 @@
 // PPF (Drost et al. 2010) settings: PCL's PPFEstimation + PPFRegistration.
 #pragma once
 
-#include "core/yaml.h"
+#include "core/settings_fields.h"
 
 namespace pb {
 
@@ -13,8 +13,18 @@ struct PpfSettings {
   double position_cluster_mm = 30.0;      // pose clustering: translation threshold
   double rotation_cluster_deg = 30.0;     // pose clustering: rotation threshold
   int max_hypotheses = 5;                 // clustered poses passed on
-};
 
-void parse_ppf(const YamlNode& node, PpfSettings& s);
+  template <class S, class F>
+  static void fields(S& s, F& f) {
+    // at most 5000: the model's pair features grow with its square
+    f("model_points", s.model_points, fields::at_least(10, 5000));
+    f("angle_step_deg", s.angle_step_deg, fields::positive(90));
+    f("distance_step_fraction", s.distance_step_fraction, fields::positive(1));
+    f("scene_reference_fraction", s.scene_reference_fraction, fields::positive(1));
+    f("position_cluster_mm", s.position_cluster_mm, fields::positive());
+    f("rotation_cluster_deg", s.rotation_cluster_deg, fields::positive());
+    f("max_hypotheses", s.max_hypotheses, fields::at_least(1));
+  }
+};
 
 }  // namespace pb

@@ -10,13 +10,6 @@
 
 namespace pb::detail {
 
-// Voxel grid with the cells of pcl::VoxelGrid (cell = floor(p / leaf)) and
-// its output order (cells by increasing z, then y, then x index). Each cell
-// becomes the centroid of its points; normals (if present) are averaged and
-// renormalized, curvature averaged; the pixel of a cell is the pixel of its
-// point nearest to the centroid (ties: the smaller pixel index).
-PointSet voxel_downsample(const PointSet& in, double leaf_mm);
-
 // Seeded RANSAC plane fit (as pcl::SACSegmentation with SACMODEL_PLANE and
 // optimized coefficients): `iterations` random triples, the plane with most
 // points within `threshold_mm` wins (first found on ties), then a least

@@ -18,25 +18,13 @@
 
 #include "core/random.h"
 #include "recognition/preprocess/internal.h"
+#include "recognition/preprocess/voxel_grid.h"
 
 namespace pb {
 
-void parse_preprocess(const YamlNode& node, PreprocessSettings& s) {
-  if (!node.defined()) return;
-  node.check_keys({"min_range_mm", "max_range_mm", "voxel_mm", "remove_plane", "plane_threshold_mm",
-                   "plane_iterations", "min_plane_fraction", "normal_radius_mm"});
-  s.min_range_mm = node.get_nonnegative("min_range_mm", s.min_range_mm);
-  s.max_range_mm = node.get_positive("max_range_mm", s.max_range_mm);
-  if (s.max_range_mm <= s.min_range_mm)
-    node["max_range_mm"].fail("must be greater than min_range_mm (" + std::to_string(s.min_range_mm) + ")");
-  s.voxel_mm = node.get_nonnegative("voxel_mm", s.voxel_mm);
-  node.read("remove_plane", s.remove_plane);
-  s.plane_threshold_mm = node.get_positive("plane_threshold_mm", s.plane_threshold_mm);
-  s.plane_iterations = node.get_or<int>("plane_iterations", s.plane_iterations);
-  if (s.plane_iterations < 1) node["plane_iterations"].fail("must be at least 1");
-  s.min_plane_fraction = node.get_nonnegative("min_plane_fraction", s.min_plane_fraction);
-  if (s.min_plane_fraction > 1) node["min_plane_fraction"].fail("must be in [0, 1]");
-  s.normal_radius_mm = node.get_positive("normal_radius_mm", s.normal_radius_mm);
+void PreprocessSettings::validate(const YamlNode& node) const {
+  if (max_range_mm <= min_range_mm)
+    node["max_range_mm"].fail("must be greater than min_range_mm (" + std::to_string(min_range_mm) + ")");
 }
 
 namespace detail {
@@ -57,88 +45,6 @@ PointSet select(const PointSet& in, const std::vector<char>& keep) {
   return out;
 }
 
-PointSet voxel_downsample(const PointSet& in, double leaf_mm) {
-  if (!(leaf_mm > 0) || in.points.empty()) return in;
-  const size_t n = in.points.size();
-  const bool has_n = in.normals.size() == n, has_c = in.curvature.size() == n, has_px = in.pixel.size() == n;
-  // Cell index per point, packed as 21 bits per axis with z most
-  // significant, so that sorting the packed keys gives pcl::VoxelGrid's
-  // order (z, then y, then x index).
-  constexpr int64_t kOff = int64_t(1) << 20;
-  const double inv = 1.0 / leaf_mm;
-  std::vector<uint64_t> key(n, ~uint64_t(0));
-  for (size_t i = 0; i < n; ++i) {
-    const Vec3f& p = in.points[i];
-    if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) continue;
-    const double c[3] = {std::floor(p.x() * inv), std::floor(p.y() * inv), std::floor(p.z() * inv)};
-    if (std::abs(c[0]) >= kOff || std::abs(c[1]) >= kOff || std::abs(c[2]) >= kOff)
-      throw std::invalid_argument("voxel grid: leaf " + std::to_string(leaf_mm) + " mm too small for the extent");
-    key[i] = (static_cast<uint64_t>(static_cast<int64_t>(c[2]) + kOff) << 42) |
-             (static_cast<uint64_t>(static_cast<int64_t>(c[1]) + kOff) << 21) |
-             static_cast<uint64_t>(static_cast<int64_t>(c[0]) + kOff);
-  }
-  // Accumulate per cell in input order (hash map from key to cell slot).
-  struct Cell {
-    Vec3 sum = Vec3::Zero(), nsum = Vec3::Zero();
-    double csum = 0;
-    uint32_t count = 0, first = 0;
-  };
-  std::unordered_map<uint64_t, uint32_t> slot;
-  slot.reserve(n / 8 + 16);
-  std::vector<Cell> cells;
-  std::vector<uint32_t> cell_of(n, ~uint32_t(0));
-  for (size_t i = 0; i < n; ++i) {
-    if (key[i] == ~uint64_t(0)) continue;
-    auto [it, fresh] = slot.emplace(key[i], static_cast<uint32_t>(cells.size()));
-    if (fresh) {
-      cells.emplace_back();
-      cells.back().first = static_cast<uint32_t>(i);
-    }
-    Cell& c = cells[it->second];
-    c.sum += in.points[i].cast<double>();
-    if (has_n) c.nsum += in.normals[i].cast<double>();
-    if (has_c) c.csum += in.curvature[i];
-    ++c.count;
-    cell_of[i] = it->second;
-  }
-  std::vector<Vec3> centroid(cells.size());
-  for (size_t k = 0; k < cells.size(); ++k) centroid[k] = cells[k].sum / static_cast<double>(cells[k].count);
-  // The pixel of a cell: its point nearest to the centroid (smaller pixel on ties).
-  std::vector<int> best_px(cells.size(), -1);
-  if (has_px) {
-    std::vector<double> best_d(cells.size(), std::numeric_limits<double>::infinity());
-    for (size_t i = 0; i < n; ++i) {
-      const uint32_t k = cell_of[i];
-      if (k == ~uint32_t(0)) continue;
-      const double d = (in.points[i].cast<double>() - centroid[k]).squaredNorm();
-      const int px = in.pixel[i];
-      if (d < best_d[k] || (d == best_d[k] && px < best_px[k])) {
-        best_d[k] = d;
-        best_px[k] = px;
-      }
-    }
-  }
-  std::vector<std::pair<uint64_t, uint32_t>> order;
-  order.reserve(cells.size());
-  for (const auto& [k, v] : slot) order.emplace_back(k, v);
-  std::sort(order.begin(), order.end());
-
-  PointSet out;
-  out.source_width = in.source_width;
-  out.source_height = in.source_height;
-  out.points.reserve(order.size());
-  for (const auto& [k, idx] : order) {
-    const Cell& c = cells[idx];
-    out.points.push_back(centroid[idx].cast<float>());
-    if (has_n) {
-      const double l = c.nsum.norm();
-      out.normals.push_back(l > 0 ? Vec3f((c.nsum / l).cast<float>()) : in.normals[c.first]);
-    }
-    if (has_c) out.curvature.push_back(static_cast<float>(c.csum / c.count));
-    if (has_px) out.pixel.push_back(best_px[idx]);
-  }
-  return out;
-}
 
 namespace {
 
@@ -244,7 +150,7 @@ PointSet range_cut(const OrganizedCloud& cloud, double min_z, double max_z) {
 
 PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings& s, uint64_t seed) {
   PointSet ps = range_cut(cloud, s.min_range_mm, s.max_range_mm);
-  ps = detail::voxel_downsample(ps, s.voxel_mm);
+  ps = voxel_downsample(ps, {s.voxel_mm});
   if (s.remove_plane && ps.size() >= 3) {
     const std::vector<char> on_plane =
         detail::ransac_plane(ps.points, s.plane_threshold_mm, s.plane_iterations, seed);
@@ -263,7 +169,7 @@ PointSet preprocess_view(const OrganizedCloud& cloud, const PreprocessSettings& 
   // The model is alone in its view, rendered at the distance the view
   // settings chose: no range cut, no plane.
   PointSet ps = range_cut(cloud, 0.0, std::numeric_limits<double>::infinity());
-  ps = detail::voxel_downsample(ps, s.voxel_mm);
+  ps = voxel_downsample(ps, {s.voxel_mm});
   detail::estimate_normals(ps, s.normal_radius_mm);
   return ps;
 }

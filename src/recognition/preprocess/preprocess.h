@@ -4,7 +4,7 @@
 #pragma once
 
 #include "core/types.h"
-#include "core/yaml.h"
+#include "core/settings_fields.h"
 #include "recognition/cloud.h"
 
 namespace pb {
@@ -18,9 +18,20 @@ struct PreprocessSettings {
   int plane_iterations = 200;       // RANSAC iterations
   double min_plane_fraction = 0.2;  // remove the plane only if it holds this fraction
   double normal_radius_mm = 20.0;   // PCA neighbourhood radius for normals
-};
 
-void parse_preprocess(const YamlNode& node, PreprocessSettings& s);
+  template <class S, class F>
+  static void fields(S& s, F& f) {
+    f("min_range_mm", s.min_range_mm, fields::nonnegative());
+    f("max_range_mm", s.max_range_mm, fields::positive());
+    f("voxel_mm", s.voxel_mm, fields::nonnegative());
+    f("remove_plane", s.remove_plane);
+    f("plane_threshold_mm", s.plane_threshold_mm, fields::positive());
+    f("plane_iterations", s.plane_iterations, fields::at_least(1));
+    f("min_plane_fraction", s.min_plane_fraction, fields::in_range(0, 1));
+    f("normal_radius_mm", s.normal_radius_mm, fields::positive());
+  }
+  void validate(const YamlNode& node) const;  // max_range_mm > min_range_mm
+};
 
 // Scene preprocessing. Every random choice (RANSAC) draws from `seed`.
 PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings& s, uint64_t seed);

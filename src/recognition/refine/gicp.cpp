@@ -2,26 +2,20 @@
 // each point carries a covariance that is flat along its surface; by default
 // built from the clouds' normals (thesis: "covariances from normals"),
 // otherwise PCL computes them from k neighbours. The clouds arrive de-meaned
-// (centred on the scene crop, refine_internal.h): PCL issue 6263, GICP fails
+// (centred on the scene crop, internal.h): PCL issue 6263, GICP fails
 // on clouds far from the origin.
-#include <pcl/point_types.h>
 #include <pcl/registration/gicp.h>
 
 #include <cmath>
 
-#include "recognition/refine/internal.h"
+#include "recognition/pcl_adapter.h"
+#include "recognition/refine/pcl_registration.h"
 
-namespace pb {
-namespace refine_detail {
+namespace pb::refine_detail {
 
 namespace {
 
 using Gicp = pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ>;
-
-class GicpCount : public Gicp {
- public:
-  int iterations() const { return nr_iterations_; }
-};
 
 // Covariance of a locally planar patch with unit normal n: variance 1 in the
 // plane, eps along the normal (PCL's gicp_epsilon 0.001).
@@ -37,49 +31,36 @@ Gicp::MatricesVectorPtr plane_covariances(const std::vector<Vec3f>& normals) {
 
 }  // namespace
 
-Outcome run_gicp(const Problem& p, const RefineSettings& s) {
-  using Cloud = pcl::PointCloud<pcl::PointXYZ>;
-  Cloud::Ptr src(new Cloud), tgt(new Cloud), out(new Cloud);
-  src->resize(p.src.size());
-  for (size_t i = 0; i < p.src.size(); ++i) (*src)[i].getVector3fMap() = p.src[i];
-  tgt->resize(p.tgt.size());
-  for (size_t i = 0; i < p.tgt.size(); ++i) (*tgt)[i].getVector3fMap() = p.tgt[i];
-
-  Outcome o;
+Outcome run_gicp(const Problem& p, const RefineSettings& s, uint64_t /*seed*/) {
   const int k = static_cast<int>(s.gicp_correspondence_randomness);
   const bool from_normals = s.gicp_covariances_from_normals && p.src_normals.size() == p.src.size() &&
                             p.tgt_normals.size() == p.tgt.size();
   // PCL's own covariances need k neighbours in both clouds.
-  if (!from_normals && (static_cast<int>(src->size()) < k || static_cast<int>(tgt->size()) < k)) return o;
+  if (!from_normals && (static_cast<int>(p.src.size()) < k || static_cast<int>(p.tgt.size()) < k)) return {};
 
-  GicpCount gicp;
-  gicp.setInputSource(src);
-  gicp.setInputTarget(tgt);
-  if (from_normals) {
-    gicp.setSourceCovariances(plane_covariances(p.src_normals));
-    gicp.setTargetCovariances(plane_covariances(p.tgt_normals));
-  } else {
-    gicp.setCorrespondenceRandomness(k);
-  }
-  gicp.setMaximumIterations(s.max_iterations);
-  gicp.setMaxCorrespondenceDistance(s.max_correspondence_mm * 1e-3);
-  // PCL's GICP stops when every translation entry of the per-iteration change
-  // is below transformation_epsilon (m, not squared) and every rotation entry
-  // below rotation_epsilon (~ radians): the same rule as the ICP family.
-  gicp.setTransformationEpsilon(std::sqrt(s.transformation_epsilon));
-  gicp.setRotationEpsilon(s.rotation_epsilon_deg * M_PI / 180.0);
-  // The inner BFGS stops when the gradient norms drop below these; PCL's
-  // 1e-2 assumes metre-sized scenes and stops several degrees short on
-  // objects of about 10 cm (measured: mean rotation error 3.2 degrees).
-  gicp.setTranslationGradientTolerance(1e-6);
-  gicp.setRotationGradientTolerance(1e-6);
-  gicp.align(*out);
-
-  o.delta = gicp.getFinalTransformation();
-  o.iterations = gicp.iterations();
-  o.converged = gicp.hasConverged() && o.iterations < s.max_iterations;
-  return o;
+  auto configure = [&](auto& r) {
+    if (!from_normals) r.setCorrespondenceRandomness(k);
+    r.setMaxCorrespondenceDistance(s.max_correspondence_mm * 1e-3);
+    // PCL's GICP stops when every translation entry of the per-iteration change
+    // is below transformation_epsilon (m, not squared) and every rotation entry
+    // below rotation_epsilon (~ radians): the same rule as the ICP family.
+    r.setTransformationEpsilon(std::sqrt(s.transformation_epsilon));
+    r.setRotationEpsilon(s.rotation_epsilon_deg * M_PI / 180.0);
+    // The inner BFGS stops when the gradient norms drop below these; PCL's
+    // 1e-2 assumes metre-sized scenes and stops several degrees short on
+    // objects of about 10 cm (measured: mean rotation error 3.2 degrees).
+    r.setTranslationGradientTolerance(1e-6);
+    r.setRotationGradientTolerance(1e-6);
+  };
+  // Setting the inputs resets the covariances: set them after.
+  auto after_inputs = [&](auto& r) {
+    if (!from_normals) return;
+    r.setSourceCovariances(plane_covariances(p.src_normals));
+    r.setTargetCovariances(plane_covariances(p.tgt_normals));
+  };
+  Counted<Gicp> gicp;
+  return align<StopReport::kFlagAndCap>(gicp, pcl_adapter::xyz(p.src), pcl_adapter::xyz(p.tgt), s, configure,
+               after_inputs);
 }
 
-}  // namespace refine_detail
-}  // namespace pb
+}  // namespace pb::refine_detail

@@ -36,11 +36,13 @@ struct Outcome {
   int iterations = 0;
 };
 
+// The methods the registry lists (registry.cpp); each is its PCL object and
+// a configure function around the one driver in pcl_registration.h.
 Outcome run_icp(const Problem& p, const RefineSettings& s, uint64_t seed);
-Outcome run_icp_lm(const Problem& p, const RefineSettings& s);
-Outcome run_icp_plane(const Problem& p, const RefineSettings& s);
-Outcome run_gicp(const Problem& p, const RefineSettings& s);
-Outcome run_ndt(const Problem& p, const RefineSettings& s);
+Outcome run_icp_lm(const Problem& p, const RefineSettings& s, uint64_t seed);
+Outcome run_icp_plane(const Problem& p, const RefineSettings& s, uint64_t seed);
+Outcome run_gicp(const Problem& p, const RefineSettings& s, uint64_t seed);
+Outcome run_ndt(const Problem& p, const RefineSettings& s, uint64_t seed);
 
 // Unit normals by PCA over the k nearest neighbours (sign arbitrary: the
 // point-to-plane and plane-to-plane metrics do not depend on it).

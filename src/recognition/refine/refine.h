@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "core/types.h"
-#include "core/yaml.h"
+#include "core/settings_fields.h"
 #include "recognition/cloud.h"
 
 namespace pb {
@@ -46,9 +46,30 @@ struct RefineSettings {
                                            // initial model centre are registered (< 0: use
                                            // max_correspondence_mm)
   int normal_neighbours = 10;              // k for PCA normals when a cloud has none (icp_plane, gicp)
-};
 
-void parse_refine(const YamlNode& node, RefineSettings& s);
+  template <class S, class F>
+  static void fields(S& s, F& f) {
+    f("max_iterations", s.max_iterations, fields::at_least(1));
+    f("max_correspondence_mm", s.max_correspondence_mm, fields::positive());
+    f("transformation_epsilon", s.transformation_epsilon, fields::nonnegative());
+    f("rotation_epsilon_deg", s.rotation_epsilon_deg, fields::nonnegative());
+    f("fitness_epsilon", s.fitness_epsilon, fields::nonnegative());
+    f("reciprocal_correspondences", s.reciprocal_correspondences);
+    f("icp_sample_points", s.icp_sample_points, fields::at_least(0));
+    f("ndt_resolution_mm", s.ndt_resolution_mm, fields::positive());
+    f("ndt_resolution_fraction", s.ndt_resolution_fraction, fields::nonnegative());
+    f("ndt_step_size_mm", s.ndt_step_size_mm, fields::positive());
+    f("ndt_outlier_ratio", s.ndt_outlier_ratio, fields::positive());
+    f("ndt_min_points_per_cell", s.ndt_min_points_per_cell, fields::at_least(3));
+    f("gicp_correspondence_randomness", s.gicp_correspondence_randomness, fields::at_least(3));
+    f("gicp_covariances_from_normals", s.gicp_covariances_from_normals);
+    f("crop_margin_mm", s.crop_margin_mm);
+    f("normal_neighbours", s.normal_neighbours, fields::at_least(3));
+  }
+  void validate(const YamlNode& node) const {
+    if (ndt_outlier_ratio >= 1) node["ndt_outlier_ratio"].fail("must be below 1");
+  }
+};
 
 struct RefineResult {
   Pose T_cam_model;        // refined pose

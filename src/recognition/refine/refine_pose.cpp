@@ -1,7 +1,7 @@
 // refine_pose: the common frame, crop and bookkeeping around the PCL
-// registration methods (one .cpp per method: refine_icp.cpp,
-// refine_icp_lm.cpp, refine_icp_plane.cpp, refine_gicp.cpp, refine_ndt.cpp),
-// and parse_refine. See refine_internal.h for the frame and units.
+// registration methods (one .cpp per method: icp.cpp, icp_lm.cpp,
+// icp_plane.cpp, gicp.cpp, ndt.cpp; listed in registry.cpp). See internal.h
+// for the frame and units.
 #include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_types.h>
 
@@ -11,32 +11,19 @@
 #include <limits>
 
 #include "core/error.h"
-#include "recognition/refine/refine.h"
+#include "recognition/pcl_adapter.h"
 #include "recognition/refine/internal.h"
+#include "recognition/refine/refine.h"
+#include "recognition/registry.h"
 
 namespace pb {
-
-namespace {
-
-pcl::PointCloud<pcl::PointXYZ>::Ptr to_pcl(const std::vector<Vec3f>& pts) {
-  pcl::PointCloud<pcl::PointXYZ>::Ptr c(new pcl::PointCloud<pcl::PointXYZ>);
-  c->resize(pts.size());
-  for (size_t i = 0; i < pts.size(); ++i) (*c)[i].getVector3fMap() = pts[i];
-  return c;
-}
-
-bool needs_normals(const std::string& method, const RefineSettings& s) {
-  return method == "icp_plane" || (method == "gicp" && s.gicp_covariances_from_normals);
-}
-
-}  // namespace
 
 namespace refine_detail {
 
 std::vector<Vec3f> estimate_normals(const std::vector<Vec3f>& pts, int k) {
   std::vector<Vec3f> normals(pts.size(), Vec3f(0, 0, 1));
   if (pts.size() < 3) return normals;
-  auto cloud = to_pcl(pts);
+  auto cloud = pcl_adapter::xyz(pts);
   pcl::KdTreeFLANN<pcl::PointXYZ> tree;
   tree.setInputCloud(cloud);
   const int kk = std::max(3, std::min<int>(k, static_cast<int>(pts.size())));
@@ -62,19 +49,13 @@ std::vector<Vec3f> estimate_normals(const std::vector<Vec3f>& pts, int k) {
 
 RefineResult refine_pose(const std::string& method, const PointSet& model, const PointSet& scene,
                          const Pose& init, const RefineSettings& s, uint64_t seed) {
-  static const char* kMethods[] = {"none", "icp", "icp_lm", "icp_plane", "gicp", "ndt"};
-  if (std::find_if(std::begin(kMethods), std::end(kMethods),
-                   [&](const char* m) { return method == m; }) == std::end(kMethods))
-    throw InputError("", "refinement",
-                     "unknown refinement method '" + method +
-                         "' (known: none, icp, icp_lm, icp_plane, gicp, ndt)");
+  const RefinementEntry& entry = refinement_entry(method);
 
   RefineResult res;
   res.T_cam_model = init;
   const double max_corr = s.max_correspondence_mm;
   res.fitness = max_corr * max_corr;
   if (model.empty() || scene.empty()) return res;
-
   // Model at the initial pose (camera frame, mm), its centre and radius.
   std::vector<Eigen::Vector3d> moved(model.size());
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
@@ -109,8 +90,8 @@ RefineResult refine_pose(const std::string& method, const PointSet& model, const
   p.tgt.reserve(crop.size());
   for (size_t i : crop) p.tgt.push_back(((scene.points[i].cast<double>() - c) * 1e-3).cast<float>());
 
-  if (method != "none") {
-    if (needs_normals(method, s)) {
+  if (entry.run) {
+    if (entry.needs_normals(s)) {
       if (model.has_normals()) {
         p.src_normals.reserve(model.size());
         for (const auto& n : model.normals) p.src_normals.push_back((init.R * n.cast<double>()).cast<float>());
@@ -124,13 +105,7 @@ RefineResult refine_pose(const std::string& method, const PointSet& model, const
         p.tgt_normals = refine_detail::estimate_normals(p.tgt, s.normal_neighbours);
       }
     }
-    refine_detail::Outcome o;
-    if (method == "icp") o = refine_detail::run_icp(p, s, seed);
-    else if (method == "icp_lm") o = refine_detail::run_icp_lm(p, s);
-    else if (method == "icp_plane") o = refine_detail::run_icp_plane(p, s);
-    else if (method == "gicp") o = refine_detail::run_gicp(p, s);
-    else o = refine_detail::run_ndt(p, s);
-
+    const refine_detail::Outcome o = entry.run(p, s, seed);
     const Eigen::Matrix4d D = o.delta.cast<double>();
     if (D.allFinite()) {
       // Re-orthonormalize the float rotation (SVD projection onto SO(3)).
@@ -155,7 +130,7 @@ RefineResult refine_pose(const std::string& method, const PointSet& model, const
   // Fitness: mean squared distance (mm^2) of the model points to their
   // nearest cropped scene point, over pairs within max_correspondence_mm.
   {
-    auto tgt = to_pcl(p.tgt);
+    auto tgt = pcl_adapter::xyz(p.tgt);
     pcl::KdTreeFLANN<pcl::PointXYZ> tree;
     tree.setInputCloud(tgt);
     pcl::Indices idx(1);
@@ -177,40 +152,6 @@ RefineResult refine_pose(const std::string& method, const PointSet& model, const
     if (n > 0) res.fitness = sum / static_cast<double>(n);
   }
   return res;
-}
-
-void parse_refine(const YamlNode& node, RefineSettings& s) {
-  if (!node.defined()) return;
-  node.check_keys({"max_iterations", "max_correspondence_mm", "transformation_epsilon",
-                   "rotation_epsilon_deg", "fitness_epsilon", "reciprocal_correspondences", "icp_sample_points",
-                   "ndt_resolution_mm", "ndt_resolution_fraction", "ndt_step_size_mm",
-                   "ndt_outlier_ratio", "ndt_min_points_per_cell", "gicp_correspondence_randomness",
-                   "gicp_covariances_from_normals", "crop_margin_mm", "normal_neighbours"});
-  auto positive_int = [&](const std::string& key, int& v, int min_value) {
-    if (!node.has(key)) return;
-    const int x = node.get<int>(key);
-    if (x < min_value) node[key].fail("must be at least " + std::to_string(min_value) + ", got " + std::to_string(x));
-    v = x;
-  };
-  positive_int("max_iterations", s.max_iterations, 1);
-  s.max_correspondence_mm = node.get_positive("max_correspondence_mm", s.max_correspondence_mm);
-  s.transformation_epsilon = node.get_nonnegative("transformation_epsilon", s.transformation_epsilon);
-  s.rotation_epsilon_deg = node.get_nonnegative("rotation_epsilon_deg", s.rotation_epsilon_deg);
-  s.fitness_epsilon = node.get_nonnegative("fitness_epsilon", s.fitness_epsilon);
-  node.read("reciprocal_correspondences", s.reciprocal_correspondences);
-  positive_int("icp_sample_points", s.icp_sample_points, 0);
-  s.ndt_resolution_mm = node.get_positive("ndt_resolution_mm", s.ndt_resolution_mm);
-  s.ndt_resolution_fraction = node.get_nonnegative("ndt_resolution_fraction", s.ndt_resolution_fraction);
-  s.ndt_step_size_mm = node.get_positive("ndt_step_size_mm", s.ndt_step_size_mm);
-  s.ndt_outlier_ratio = node.get_positive("ndt_outlier_ratio", s.ndt_outlier_ratio);
-  if (s.ndt_outlier_ratio >= 1) node["ndt_outlier_ratio"].fail("must be below 1");
-  positive_int("ndt_min_points_per_cell", s.ndt_min_points_per_cell, 3);
-  s.gicp_correspondence_randomness =
-      node.get_positive("gicp_correspondence_randomness", s.gicp_correspondence_randomness);
-  if (s.gicp_correspondence_randomness < 3) node["gicp_correspondence_randomness"].fail("must be at least 3");
-  node.read("gicp_covariances_from_normals", s.gicp_covariances_from_normals);
-  if (node.has("crop_margin_mm")) s.crop_margin_mm = node.get<double>("crop_margin_mm");
-  positive_int("normal_neighbours", s.normal_neighbours, 3);
 }
 
 }  // namespace pb

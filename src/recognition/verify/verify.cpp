@@ -12,17 +12,6 @@
 
 namespace pb {
 
-void parse_verify(const YamlNode& node, VerifySettings& s) {
-  if (!node.defined()) return;
-  node.check_keys({"inlier_threshold_mm", "min_inlier_fraction", "inlier_model"});
-  s.inlier_model = node.get_or<std::string>("inlier_model", s.inlier_model);
-  if (s.inlier_model != "view" && s.inlier_model != "merged")
-    node["inlier_model"].fail("must be 'view' or 'merged', got '" + s.inlier_model + "'");
-  s.inlier_threshold_mm = node.get_positive("inlier_threshold_mm", s.inlier_threshold_mm);
-  s.min_inlier_fraction = node.get_nonnegative("min_inlier_fraction", s.min_inlier_fraction);
-  if (s.min_inlier_fraction > 1) node["min_inlier_fraction"].fail("must be in [0, 1]");
-}
-
 struct PointIndex::Impl {
   pcl::PointCloud<pcl::PointXYZ>::Ptr cloud{new pcl::PointCloud<pcl::PointXYZ>};
   pcl::KdTreeFLANN<pcl::PointXYZ> tree{true};  // sorted radius results

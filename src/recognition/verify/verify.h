@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "core/types.h"
-#include "core/yaml.h"
+#include "core/settings_fields.h"
 #include "recognition/cloud.h"
 
 namespace pb {
@@ -24,9 +24,14 @@ struct VerifySettings {
   // (voxelized), the same cloud for every hypothesis, so counts compare
   // fairly across views (a flipped pose from a larger view no longer wins).
   std::string inlier_model = "view";
-};
 
-void parse_verify(const YamlNode& node, VerifySettings& s);
+  template <class S, class F>
+  static void fields(S& s, F& f) {
+    f("inlier_threshold_mm", s.inlier_threshold_mm, fields::positive());
+    f("min_inlier_fraction", s.min_inlier_fraction, fields::in_range(0, 1));
+    f("inlier_model", s.inlier_model, fields::one_of({"view", "merged"}));
+  }
+};
 
 // A kd-tree over 3D points (PCL inside), for nearest neighbour queries.
 class PointIndex {

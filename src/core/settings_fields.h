@@ -1,0 +1,127 @@
+// One list of fields per settings struct, from which the YAML parser (with
+// unknown keys rejected), the key list and the JSON form all derive, so a
+// field is declared once (with its comment) and listed once:
+//
+//   struct PreprocessSettings {
+//     double voxel_mm = 10.0;  // downsampling voxel
+//     template <class S, class F> static void fields(S& s, F& f) {
+//       f("voxel_mm", s.voxel_mm, fields::nonnegative());
+//     }
+//     void validate(const YamlNode& node) const;  // optional: checks across fields
+//   };
+//
+//   parse_section(node, settings);      // YAML section -> struct
+//   section_json(settings);             // struct -> ordered JSON (records, cache keys)
+//
+// The rules give the messages the project's parsers always gave ("must be
+// positive, got -3", "must be in [0, 1]", ...), with file, line and key
+// through YamlNode::fail.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <set>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "core/yaml.h"
+
+namespace pb {
+namespace fields {
+
+struct Rule {
+  enum Kind { kAny, kPositive, kNonnegative, kAtLeast, kRange, kOneOf } kind = kAny;
+  double lo = 0, hi = 0;
+  std::vector<std::string> names;  // kOneOf
+  double max = 0;                  // > 0: also "must be at most max" (kPositive, kNonnegative)
+  std::string unit;                // appended to "at most" messages, e.g. " degrees"
+};
+
+inline Rule any() { return {}; }
+inline Rule positive(double max = 0, std::string unit = "") { return {Rule::kPositive, 0, 0, {}, max, unit}; }
+inline Rule nonnegative(double max = 0, std::string unit = "") {
+  return {Rule::kNonnegative, 0, 0, {}, max, unit};
+}
+inline Rule at_least(double lo, double max = 0) { return {Rule::kAtLeast, lo, 0, {}, max, ""}; }
+inline Rule in_range(double lo, double hi) { return {Rule::kRange, lo, hi, {}, 0, ""}; }
+inline Rule one_of(std::vector<std::string> names) { return {Rule::kOneOf, 0, 0, std::move(names), 0, ""}; }
+
+// Checks a read value; fails at `node` (the field's node).
+void check(const YamlNode& node, double v, const Rule& r);
+void check(const YamlNode& node, const std::string& v, const Rule& r);
+
+struct KeyLister {
+  std::set<std::string> keys;
+  template <typename T>
+  void operator()(const char* key, const T&, const Rule& = {}) {
+    keys.insert(key);
+  }
+};
+
+struct Reader {
+  const YamlNode& node;
+  template <typename T>
+  void operator()(const char* key, T& v, const Rule& r = {}) {
+    if (!node.has(key)) return;
+    const YamlNode n = node[key];
+    if constexpr (std::is_same_v<T, bool>) {
+      v = n.as<bool>();
+    } else if constexpr (std::is_same_v<T, std::string>) {
+      v = n.as<std::string>();
+      check(n, v, r);
+    } else if constexpr (std::is_integral_v<T>) {
+      v = n.as<T>();
+      check(n, static_cast<double>(v), r);
+    } else {
+      v = n.as<T>();
+      check(n, static_cast<double>(v), r);
+    }
+  }
+};
+
+struct JsonWriter {
+  nlohmann::ordered_json j = nlohmann::ordered_json::object();
+  template <typename T>
+  void operator()(const char* key, const T& v, const Rule& = {}) {
+    j[key] = v;
+  }
+};
+
+template <typename S, typename = void>
+struct has_validate : std::false_type {};
+template <typename S>
+struct has_validate<S, std::void_t<decltype(std::declval<const S&>().validate(std::declval<const YamlNode&>()))>>
+    : std::true_type {};
+
+}  // namespace fields
+
+// Reads a YAML section over `s` (fields not given keep their values).
+template <typename S>
+void parse_section(const YamlNode& node, S& s) {
+  if (!node.defined()) return;
+  fields::KeyLister keys;
+  S::fields(s, keys);
+  node.check_keys(keys.keys);
+  fields::Reader reader{node};
+  S::fields(s, reader);
+  if constexpr (fields::has_validate<S>::value) s.validate(node);
+}
+
+// Every field, in declaration order.
+template <typename S>
+nlohmann::ordered_json section_json(const S& s) {
+  fields::JsonWriter w;
+  S::fields(s, w);
+  return std::move(w.j);
+}
+
+template <typename S>
+std::set<std::string> section_keys() {
+  S s;
+  fields::KeyLister keys;
+  S::fields(s, keys);
+  return keys.keys;
+}
+
+}  // namespace pb

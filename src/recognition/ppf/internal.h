@@ -1,0 +1,74 @@
+// Private pieces of the PPF method (ppf/method.cpp, ppf/voting.cpp): the
+// pair feature table, the reference frames of PCL's PPF convention, voting
+// and pose clustering. Includes PCL (private to ppf/).
+#pragma once
+
+#include <pcl/features/ppf.h>
+#include <pcl/point_types.h>
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <tuple>
+#include <vector>
+
+#include "core/types.h"
+#include "recognition/cloud.h"
+#include "recognition/ppf/ppf.h"
+
+namespace pb::ppf {
+
+// One model pair in the feature table.
+struct PairEntry {
+  uint64_t key;
+  uint32_t ref, other;  // model reference point, second point
+  bool operator<(const PairEntry& o) const {
+    return std::tie(key, ref, other) < std::tie(o.key, o.ref, o.other);
+  }
+};
+
+// The discretized feature (PCL's floor(f / step), in float) packed into 64
+// bits, 16 per component (bin indices are clamped to +-32767).
+inline uint64_t feature_key(float f1, float f2, float f3, float f4, float angle_step, float distance_step) {
+  auto bin = [](float f, float step) {
+    const float b = std::floor(f / step);
+    const float c = std::max(-32767.f, std::min(32767.f, b));
+    return static_cast<uint64_t>(static_cast<int64_t>(c) + 32768) & 0xffffu;
+  };
+  return (bin(f1, angle_step) << 48) | (bin(f2, angle_step) << 32) | (bin(f3, angle_step) << 16) |
+         bin(f4, distance_step);
+}
+
+// The trained model: downsampled merged views (model frame, mm), the n x n
+// pair features (row = reference point) and the pairs sorted by feature key.
+struct Model {
+  std::vector<Vec3f> points, normals;
+  std::vector<pcl::PPFSignature> features;
+  std::vector<PairEntry> table;  // empty: nothing to match
+  float angle_step = 0, distance_step = 0, diameter = 0;
+};
+
+struct PoseVote {
+  Pose pose;
+  double votes = 0;
+};
+
+// Rigid transform taking point p to the origin and the unit normal n onto
+// +x (PCL's PPF convention).
+Eigen::Affine3f to_reference_frame(const Vec3f& p, const Vec3f& n);
+
+// Rotation angle of a point about +x in its reference frame, with the signs
+// of PCL's alpha_m / alpha_s (alpha = alpha_m - alpha_s aligns the model
+// pair with the scene pair).
+float pcl_alpha(const Eigen::Affine3f& T, const Vec3f& other);
+
+// The seeded subset of scene reference points (ascending indices).
+std::vector<int> reference_points(size_t n, double fraction, uint64_t seed);
+
+// One pose per reference point: the best accumulator cell of its votes.
+std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vector<int>& refs);
+
+// Greedy clustering, most votes first; the best max_hypotheses clusters as
+// hypotheses (mean translation, sign-aligned mean quaternion, summed votes).
+std::vector<Hypothesis> cluster_poses(std::vector<PoseVote> poses, const PpfSettings& s);
+
+}  // namespace pb::ppf

@@ -1,0 +1,171 @@
+#include "recognition/preprocess/voxel_grid.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+namespace pb {
+
+namespace {
+
+using Key = std::array<int64_t, 3>;  // cell index, in sort priority order
+
+struct KeyHash {
+  size_t operator()(const Key& k) const {
+    uint64_t h = 1469598103934665603ull;  // mixing only (not persisted)
+    for (int64_t v : k) h = (h ^ static_cast<uint64_t>(v)) * 1099511628211ull;
+    return static_cast<size_t>(h);
+  }
+};
+
+// Points grouped by cell: cell_of[i] (or -1), cells in output order, the
+// first point of each cell and its count.
+struct Cells {
+  std::vector<int> cell_of;
+  std::vector<int> first, count;
+  size_t size() const { return first.size(); }
+};
+
+Cells group(const std::vector<Vec3f>& pts, const VoxelGridOptions& opt) {
+  const size_t n = pts.size();
+  const double inv = 1.0 / opt.leaf_mm;
+  Cells c;
+  c.cell_of.assign(n, -1);
+  std::unordered_map<Key, int, KeyHash> slot;
+  slot.reserve(n / 8 + 16);
+  std::vector<Key> keys;
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3f& p = pts[i];
+    if (!p.allFinite()) continue;
+    int64_t a[3];
+    for (int d = 0; d < 3; ++d)
+      a[d] = static_cast<int64_t>(opt.cell_index == VoxelGridOptions::CellIndex::kDivide ? std::floor(p[d] / opt.leaf_mm)
+                                                                                       : std::floor(p[d] * inv));
+    const Key k = opt.order == VoxelGridOptions::Order::kZYX ? Key{a[2], a[1], a[0]} : Key{a[0], a[1], a[2]};
+    auto [it, fresh] = slot.emplace(k, static_cast<int>(keys.size()));
+    if (fresh) {
+      keys.push_back(k);
+      c.first.push_back(static_cast<int>(i));
+      c.count.push_back(0);
+    }
+    ++c.count[static_cast<size_t>(it->second)];
+    c.cell_of[i] = it->second;
+  }
+  // Renumber the cells in key order.
+  std::vector<int> order(keys.size());
+  for (size_t k = 0; k < order.size(); ++k) order[k] = static_cast<int>(k);
+  std::sort(order.begin(), order.end(), [&](int x, int y) { return keys[x] < keys[y]; });
+  std::vector<int> rank(order.size());
+  for (size_t r = 0; r < order.size(); ++r) rank[static_cast<size_t>(order[r])] = static_cast<int>(r);
+  Cells out;
+  out.cell_of.assign(n, -1);
+  out.first.resize(order.size());
+  out.count.resize(order.size());
+  for (size_t r = 0; r < order.size(); ++r) {
+    out.first[r] = c.first[static_cast<size_t>(order[r])];
+    out.count[r] = c.count[static_cast<size_t>(order[r])];
+  }
+  for (size_t i = 0; i < n; ++i)
+    if (c.cell_of[i] >= 0) out.cell_of[i] = rank[static_cast<size_t>(c.cell_of[i])];
+  return out;
+}
+
+// Centroids accumulated in input order (double).
+std::vector<Vec3> centroids(const std::vector<Vec3f>& pts, const Cells& c) {
+  std::vector<Vec3> sum(c.size(), Vec3::Zero());
+  for (size_t i = 0; i < pts.size(); ++i)
+    if (c.cell_of[i] >= 0) sum[static_cast<size_t>(c.cell_of[i])] += pts[i].cast<double>();
+  for (size_t k = 0; k < c.size(); ++k) sum[k] /= static_cast<double>(c.count[k]);
+  return sum;
+}
+
+}  // namespace
+
+PointSet voxel_downsample(const PointSet& in, const VoxelGridOptions& opt) {
+  if (!(opt.leaf_mm > 0) || in.points.empty()) return in;
+  const size_t n = in.points.size();
+  const bool has_n = in.normals.size() == n, has_c = in.curvature.size() == n, has_px = in.pixel.size() == n;
+  const Cells c = group(in.points, opt);
+  const std::vector<Vec3> centroid = centroids(in.points, c);
+  std::vector<Vec3> nsum(has_n ? c.size() : 0, Vec3::Zero());
+  std::vector<double> csum(has_c ? c.size() : 0, 0.0);
+  std::vector<int> best_px(has_px ? c.size() : 0, -1);
+  std::vector<double> best_d(has_px ? c.size() : 0, std::numeric_limits<double>::infinity());
+  for (size_t i = 0; i < n; ++i) {
+    const int k = c.cell_of[i];
+    if (k < 0) continue;
+    if (has_n) nsum[static_cast<size_t>(k)] += in.normals[i].cast<double>();
+    if (has_c) csum[static_cast<size_t>(k)] += in.curvature[i];
+    if (has_px) {  // the point nearest the centroid; ties: the smaller pixel
+      const double d = (in.points[i].cast<double>() - centroid[static_cast<size_t>(k)]).squaredNorm();
+      const int px = in.pixel[i];
+      if (d < best_d[static_cast<size_t>(k)] || (d == best_d[static_cast<size_t>(k)] && px < best_px[static_cast<size_t>(k)])) {
+        best_d[static_cast<size_t>(k)] = d;
+        best_px[static_cast<size_t>(k)] = px;
+      }
+    }
+  }
+  PointSet out;
+  out.source_width = in.source_width;
+  out.source_height = in.source_height;
+  out.points.reserve(c.size());
+  for (size_t k = 0; k < c.size(); ++k) {
+    if (has_n) {
+      const double l = nsum[k].norm();
+      if (opt.drop_cancelled_normals > 0 && !(l > opt.drop_cancelled_normals * c.count[k])) continue;
+      out.normals.push_back(l > 0 ? Vec3f((nsum[k] / l).cast<float>()) : in.normals[static_cast<size_t>(c.first[k])]);
+    }
+    out.points.push_back(centroid[k].cast<float>());
+    if (has_c) out.curvature.push_back(static_cast<float>(csum[k] / c.count[k]));
+    if (has_px) out.pixel.push_back(best_px[k]);
+  }
+  return out;
+}
+
+std::vector<int> voxel_nearest_points(const PointSet& in, const VoxelGridOptions& opt) {
+  std::vector<int> out;
+  if (in.empty() || !(opt.leaf_mm > 0)) return out;
+  const Cells c = group(in.points, opt);
+  const std::vector<Vec3> centroid = centroids(in.points, c);
+  out.assign(c.size(), -1);
+  std::vector<double> best(c.size(), std::numeric_limits<double>::max());
+  for (size_t i = 0; i < in.points.size(); ++i) {  // input order: ties -> lowest index
+    const int k = c.cell_of[i];
+    if (k < 0) continue;
+    const double d = (in.points[i].cast<double>() - centroid[static_cast<size_t>(k)]).squaredNorm();
+    if (d < best[static_cast<size_t>(k)]) {
+      best[static_cast<size_t>(k)] = d;
+      out[static_cast<size_t>(k)] = static_cast<int>(i);
+    }
+  }
+  return out;
+}
+
+PointSet voxel_downsample_to(const PointSet& in, int target, const VoxelGridOptions& base) {
+  VoxelGridOptions o = base;
+  auto grid = [&](double leaf) {
+    o.leaf_mm = leaf;
+    return voxel_downsample(in, o);
+  };
+  if (in.points.size() <= static_cast<size_t>(target)) return grid(1e-3);
+  Eigen::AlignedBox3f box;
+  for (const auto& p : in.points) box.extend(p);
+  double lo = 1e-3, hi = std::max(1e-2, static_cast<double>(box.diagonal().norm()));
+  PointSet best = grid(hi);
+  for (int it = 0; it < 30; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    PointSet c = grid(mid);
+    if (c.points.size() <= static_cast<size_t>(target)) {
+      hi = mid;
+      best = std::move(c);
+    } else {
+      lo = mid;
+    }
+  }
+  return best;
+}
+
+}  // namespace pb

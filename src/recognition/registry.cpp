@@ -1,0 +1,84 @@
+// The registry: descriptor methods (each built with its own settings
+// section) and refinement methods, by name.
+#include "recognition/registry.h"
+
+#include <algorithm>
+
+#include "core/error.h"
+#include "recognition/settings.h"
+
+namespace pb {
+
+const std::vector<DescriptorEntry>& descriptor_registry() {
+  static const std::vector<DescriptorEntry> v = {
+      {"fpfh", "local", [](const RecognitionSettings& s) { return make_fpfh_method(s.local); }},
+      {"shot", "local", [](const RecognitionSettings& s) { return make_shot_method(s.local); }},
+      {"cvfh", "global", [](const RecognitionSettings& s) { return make_cvfh_method(s.global); }},
+      {"esf", "global", [](const RecognitionSettings& s) { return make_esf_method(s.global); }},
+      {"cesf", "global", [](const RecognitionSettings& s) { return make_cesf_method(s.global); }},
+      {"ourcvfh", "global", [](const RecognitionSettings& s) { return make_ourcvfh_method(s.global); }},
+      {"ppf", "ppf", [](const RecognitionSettings& s) { return make_ppf_method(s.ppf); }},
+  };
+  return v;
+}
+
+const std::vector<RefinementEntry>& refinement_registry() {
+  using namespace refine_detail;
+  auto no = [](const RefineSettings&) { return false; };
+  static const std::vector<RefinementEntry> v = {
+      {"none", no, nullptr},
+      {"icp", no, run_icp},
+      {"icp_lm", no, run_icp_lm},
+      {"icp_plane", [](const RefineSettings&) { return true; }, run_icp_plane},
+      {"gicp", [](const RefineSettings& s) { return s.gicp_covariances_from_normals; }, run_gicp},
+      {"ndt", no, run_ndt},
+  };
+  return v;
+}
+
+namespace {
+
+template <typename E>
+std::vector<std::string> names_of(const std::vector<E>& v) {
+  std::vector<std::string> n;
+  for (const auto& e : v) n.push_back(e.name);
+  return n;
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+
+template <typename E>
+const E& find_entry(const std::vector<E>& v, const std::string& name, const std::string& file,
+                    const std::string& field, const char* what) {
+  for (const auto& e : v)
+    if (e.name == name) return e;
+  throw InputError(file, field, std::string("unknown ") + what + " '" + name + "' (allowed: " + join(names_of(v)) + ")");
+}
+
+}  // namespace
+
+std::vector<std::string> descriptor_names() { return names_of(descriptor_registry()); }
+std::vector<std::string> refinement_names() { return names_of(refinement_registry()); }
+
+const DescriptorEntry& descriptor_entry(const std::string& name, const std::string& file, const std::string& field) {
+  return find_entry(descriptor_registry(), name, file, field, "descriptor");
+}
+
+const RefinementEntry& refinement_entry(const std::string& name, const std::string& file, const std::string& field) {
+  return find_entry(refinement_registry(), name, file, field, "refinement");
+}
+
+std::string check_name(const YamlNode& node, const std::vector<std::string>& allowed) {
+  const std::string v = node.as<std::string>();
+  if (std::find(allowed.begin(), allowed.end(), v) == allowed.end())
+    node.fail("unknown name '" + v + "' (allowed: " + join(allowed) + ")");
+  return v;
+}
+
+std::unique_ptr<Method> make_method(const RecognitionSettings& s) { return descriptor_entry(s.descriptor).make(s); }
+
+}  // namespace pb

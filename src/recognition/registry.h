@@ -1,0 +1,46 @@
+// The method registry: every descriptor method and every refinement method
+// by name, listed in one place (registry.cpp), so one binary covers them all
+// and a config selects them. PCL-free.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/yaml.h"
+#include "recognition/method.h"
+#include "recognition/refine/internal.h"
+
+namespace pb {
+
+struct RecognitionSettings;
+
+struct DescriptorEntry {
+  std::string name;
+  std::string section;  // the settings section the method reads ("local", "global", "ppf")
+  std::unique_ptr<Method> (*make)(const RecognitionSettings& s);  // passes that section alone
+};
+
+struct RefinementEntry {
+  std::string name;
+  bool (*needs_normals)(const RefineSettings& s);  // both clouds need normals (plane metrics)
+  // Aligns p.src to p.tgt (refine/internal.h); null for "none".
+  refine_detail::Outcome (*run)(const refine_detail::Problem& p, const RefineSettings& s, uint64_t seed);
+};
+
+const std::vector<DescriptorEntry>& descriptor_registry();
+const std::vector<RefinementEntry>& refinement_registry();
+std::vector<std::string> descriptor_names();
+std::vector<std::string> refinement_names();
+
+// Lookups: InputError(file, field) naming the allowed names when unknown.
+const DescriptorEntry& descriptor_entry(const std::string& name, const std::string& file = "",
+                                        const std::string& field = "descriptor");
+const RefinementEntry& refinement_entry(const std::string& name, const std::string& file = "",
+                                        const std::string& field = "refinement");
+// The node's string if it is one of `allowed`, else fails at the node.
+std::string check_name(const YamlNode& node, const std::vector<std::string>& allowed);
+
+std::unique_ptr<Method> make_method(const RecognitionSettings& s);  // for s.descriptor
+
+}  // namespace pb
