@@ -66,10 +66,10 @@ const Fixture& fixture() {
 }
 
 std::unique_ptr<Method> make(const std::string& name) {
-  if (name == "cvfh") return make_cvfh_method();
-  if (name == "esf") return make_esf_method();
-  if (name == "cesf") return make_cesf_method();
-  return make_ourcvfh_method();
+  if (name == "cvfh") return make_cvfh_method(fixture().s.global);
+  if (name == "esf") return make_esf_method(fixture().s.global);
+  if (name == "cesf") return make_cesf_method(fixture().s.global);
+  return make_ourcvfh_method(fixture().s.global);
 }
 
 void BM_Preprocess(benchmark::State& state) {
@@ -124,7 +124,7 @@ void BM_Train(benchmark::State& state, const std::string& name) {
   const Fixture& f = fixture();
   for (auto _ : state) {
     auto m = make(name);
-    m->train(f.views, f.s);
+    m->train(f.views, f.s.seed);
   }
   state.counters["views"] = static_cast<double>(f.views.size());
 }
@@ -133,7 +133,7 @@ void BM_Train(benchmark::State& state, const std::string& name) {
 void BM_Online(benchmark::State& state, const std::string& name) {
   const Fixture& f = fixture();
   auto m = make(name);
-  m->train(f.views, f.s);
+  m->train(f.views, f.s.seed);
   const OrganizedCloud cloud = OrganizedCloud::from_depth(f.depth, f.K);
   StageTimes sum;
   double hyps = 0;
@@ -142,7 +142,7 @@ void BM_Online(benchmark::State& state, const std::string& name) {
     Timer timer;
     const PointSet scene = preprocess_scene(cloud, f.s.preprocess, 1);
     t.preprocess = timer.seconds();
-    auto h = m->hypothesize(scene, f.views, f.s, 2, t);
+    auto h = m->hypothesize(scene, f.views, 2, t);
     timer.reset();
     std::vector<Pose> refined;
     for (size_t i = 0; i < h.size(); ++i)

@@ -188,13 +188,13 @@ void BM_Hough(benchmark::State& state, int d) {
   state.counters["clusters"] = static_cast<double>(clusters);
 }
 
-std::unique_ptr<Method> make(int d) { return d == 0 ? make_fpfh_method() : make_shot_method(); }
+std::unique_ptr<Method> make(int d) { return d == 0 ? make_fpfh_method(fixture().s.local) : make_shot_method(fixture().s.local); }
 
 void BM_Train(benchmark::State& state, int d) {
   const Fixture& f = fixture();
   for (auto _ : state) {
     auto m = make(d);
-    m->train(f.views, f.s);
+    m->train(f.views, f.s.seed);
   }
   state.counters["views"] = static_cast<double>(f.views.size());
 }
@@ -203,7 +203,7 @@ void BM_Train(benchmark::State& state, int d) {
 void BM_Online(benchmark::State& state, int d) {
   const Fixture& f = fixture();
   auto m = make(d);
-  m->train(f.views, f.s);
+  m->train(f.views, f.s.seed);
   const OrganizedCloud cloud = OrganizedCloud::from_depth(f.depth, f.K);
   StageTimes sum;
   double hyps = 0;
@@ -212,7 +212,7 @@ void BM_Online(benchmark::State& state, int d) {
     Timer timer;
     const PointSet scene = preprocess_scene(cloud, f.s.preprocess, 1);
     t.preprocess = timer.seconds();
-    auto h = m->hypothesize(scene, f.views, f.s, 2, t);
+    auto h = m->hypothesize(scene, f.views, 2, t);
     timer.reset();
     std::vector<Pose> refined;
     for (size_t i = 0; i < h.size(); ++i)

@@ -30,6 +30,7 @@
 #include "eval/errors.h"
 #include "eval/symmetry.h"
 #include "recognition/pipeline.h"
+#include "../tests/recognition_train_util.h"
 #include "scenes/generator.h"
 #include "scenes/scene_config.h"
 
@@ -86,7 +87,7 @@ std::shared_ptr<const TrainedModel> trained(const std::string& descriptor) {
   static std::map<std::string, std::shared_ptr<const TrainedModel>> models;
   std::lock_guard<std::mutex> lock(mu);
   auto& m = models[descriptor];
-  if (!m) m = train_model(image().mesh, settings_for(descriptor), TrainOptions{"", "ls5"});
+  if (!m) m = test::train(image().mesh, settings_for(descriptor), TrainOptions{}, nullptr, "ls5");
   return m;
 }
 

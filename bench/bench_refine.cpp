@@ -82,8 +82,8 @@ void BM_PpfTrain(benchmark::State& state) {
   RecognitionSettings s = ppf_settings();
   s.ppf.model_points = static_cast<int>(state.range(0));
   for (auto _ : state) {
-    auto m = make_ppf_method();
-    m->train(ppf_views(), s);
+    auto m = make_ppf_method(s.ppf);
+    m->train(ppf_views(), s.seed);
     benchmark::DoNotOptimize(m);
   }
 }
@@ -92,15 +92,15 @@ BENCHMARK(BM_PpfTrain)->Arg(150)->Arg(300)->Arg(600)->Unit(benchmark::kMilliseco
 void BM_PpfMatch(benchmark::State& state) {
   const RecognitionSettings s = ppf_settings();
   static const std::unique_ptr<Method> m = [&] {
-    auto p = make_ppf_method();
-    p->train(ppf_views(), s);
+    auto p = make_ppf_method(s.ppf);
+    p->train(ppf_views(), s.seed);
     return p;
   }();
   const auto& c = registration_case(0);
   std::vector<Hypothesis> h;
   StageTimes t;
   for (auto _ : state) {
-    h = m->hypothesize(c.scene, ppf_views(), s, 1, t);
+    h = m->hypothesize(c.scene, ppf_views(), 1, t);
     benchmark::DoNotOptimize(h);
   }
   state.counters["scene_points"] = static_cast<double>(c.scene.size());

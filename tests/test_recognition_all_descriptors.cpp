@@ -27,6 +27,8 @@
 #include "core/yaml.h"
 #include "models/registry.h"
 #include "recognition/pipeline.h"
+#include "recognition/registry.h"
+#include "recognition_train_util.h"
 #include "scenes/generator.h"
 #include "scenes/scene_config.h"
 
@@ -137,7 +139,7 @@ class AllDescriptors : public ::testing::Test {
 
   // Trains once with `s`, recognizes every image, prints one line per image.
   static Outcome run(const RecognitionSettings& s, const std::string& label) {
-    const auto model = train_model(set_->mesh, s);
+    const auto model = test::train(set_->mesh, s);
     const TrainedModelInfo info = trained_model_info(*model);
     EXPECT_FALSE(info.empty) << label << ": " << info.empty_reason;
     Outcome o;

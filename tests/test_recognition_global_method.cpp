@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "core/error.h"
+#include "recognition/registry.h"
 #include "recognition/global/internal.h"
 #include "test_recognition_global_data.h"
 #include "test_recognition_global_util.h"
@@ -16,11 +17,11 @@ namespace {
 
 using namespace testing_global;
 
-std::unique_ptr<Method> make(const std::string& name) {
-  if (name == "cvfh") return make_cvfh_method();
-  if (name == "esf") return make_esf_method();
-  if (name == "cesf") return make_cesf_method();
-  return make_ourcvfh_method();
+std::unique_ptr<Method> make(const std::string& name, const GlobalSettings& g = {}) {
+  if (name == "cvfh") return make_cvfh_method(g);
+  if (name == "esf") return make_esf_method(g);
+  if (name == "cesf") return make_cesf_method(g);
+  return make_ourcvfh_method(g);
 }
 
 bool same(const std::vector<Hypothesis>& a, const std::vector<Hypothesis>& b) {
@@ -62,9 +63,9 @@ TEST_P(GlobalMethod, SaveLoadDeterminismThreads) {
   s.descriptor = GetParam();
   auto m = make(GetParam());
   EXPECT_EQ(m->name(), GetParam());
-  m->train(*views_, s);
+  m->train(*views_, s.seed);
   StageTimes t;
-  const auto h1 = m->hypothesize(*scene_, *views_, s, 11, t);
+  const auto h1 = m->hypothesize(*scene_, *views_, 11, t);
   ASSERT_FALSE(h1.empty());
   EXPECT_LE(h1.size(), static_cast<size_t>(s.global.top_k * s.global.crh_max_peaks));
   for (const auto& h : h1) {
@@ -79,30 +80,33 @@ TEST_P(GlobalMethod, SaveLoadDeterminismThreads) {
   EXPECT_GT(t.describe, 0.0);
 
   // Same call again: bit for bit.
-  EXPECT_TRUE(same(h1, m->hypothesize(*scene_, *views_, s, 11, t)));
+  EXPECT_TRUE(same(h1, m->hypothesize(*scene_, *views_, 11, t)));
 
   // Saved and loaded into a fresh method: the same hypotheses.
-  std::stringstream buf;
+  BinaryWriter buf;
   m->save(buf);
   auto m2 = make(GetParam());
-  m2->load(buf);
-  EXPECT_TRUE(same(h1, m2->hypothesize(*scene_, *views_, s, 11, t)));
+  BinaryReader in(buf.buffer(), "test");
+  m2->load(in);
+  EXPECT_TRUE(in.at_end());
+  EXPECT_TRUE(same(h1, m2->hypothesize(*scene_, *views_, 11, t)));
   // A state of another method is refused with a clear error.
-  std::stringstream buf2(buf.str());
+  BinaryReader in2(buf.buffer(), "test");
   auto other = make(GetParam() == "cvfh" ? "esf" : "cvfh");
-  EXPECT_THROW(other->load(buf2), InputError);
-  std::stringstream junk("not a state");
-  EXPECT_THROW(m2->load(junk), InputError);
+  EXPECT_THROW(other->load(in2), BinaryError);
+  const std::string junk = "not a state";
+  BinaryReader junk_in(junk, "test");
+  EXPECT_THROW(m2->load(junk_in), BinaryError);
 
   // Two threads on the same const method at once.
   std::vector<Hypothesis> a, b;
   std::thread ta([&] {
     StageTimes tt;
-    a = m->hypothesize(*scene_, *views_, s, 11, tt);
+    a = m->hypothesize(*scene_, *views_, 11, tt);
   });
   std::thread tb([&] {
     StageTimes tt;
-    b = m->hypothesize(*scene_, *views_, s, 11, tt);
+    b = m->hypothesize(*scene_, *views_, 11, tt);
   });
   ta.join();
   tb.join();
@@ -113,9 +117,9 @@ TEST_P(GlobalMethod, SaveLoadDeterminismThreads) {
 TEST_P(GlobalMethod, DegenerateScenesGiveNoHypothesis) {
   RecognitionSettings s;
   auto m = make(GetParam());
-  m->train(*views_, s);
+  m->train(*views_, s.seed);
   StageTimes t;
-  EXPECT_TRUE(m->hypothesize(PointSet{}, *views_, s, 1, t).empty());
+  EXPECT_TRUE(m->hypothesize(PointSet{}, *views_, 1, t).empty());
   // A handful of points: below the cluster size, no crash.
   PointSet few;
   for (int i = 0; i < 5; ++i) {
@@ -123,14 +127,14 @@ TEST_P(GlobalMethod, DegenerateScenesGiveNoHypothesis) {
     few.normals.emplace_back(0.f, 0.f, -1.f);
     few.curvature.push_back(0.f);
   }
-  EXPECT_TRUE(m->hypothesize(few, *views_, s, 1, t).empty());
+  EXPECT_TRUE(m->hypothesize(few, *views_, 1, t).empty());
   // Points without normals.
   PointSet bare;
   for (int i = 0; i < 200; ++i) bare.points.emplace_back(static_cast<float>(i % 20), static_cast<float>(i / 20), 500.f);
-  m->hypothesize(bare, *views_, s, 1, t);  // any outcome but a crash
+  m->hypothesize(bare, *views_, 1, t);  // any outcome but a crash
   // An untrained method has nothing to match.
   auto empty = make(GetParam());
-  EXPECT_TRUE(empty->hypothesize(*scene_, *views_, s, 1, t).empty());
+  EXPECT_TRUE(empty->hypothesize(*scene_, *views_, 1, t).empty());
 }
 
 INSTANTIATE_TEST_SUITE_P(All, GlobalMethod, ::testing::Values("cvfh", "esf", "cesf", "ourcvfh"));
@@ -152,7 +156,7 @@ TEST(GlobalRegions, StableRegionsMatchPclCvfh) {
 
 TEST(GlobalSettingsYaml, ParsesAndRejects) {
   GlobalSettings g;
-  parse_global(YamlNode::load_string("top_k: 7\nskip_crh: true\ncrh_max_peaks: 2\nesf_samples: 5000\n", "g.yaml"), g);
+  parse_section(YamlNode::load_string("top_k: 7\nskip_crh: true\ncrh_max_peaks: 2\nesf_samples: 5000\n", "g.yaml"), g);
   EXPECT_EQ(g.top_k, 7);
   EXPECT_TRUE(g.skip_crh);
   EXPECT_EQ(g.crh_max_peaks, 2);
@@ -160,7 +164,7 @@ TEST(GlobalSettingsYaml, ParsesAndRejects) {
   auto msg = [](const std::string& text) {
     GlobalSettings x;
     try {
-      parse_global(YamlNode::load_string(text, "bad.yaml"), x);
+      parse_section(YamlNode::load_string(text, "bad.yaml"), x);
     } catch (const InputError& e) {
       return std::string(e.what());
     }

@@ -14,6 +14,7 @@
 #include "core/timer.h"
 #include "recognition/refine/refine.h"
 #include "recognition/verify/verify.h"
+#include "recognition/registry.h"
 #include "test_recognition_global_util.h"
 
 namespace pb {
@@ -63,11 +64,8 @@ Outcome evaluate(const std::string& descriptor, const Mesh& mesh, RecognitionSet
                  const std::vector<Pose>& poses) {
   s.descriptor = descriptor;
   const std::vector<ViewData> views = training_views(mesh, s);
-  std::unique_ptr<Method> method = descriptor == "cvfh"  ? make_cvfh_method()
-                                   : descriptor == "esf"  ? make_esf_method()
-                                   : descriptor == "cesf" ? make_cesf_method()
-                                                          : make_ourcvfh_method();
-  method->train(views, s);
+  std::unique_ptr<Method> method = make_method(s);
+  method->train(views, s.seed);
   // The model clouds of the views (model frame), the refinement's sources.
   std::vector<PointSet> model_clouds;
   for (const auto& v : views) {
@@ -87,7 +85,7 @@ Outcome evaluate(const std::string& descriptor, const Mesh& mesh, RecognitionSet
     ++o.images;
     StageTimes times;
     Timer timer;
-    const auto hyps = method->hypothesize(scene, views, s, derive_seed(s.seed, {i}), times);
+    const auto hyps = method->hypothesize(scene, views, derive_seed(s.seed, {i}), times);
     o.seconds += timer.seconds();
     if (hyps.empty()) continue;
     ++o.with_hypothesis;

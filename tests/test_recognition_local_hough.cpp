@@ -151,8 +151,8 @@ TEST(LocalKeypoints, OnePerVoxelNearestCentroid) {
 
 class LocalMethodOnCopy : public ::testing::TestWithParam<std::string> {};
 
-std::unique_ptr<Method> local_method(const std::string& name) {
-  return name == "fpfh" ? make_fpfh_method() : make_shot_method();
+std::unique_ptr<Method> local_method(const std::string& name, const LocalSettings& s) {
+  return name == "fpfh" ? make_fpfh_method(s) : make_shot_method(s);
 }
 
 TEST_P(LocalMethodOnCopy, FindsTransformSaveLoadAndThreads) {
@@ -166,12 +166,12 @@ TEST_P(LocalMethodOnCopy, FindsTransformSaveLoadAndThreads) {
   views[0].cloud = model;
   views[0].T_cam_model = Pose::identity();
 
-  auto m = local_method(GetParam());
-  ASSERT_EQ(m->name(), GetParam());
   s.local.threads = 1;
-  m->train(views, s);
+  auto m = local_method(GetParam(), s.local);
+  ASSERT_EQ(m->name(), GetParam());
+  m->train(views, s.seed);
   StageTimes times;
-  const std::vector<Hypothesis> h1 = m->hypothesize(scene, views, s, 1, times);
+  const std::vector<Hypothesis> h1 = m->hypothesize(scene, views, 1, times);
   ASSERT_FALSE(h1.empty());
   EXPECT_EQ(h1[0].view, 0);
   EXPECT_GE(h1[0].score, s.local.hough_min_votes);
@@ -182,13 +182,14 @@ TEST_P(LocalMethodOnCopy, FindsTransformSaveLoadAndThreads) {
   EXPECT_GT(times.describe, 0.0);
 
   // Save / load: same hypotheses bit for bit.
-  std::stringstream buf;
+  BinaryWriter buf;
   m->save(buf);
-  auto m2 = local_method(GetParam());
-  m2->load(buf);
   // Two threads: same hypotheses bit for bit.
   s.local.threads = 2;
-  const std::vector<Hypothesis> h2 = m2->hypothesize(scene, views, s, 1, times);
+  auto m2 = local_method(GetParam(), s.local);
+  BinaryReader in(buf.buffer(), "test");
+  m2->load(in);
+  const std::vector<Hypothesis> h2 = m2->hypothesize(scene, views, 1, times);
   ASSERT_EQ(h1.size(), h2.size());
   for (size_t i = 0; i < h1.size(); ++i) {
     EXPECT_EQ(h1[i].T_cam_model.matrix(), h2[i].T_cam_model.matrix());
@@ -196,17 +197,17 @@ TEST_P(LocalMethodOnCopy, FindsTransformSaveLoadAndThreads) {
   }
 
   // A corrupt cache is rejected, not silently used.
-  std::string bytes = buf.str();
-  std::stringstream cut(bytes.substr(0, bytes.size() / 2));
-  auto m3 = local_method(GetParam());
-  EXPECT_THROW(m3->load(cut), std::runtime_error);
+  const std::string cut = buf.buffer().substr(0, buf.buffer().size() / 2);
+  BinaryReader cut_in(cut, "test");
+  auto m3 = local_method(GetParam(), s.local);
+  EXPECT_THROW(m3->load(cut_in), std::runtime_error);
 
   // Concurrent calls on one trained method (const, thread-safe): the same
   // hypotheses as the sequential call.
   std::vector<Hypothesis> c1, c2;
   StageTimes t1, t2;
-  std::thread a([&] { c1 = m2->hypothesize(scene, views, s, 1, t1); });
-  std::thread b([&] { c2 = m2->hypothesize(scene, views, s, 1, t2); });
+  std::thread a([&] { c1 = m2->hypothesize(scene, views, 1, t1); });
+  std::thread b([&] { c2 = m2->hypothesize(scene, views, 1, t2); });
   a.join();
   b.join();
   ASSERT_EQ(c1.size(), h1.size());
@@ -217,24 +218,24 @@ TEST_P(LocalMethodOnCopy, FindsTransformSaveLoadAndThreads) {
   }
 
   // Empty scene: no hypothesis, no crash.
-  EXPECT_TRUE(m->hypothesize(PointSet{}, views, s, 1, times).empty());
+  EXPECT_TRUE(m->hypothesize(PointSet{}, views, 1, times).empty());
 }
 
 INSTANTIATE_TEST_SUITE_P(Descriptors, LocalMethodOnCopy, ::testing::Values("fpfh", "shot"));
 
 TEST(LocalSettings, ParseAndReject) {
   LocalSettings s;
-  parse_local(YamlNode::load_string("keypoint_voxel_mm: 10\nmatches_per_keypoint: 3\nhough_interpolation: true\n",
+  parse_section(YamlNode::load_string("keypoint_voxel_mm: 10\nmatches_per_keypoint: 3\nhough_interpolation: true\n",
                                     "cfg.yaml"),
               s);
   EXPECT_EQ(s.keypoint_voxel_mm, 10.0);
   EXPECT_EQ(s.matches_per_keypoint, 3);
   EXPECT_TRUE(s.hough_interpolation);
-  EXPECT_THROW(parse_local(YamlNode::load_string("keypoint_voxl_mm: 10\n", "cfg.yaml"), s), InputError);
-  EXPECT_THROW(parse_local(YamlNode::load_string("hough_bin_mm: -5\n", "cfg.yaml"), s), InputError);
-  EXPECT_THROW(parse_local(YamlNode::load_string("max_hypotheses: 0\n", "cfg.yaml"), s), InputError);
+  EXPECT_THROW(parse_section(YamlNode::load_string("keypoint_voxl_mm: 10\n", "cfg.yaml"), s), InputError);
+  EXPECT_THROW(parse_section(YamlNode::load_string("hough_bin_mm: -5\n", "cfg.yaml"), s), InputError);
+  EXPECT_THROW(parse_section(YamlNode::load_string("max_hypotheses: 0\n", "cfg.yaml"), s), InputError);
   try {
-    parse_local(YamlNode::load_string("threads: -1\n", "cfg.yaml"), s);
+    parse_section(YamlNode::load_string("threads: -1\n", "cfg.yaml"), s);
     FAIL() << "no error";
   } catch (const InputError& e) {
     EXPECT_EQ(e.file(), "cfg.yaml");

@@ -16,6 +16,7 @@
 #include "core/yaml.h"
 #include "models/registry.h"
 #include "recognition/pipeline.h"
+#include "recognition_train_util.h"
 #include "scenes/generator.h"
 #include "scenes/scene_config.h"
 
@@ -82,7 +83,7 @@ std::string* LocalScenes::skip_reason_ = nullptr;
 TEST_P(LocalScenes, FindsThePoseInMostImages) {
   RecognitionSettings s;
   s.descriptor = GetParam();
-  const auto model = train_model(set_->mesh, s);
+  const auto model = test::train(set_->mesh, s);
   int correct = 0;
   for (size_t i = 0; i < set_->images.size(); ++i) {
     const GeneratedImage& im = set_->images[i];
@@ -102,7 +103,7 @@ TEST_P(LocalScenes, SamePoseWithOneAndTwoThreads) {
   RecognitionSettings s;
   s.descriptor = GetParam();
   s.views.views = 8;
-  const auto model = train_model(set_->mesh, s);
+  const auto model = test::train(set_->mesh, s);
   const GeneratedImage& im = set_->images.at(0);
   s.local.threads = 1;
   const RecognitionResult a = recognize(im.depth, im.info.K, *model, s);

@@ -12,6 +12,7 @@
 #include <fstream>
 
 #include "recognition/pipeline.h"
+#include "recognition_train_util.h"
 #include "test_recognition_pipeline_util.h"
 
 namespace fs = std::filesystem;
@@ -76,14 +77,14 @@ class PipelineDeterminism : public Pipeline, public ::testing::WithParamInterfac
 
 TEST_P(PipelineDeterminism, SamePoseBitForBitWithOneAndTwoThreads) {
   const pb::RecognitionSettings s = small_settings(GetParam());
-  const auto model = pb::train_model(*mesh_, s);
+  const auto model = pb::test::train(*mesh_, s);
   const pb::RecognitionResult a = run_with_threads(1, *scene_, *model, s);
   const pb::RecognitionResult b = run_with_threads(2, *scene_, *model, s);
   const pb::RecognitionResult c = run_with_threads(1, *scene_, *model, s);
   expect_same_result(a, b, GetParam() + ": 1 vs 2 threads");
   expect_same_result(a, c, GetParam() + ": repeated");
   // Training is deterministic too: a second model gives the same result.
-  const auto model2 = pb::train_model(*mesh_, s);
+  const auto model2 = pb::test::train(*mesh_, s);
   expect_same_result(a, run_with_threads(2, *scene_, *model2, s), GetParam() + ": retrained");
   // The call reports its stages.
   EXPECT_GT(a.times.preprocess, 0.0);
@@ -102,7 +103,7 @@ INSTANTIATE_TEST_SUITE_P(EveryDescriptor, PipelineDeterminism,
 
 TEST_F(Pipeline, FindsTheLBlockWithFpfhAndIcp) {
   const pb::RecognitionSettings s = small_settings("fpfh");
-  const auto model = pb::train_model(*mesh_, s);
+  const auto model = pb::test::train(*mesh_, s);
   const pb::RecognitionResult r = pb::recognize(scene_->depth, scene_->K, *model, s);
   ASSERT_EQ(r.status, "ok") << r.message;
   EXPECT_LT((r.T_cam_model.t - scene_->T_cam_model.t).norm(), 10.0);
@@ -111,7 +112,7 @@ TEST_F(Pipeline, FindsTheLBlockWithFpfhAndIcp) {
 
 TEST_F(Pipeline, NoPointsAfterFilteringIsNoHypothesis) {
   const pb::RecognitionSettings s = small_settings("fpfh");
-  const auto model = pb::train_model(*mesh_, s);
+  const auto model = pb::test::train(*mesh_, s);
   // An image without any depth.
   pb::DepthImage empty(scene_->K.width, scene_->K.height);
   pb::RecognitionResult r = pb::recognize(empty, scene_->K, *model, s);
@@ -130,7 +131,7 @@ TEST_F(Pipeline, NoPointsAfterFilteringIsNoHypothesis) {
 TEST_F(Pipeline, ObjectAbsentIsNoHypothesis) {
   for (const std::string d : {"fpfh", "cesf"}) {
     pb::RecognitionSettings s = small_settings(d);
-    const auto model = pb::train_model(*mesh_, s);
+    const auto model = pb::test::train(*mesh_, s);
     // Only the table: nothing is left once the plane is removed.
     pbtest::TableSceneOptions o;
     o.object = false;
@@ -161,7 +162,7 @@ class PipelineTinyScenes : public Pipeline, public ::testing::WithParamInterface
 
 TEST_P(PipelineTinyScenes, NeverThrow) {
   const pb::RecognitionSettings s = small_settings(GetParam());
-  const auto model = pb::train_model(*mesh_, s);
+  const auto model = pb::test::train(*mesh_, s);
   const pb::Intrinsics& K = scene_->K;
   std::vector<std::pair<std::string, pb::DepthImage>> scenes;
   auto patch = [&](pb::DepthImage& d, int u0, int v0, int w, int h, float z, float slope) {
@@ -199,7 +200,7 @@ TEST_F(Pipeline, EmptyModelIsNoHypothesis) {
   for (const std::string d : {"fpfh", "esf", "ppf"}) {
     const pb::RecognitionSettings s = small_settings(d);
     bool cached = true;
-    const auto model = pb::train_model(pb::Mesh{}, s, {}, &cached);
+    const auto model = pb::test::train(pb::Mesh{}, s, {}, &cached);
     EXPECT_FALSE(cached);
     EXPECT_TRUE(pb::trained_model_info(*model).empty);
     const pb::RecognitionResult r = pb::recognize(scene_->depth, scene_->K, *model, s);
@@ -211,7 +212,7 @@ TEST_F(Pipeline, EmptyModelIsNoHypothesis) {
   dot.vertices = {pb::Vec3f(0, 0, 0), pb::Vec3f(0, 0, 0), pb::Vec3f(0, 0, 0)};
   dot.faces = {Eigen::Vector3i(0, 1, 2)};
   const pb::RecognitionSettings s = small_settings("fpfh");
-  const auto model = pb::train_model(dot, s);
+  const auto model = pb::test::train(dot, s);
   const pb::RecognitionResult r = pb::recognize(scene_->depth, scene_->K, *model, s);
   EXPECT_EQ(r.status, "no_hypothesis");
   EXPECT_NE(r.message.find("empty model"), std::string::npos) << r.message;
@@ -219,7 +220,7 @@ TEST_F(Pipeline, EmptyModelIsNoHypothesis) {
 
 TEST_F(Pipeline, MismatchedSettingsAreInputErrors) {
   const pb::RecognitionSettings s = small_settings("fpfh");
-  const auto model = pb::train_model(*mesh_, s);
+  const auto model = pb::test::train(*mesh_, s);
   pb::RecognitionSettings other = s;
   other.descriptor = "shot";
   EXPECT_THROW(pb::recognize(scene_->depth, scene_->K, *model, other), pb::InputError);
@@ -229,7 +230,7 @@ TEST_F(Pipeline, MismatchedSettingsAreInputErrors) {
   pb::Intrinsics K = scene_->K;
   K.width += 1;
   EXPECT_THROW(pb::recognize(scene_->depth, K, *model, s), pb::InputError);
-  EXPECT_THROW(pb::train_model(*mesh_, small_settings("sift")), pb::InputError);
+  EXPECT_THROW(pb::test::train(*mesh_, small_settings("sift")), pb::InputError);
 }
 
 fs::path fresh_cache_dir(const std::string& tag) {
@@ -246,14 +247,14 @@ TEST_P(PipelineCache, SecondTrainingComesFromTheCacheWithIdenticalResults) {
   const fs::path dir = fresh_cache_dir(GetParam());
   pb::TrainOptions opt;
   opt.cache_dir = dir.string();
-  opt.model_name = "l block";
+  const std::string name = "l block";
   const pb::RecognitionSettings s = small_settings(GetParam());
   bool cached = true;
-  const auto fresh = pb::train_model(*mesh_, s, opt, &cached);
+  const auto fresh = pb::test::train(*mesh_, s, opt, &cached, name);
   EXPECT_FALSE(cached);
   const std::string file = pb::trained_model_info(*fresh).cache_file;
   ASSERT_TRUE(fs::exists(file)) << file;
-  const auto again = pb::train_model(*mesh_, s, opt, &cached);
+  const auto again = pb::test::train(*mesh_, s, opt, &cached, name);
   EXPECT_TRUE(cached);
   EXPECT_EQ(pb::trained_model_info(*again).views, pb::trained_model_info(*fresh).views);
   EXPECT_EQ(pb::trained_model_info(*again).view_points, pb::trained_model_info(*fresh).view_points);
@@ -270,10 +271,10 @@ TEST_F(Pipeline, CacheKeyAndCorruptFiles) {
   const fs::path dir = fresh_cache_dir("key");
   pb::TrainOptions opt;
   opt.cache_dir = (dir / "sub" / "dir").string();  // created on demand
-  opt.model_name = "l/block";                        // sanitized in the file name
+  const std::string name = "l/block";  // sanitized in the file name
   const pb::RecognitionSettings s = small_settings("fpfh");
   bool cached = true;
-  const auto fresh = pb::train_model(*mesh_, s, opt, &cached);
+  const auto fresh = pb::test::train(*mesh_, s, opt, &cached, name);
   EXPECT_FALSE(cached);
   const std::string file = pb::trained_model_info(*fresh).cache_file;
   ASSERT_TRUE(fs::exists(file)) << file;
@@ -283,11 +284,11 @@ TEST_F(Pipeline, CacheKeyAndCorruptFiles) {
   // A setting that changes training changes the key (a new file) ...
   pb::RecognitionSettings s2 = s;
   s2.preprocess.voxel_mm = 8;
-  pb::train_model(*mesh_, s2, opt, &cached);
+  pb::test::train(*mesh_, s2, opt, &cached, name);
   EXPECT_FALSE(cached);
   s2 = s;
   s2.views.views = 6;
-  pb::train_model(*mesh_, s2, opt, &cached);
+  pb::test::train(*mesh_, s2, opt, &cached, name);
   EXPECT_FALSE(cached);
   // ... one that does not (refinement, verification, thread count) reuses it.
   s2 = s;
@@ -295,18 +296,30 @@ TEST_F(Pipeline, CacheKeyAndCorruptFiles) {
   s2.refine.max_iterations = 10;
   s2.verify.inlier_threshold_mm = 7;
   s2.local.threads = 1;
-  pb::train_model(*mesh_, s2, opt, &cached);
+  pb::test::train(*mesh_, s2, opt, &cached, name);
   EXPECT_TRUE(cached);
+  // Another method's section does not touch this method's key: FPFH reads
+  // only `local` (and preprocess, the views, the seed).
+  s2 = s;
+  s2.ppf.model_points = 123;
+  s2.global.top_k = 9;
+  pb::test::train(*mesh_, s2, opt, &cached, name);
+  EXPECT_TRUE(cached);
+  // Its own section does.
+  s2 = s;
+  s2.local.keypoint_voxel_mm = 21;
+  pb::test::train(*mesh_, s2, opt, &cached, name);
+  EXPECT_FALSE(cached);
   // A different mesh is a different key.
   pb::Mesh scaled = *mesh_;
   for (auto& v : scaled.vertices) v *= 1.1f;
-  pb::train_model(scaled, s, opt, &cached);
+  pb::test::train(scaled, s, opt, &cached, name);
   EXPECT_FALSE(cached);
 
   // Corrupt files are ignored and rebuilt: truncated, a flipped byte, garbage.
   const auto size = fs::file_size(file);
   fs::resize_file(file, size / 2);
-  const auto rebuilt = pb::train_model(*mesh_, s, opt, &cached);
+  const auto rebuilt = pb::test::train(*mesh_, s, opt, &cached, name);
   EXPECT_FALSE(cached);
   EXPECT_EQ(fs::file_size(file), size);
   expect_same_result(r1, pb::recognize(scene_->depth, scene_->K, *rebuilt, s), "rebuilt model");
@@ -318,12 +331,12 @@ TEST_F(Pipeline, CacheKeyAndCorruptFiles) {
     f.seekp(static_cast<std::streamoff>(size - 5));
     f.put(static_cast<char>(c ^ 0x5a));
   }
-  pb::train_model(*mesh_, s, opt, &cached);
+  pb::test::train(*mesh_, s, opt, &cached, name);
   EXPECT_FALSE(cached);
   std::ofstream(file, std::ios::binary | std::ios::trunc) << "not a cache file";
-  pb::train_model(*mesh_, s, opt, &cached);
+  pb::test::train(*mesh_, s, opt, &cached, name);
   EXPECT_FALSE(cached);
-  pb::train_model(*mesh_, s, opt, &cached);
+  pb::test::train(*mesh_, s, opt, &cached, name);
   EXPECT_TRUE(cached);
   // No temporary files are left behind.
   for (const auto& e : fs::directory_iterator(opt.cache_dir)) EXPECT_EQ(e.path().extension(), ".bin") << e.path();
@@ -331,7 +344,7 @@ TEST_F(Pipeline, CacheKeyAndCorruptFiles) {
   const fs::path blocker = dir / "a_file";
   std::ofstream(blocker) << "x";
   opt.cache_dir = (blocker / "cache").string();
-  EXPECT_THROW(pb::train_model(*mesh_, s, opt), pb::InputError);
+  EXPECT_THROW(pb::test::train(*mesh_, s, opt, nullptr, name), pb::InputError);
   fs::remove_all(dir);
 }
 

@@ -7,6 +7,7 @@
 
 #include "recognition/preprocess/preprocess.h"
 #include "recognition/preprocess/internal.h"
+#include "recognition/preprocess/voxel_grid.h"
 #include "recognition/verify/verify.h"
 #include "test_recognition_pipeline_util.h"
 
@@ -20,7 +21,7 @@ TEST(Voxel, CentroidsPclOrderAndNearestPixel) {
   // Two points in cell (0,0,0), one in (1,0,0), one in (0,0,1).
   in.points = {Vec3f(1, 1, 1), Vec3f(3, 3, 3), Vec3f(12, 1, 1), Vec3f(1, 1, 15)};
   in.pixel = {10, 11, 12, 13};
-  const PointSet out = pb::detail::voxel_downsample(in, 10.0);
+  const PointSet out = pb::voxel_downsample(in, {10.0});
   ASSERT_EQ(out.size(), 3u);
   // PCL's order: z index, then y, then x.
   EXPECT_TRUE(out.points[0].isApprox(Vec3f(2, 2, 2)));
@@ -33,7 +34,7 @@ TEST(Voxel, CentroidsPclOrderAndNearestPixel) {
   // Negative coordinates use floor, as pcl::VoxelGrid: -1 and 1 are in different cells.
   in.points = {Vec3f(-1, 0, 0), Vec3f(1, 0, 0)};
   in.pixel = {0, 1};
-  EXPECT_EQ(pb::detail::voxel_downsample(in, 10.0).size(), 2u);
+  EXPECT_EQ(pb::voxel_downsample(in, {10.0}).size(), 2u);
 }
 
 TEST(Ransac, FindsThePlaneDeterministically) {

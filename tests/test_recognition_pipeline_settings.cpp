@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "recognition/pipeline.h"
+#include "recognition/registry.h"
 
 namespace {
 
@@ -23,7 +24,6 @@ TEST(Settings, DefaultsAreTheThesisValues) {
   EXPECT_EQ(s.views.views, 12);
   EXPECT_EQ(s.preprocess.voxel_mm, 10.0);
   EXPECT_EQ(s.global.top_k, 5);
-  EXPECT_EQ(s.global.crh_bins, 90);
   EXPECT_EQ(s.local.hough_min_votes, 5);
   EXPECT_EQ(s.refine.max_iterations, 40);
   EXPECT_EQ(s.verify.min_inlier_fraction, 0.0);
@@ -132,7 +132,6 @@ TEST(Settings, JsonRoundTripsThroughTheParsers) {
   for (auto& [sec, v] : j.items()) {
     if (!v.is_object()) continue;
     for (auto& [k, x] : v.items()) {
-      if (sec == "global" && k == "crh_bins") continue;  // fixed at 90 (pcl::CRHEstimation)
       if (x.is_boolean()) x = !x.get<bool>();
       else if (x.is_number_integer()) x = x.get<long long>() + 1;
       else if (x.is_number_float()) x = x.get<double>() * 0.9;

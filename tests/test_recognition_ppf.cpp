@@ -15,6 +15,7 @@
 #include "core/yaml.h"
 #include "recognition/method.h"
 #include "recognition/pipeline.h"
+#include "recognition_train_util.h"
 #include "test_recognition_refine_scenes.h"
 
 namespace pb {
@@ -49,8 +50,8 @@ class PpfScenes : public ::testing::Test {
     o.with_model_view = false;
     for (int i = 0; i < kScenes; ++i) cases_.push_back(refine_test::make_case(object_, i, kSeed, o));
     views_ = training_views(object_);
-    method_ = make_ppf_method();
-    method_->train(views_, settings_);
+    method_ = make_ppf_method(settings_.ppf);
+    method_->train(views_, settings_.seed);
   }
   static Mesh object_;
   static std::vector<refine_test::Case> cases_;
@@ -74,7 +75,7 @@ TEST_F(PpfScenes, BestHypothesisFindsThePose) {
   for (size_t i = 0; i < cases_.size(); ++i) {
     const auto& c = cases_[i];
     StageTimes t;
-    const auto hyps = method_->hypothesize(c.scene, views_, settings_, derive_seed(kSeed, {i}), t);
+    const auto hyps = method_->hypothesize(c.scene, views_, derive_seed(kSeed, {i}), t);
     ASSERT_FALSE(hyps.empty()) << "scene " << i;
     EXPECT_LE(hyps.size(), static_cast<size_t>(settings_.ppf.max_hypotheses));
     bool any = false;
@@ -99,7 +100,7 @@ TEST_F(PpfScenes, BestHypothesisFindsThePose) {
 }
 
 TEST_F(PpfScenes, PipelineWithPpfFindsThePose) {
-  const auto model = train_model(object_, settings_, TrainOptions{"", "asymmetric"});
+  const auto model = test::train(object_, settings_, TrainOptions{}, nullptr, "asymmetric");
   int ok = 0;
   for (size_t i = 0; i < cases_.size(); ++i) {
     const auto& c = cases_[i];
@@ -115,15 +116,17 @@ TEST_F(PpfScenes, PipelineWithPpfFindsThePose) {
 }
 
 TEST_F(PpfScenes, TrainedStateRoundTripsAndMatchingIsDeterministic) {
-  std::stringstream ss;
+  BinaryWriter ss;
   method_->save(ss);
-  auto loaded = make_ppf_method();
-  loaded->load(ss);
+  auto loaded = make_ppf_method(settings_.ppf);
+  BinaryReader in(ss.buffer(), "test");
+  loaded->load(in);
+  EXPECT_TRUE(in.at_end());
   const auto& c = cases_[0];
   StageTimes t;
-  const auto a = method_->hypothesize(c.scene, views_, settings_, 5, t);
-  const auto b = loaded->hypothesize(c.scene, views_, settings_, 5, t);
-  const auto again = method_->hypothesize(c.scene, views_, settings_, 5, t);
+  const auto a = method_->hypothesize(c.scene, views_, 5, t);
+  const auto b = loaded->hypothesize(c.scene, views_, 5, t);
+  const auto again = method_->hypothesize(c.scene, views_, 5, t);
   ASSERT_FALSE(a.empty());
   ASSERT_EQ(a.size(), b.size());
   ASSERT_EQ(a.size(), again.size());
@@ -136,27 +139,28 @@ TEST_F(PpfScenes, TrainedStateRoundTripsAndMatchingIsDeterministic) {
     }
   }
   // A corrupt state is an error, not a crash.
-  std::stringstream bad(ss.str().substr(0, 40));
-  EXPECT_THROW(make_ppf_method()->load(bad), std::runtime_error);
-  std::stringstream junk("not a ppf state at all");
-  EXPECT_THROW(make_ppf_method()->load(junk), std::runtime_error);
+  const std::string bad = ss.buffer().substr(0, 40), junk = "not a ppf state at all";
+  BinaryReader bad_in(bad, "test"), junk_in(junk, "test");
+  EXPECT_THROW(make_ppf_method(settings_.ppf)->load(bad_in), std::runtime_error);
+  EXPECT_THROW(make_ppf_method(settings_.ppf)->load(junk_in), std::runtime_error);
 }
 
 TEST_F(PpfScenes, EmptyInputsGiveNoHypothesis) {
   StageTimes t;
   PointSet empty;
-  EXPECT_TRUE(method_->hypothesize(empty, views_, settings_, 1, t).empty());
+  EXPECT_TRUE(method_->hypothesize(empty, views_, 1, t).empty());
   PointSet no_normals = cases_[0].scene;
   no_normals.normals.clear();
-  EXPECT_TRUE(method_->hypothesize(no_normals, views_, settings_, 1, t).empty());
-  auto untrained = make_ppf_method();
-  untrained->train({}, settings_);
-  EXPECT_TRUE(untrained->hypothesize(cases_[0].scene, views_, settings_, 1, t).empty());
-  std::stringstream ss;
+  EXPECT_TRUE(method_->hypothesize(no_normals, views_, 1, t).empty());
+  auto untrained = make_ppf_method(settings_.ppf);
+  untrained->train({}, settings_.seed);
+  EXPECT_TRUE(untrained->hypothesize(cases_[0].scene, views_, 1, t).empty());
+  BinaryWriter ss;
   untrained->save(ss);
-  auto loaded = make_ppf_method();
-  loaded->load(ss);
-  EXPECT_TRUE(loaded->hypothesize(cases_[0].scene, views_, settings_, 1, t).empty());
+  auto loaded = make_ppf_method(settings_.ppf);
+  BinaryReader in(ss.buffer(), "test");
+  loaded->load(in);
+  EXPECT_TRUE(loaded->hypothesize(cases_[0].scene, views_, 1, t).empty());
 }
 
 TEST(Ppf, ParseReadsEveryFieldAndRejectsBadOnes) {
@@ -166,7 +170,7 @@ TEST(Ppf, ParseReadsEveryFieldAndRejectsBadOnes) {
       "  max_hypotheses: 3\n",
       "cfg.yaml");
   PpfSettings s;
-  parse_ppf(n["ppf"], s);
+  parse_section(n["ppf"], s);
   EXPECT_EQ(s.model_points, 200);
   EXPECT_EQ(s.angle_step_deg, 10);
   EXPECT_EQ(s.distance_step_fraction, 0.04);
@@ -177,7 +181,7 @@ TEST(Ppf, ParseReadsEveryFieldAndRejectsBadOnes) {
   auto fails = [](const std::string& text, const std::string& field) {
     PpfSettings t;
     try {
-      parse_ppf(YamlNode::load_string(text, "bad.yaml")["ppf"], t);
+      parse_section(YamlNode::load_string(text, "bad.yaml")["ppf"], t);
     } catch (const InputError& e) {
       EXPECT_EQ(e.file(), "bad.yaml");
       EXPECT_EQ(e.field(), field) << e.what();

@@ -186,7 +186,7 @@ TEST(Refine, ParseReadsEveryFieldAndRejectsBadOnes) {
       "  gicp_covariances_from_normals: false\n  crop_margin_mm: 30\n  normal_neighbours: 12\n",
       "cfg.yaml");
   RefineSettings s;
-  parse_refine(n["refine"], s);
+  parse_section(n["refine"], s);
   EXPECT_EQ(s.max_iterations, 25);
   EXPECT_EQ(s.max_correspondence_mm, 15);
   EXPECT_EQ(s.transformation_epsilon, 1e-9);
@@ -206,7 +206,7 @@ TEST(Refine, ParseReadsEveryFieldAndRejectsBadOnes) {
   auto fails = [](const std::string& text, const std::string& field) {
     RefineSettings t;
     try {
-      parse_refine(YamlNode::load_string(text, "bad.yaml")["refine"], t);
+      parse_section(YamlNode::load_string(text, "bad.yaml")["refine"], t);
     } catch (const InputError& e) {
       EXPECT_EQ(e.file(), "bad.yaml");
       EXPECT_EQ(e.field(), field) << e.what();

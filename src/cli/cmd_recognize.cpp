@@ -23,6 +23,8 @@
 #include "io/bop.h"
 #include "io/png.h"
 #include "recognition/pipeline.h"
+#include "recognition/registry.h"
+#include "scenes/views.h"
 #include "render/renderer.h"
 
 namespace {
@@ -140,63 +142,204 @@ nlohmann::ordered_json times_json(const pb::StageTimes& t) {
           {"verify", t.verify},         {"total", t.total()}};
 }
 
+struct Options {
+  std::string dataset_dir, split, object, method, refine, config, overlay, cache = default_cache_dir(),
+                                                                         scenario = "table";
+  int scene = -1, image = -1, views = 0;
+  long long seed = -1;
+  bool json = false;
+};
+
+void add_options(CLI::App& app, Options& o) {
+  app.add_option("--dataset", o.dataset_dir, "BOP dataset root (models/, test/ ...)")->required();
+  app.add_option("--split", o.split, "split folder (default: test if present, else the first)");
+  app.add_option("--scene", o.scene, "scene id")->required();
+  app.add_option("--image", o.image, "image id")->required();
+  app.add_option("--object", o.object, "object id, obj_XXXXXX or name (models_info.json)")->required();
+  app.add_option("--method", o.method, "descriptor: fpfh shot cvfh esf cesf ourcvfh ppf (default: config, else fpfh)");
+  app.add_option("--refine", o.refine, "refinement: none icp icp_lm icp_plane gicp ndt (default: config, else icp)");
+  app.add_option("--views", o.views, "training views (1, 8, 12 or N on a sphere)")->check(CLI::PositiveNumber);
+  app.add_option("--config", o.config, "recognition settings YAML (sections descriptor, refinement, views, "
+                                       "preprocess, local, global, ppf, refine, verify, seed)");
+  app.add_option("--seed", o.seed, "seed of every random choice (overrides the config)")->check(CLI::NonNegativeNumber);
+  app.add_option("--overlay", o.overlay, "write a PNG: the model at the estimated pose over the colour-mapped depth");
+  app.add_option("--cache", o.cache, "training cache folder ('' = no cache; default $POSEBENCH_CACHE or ~/.cache/posebench/train)");
+  app.add_option("--scenario", o.scenario, "thresholds for 'correct': table (50 mm) or warehouse (100 mm)");
+  app.add_flag("--json", o.json, "print one JSON object");
+}
+
+// Settings from --config, then the flags.
+void settings_from(const Options& o, pb::RecognitionSettings& s) {
+  if (!o.config.empty()) s = pb::parse_recognition_settings(pb::YamlNode::load_file(o.config), s);
+  if (!o.method.empty()) s.descriptor = pb::descriptor_entry(o.method, "", "--method").name;
+  if (!o.refine.empty()) s.refinement = pb::refinement_entry(o.refine, "", "--refine").name;
+  if (o.views > 0) s.views.views = o.views;
+  if (o.seed >= 0) s.seed = static_cast<uint64_t>(o.seed);
+}
+
+// The ground-truth instance of the object closest to the estimate, and the
+// thesis's errors against it.
+struct Evaluation {
+  bool has_gt = false, correct = false;
+  pb::ThesisErrors err;
+  pb::Pose gt_pose;
+  int gt_instances = 0;
+};
+
+Evaluation evaluate(const pb::RecognitionResult& res, const pb::ImageInfo& im, int obj_id, const pb::ModelInfo& info,
+                    const pb::ThesisThresholds& thr) {
+  Evaluation ev;
+  for (const auto& g : im.gt) ev.gt_instances += g.obj_id == obj_id;
+  if (res.status == "ok" && ev.gt_instances > 0) {
+    const auto syms = pb::symmetry_transformations(info);
+    pb::ThesisErrorOptions eo;
+    eo.thresholds = thr;
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& g : im.gt) {
+      if (g.obj_id != obj_id) continue;
+      const pb::ThesisErrors e = pb::thesis_errors(res.T_cam_model, g.T_cam_model, syms, eo);
+      const double key = std::max(e.translation_mm / thr.translation_mm, e.rotation / thr.rotation);
+      if (key < best) {
+        best = key;
+        ev.err = e;
+        ev.gt_pose = g.T_cam_model;
+        ev.has_gt = true;
+      }
+    }
+  } else if (ev.gt_instances > 0) {
+    for (const auto& g : im.gt)
+      if (g.obj_id == obj_id) {
+        ev.gt_pose = g.T_cam_model;
+        break;
+      }
+  }
+  ev.correct = ev.has_gt && pb::thesis_correct(ev.err, thr);
+  return ev;
+}
+
+// What the command prints, in either form.
+struct Outcome {
+  const Options& o;
+  const pb::RecognitionSettings& s;
+  const pb::RecognitionResult& res;
+  const Evaluation& ev;
+  const pb::ImageInfo& im;
+  int obj_id;
+  std::string model_name;
+  int train_views;
+  double train_s;
+  bool from_cache;
+};
+
+std::string json_output(const Outcome& x) {
+  const bool ok = x.res.status == "ok";
+  nlohmann::ordered_json j;
+  j["status"] = x.res.status;
+  if (!x.res.message.empty()) j["message"] = x.res.message;
+  j["dataset"] = x.o.dataset_dir;
+  j["split"] = x.o.split;
+  j["scene"] = x.o.scene;
+  j["image"] = x.o.image;
+  j["object"] = {{"id", x.obj_id}, {"name", x.model_name}};
+  j["method"] = x.s.descriptor;
+  j["refinement"] = x.s.refinement;
+  if (ok) {
+    std::vector<double> R, t;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) R.push_back(x.res.T_cam_model.R(r, c));
+    for (int r = 0; r < 3; ++r) t.push_back(x.res.T_cam_model.t[r]);
+    j["R"] = R;
+    j["t"] = t;
+  } else {
+    j["R"] = nullptr;
+    j["t"] = nullptr;
+  }
+  j["score"] = x.res.score;
+  j["inliers"] = x.res.inliers;
+  j["hypotheses"] = x.res.hypotheses.size();
+  j["times"] = times_json(x.res.times);
+  j["train"] = {{"seconds", x.train_s}, {"from_cache", x.from_cache}, {"views", x.train_views}};
+  j["ground_truth_instances"] = x.ev.gt_instances;
+  if (x.ev.has_gt)
+    j["errors"] = {{"translation_mm", x.ev.err.translation_mm},
+                   {"rotation", x.ev.err.rotation},
+                   {"rotation_deg", x.ev.err.rotation_deg},
+                   {"symmetry_aware", true},
+                   {"symmetry", x.ev.err.symmetry},
+                   {"translation_mm_plain", x.ev.err.translation_mm_plain},
+                   {"rotation_plain", x.ev.err.rotation_plain},
+                   {"rotation_deg_plain", x.ev.err.rotation_deg_plain},
+                   {"scenario", x.o.scenario},
+                   {"correct", x.ev.correct}};
+  if (!x.o.overlay.empty()) j["overlay"] = x.o.overlay;
+  return j.dump() + "\n";
+}
+
+std::string text_output(const Outcome& x, const pb::ThesisThresholds& thr) {
+  const pb::RecognitionResult& res = x.res;
+  std::ostringstream o;
+  o << std::setprecision(6);
+  o << "object " << x.model_name << " (id " << x.obj_id << ") in " << x.o.split << " scene " << x.o.scene
+    << " image " << x.o.image << ": " << x.s.descriptor << " + " << x.s.refinement << "\n";
+  o << "training: " << x.train_views << " views, " << x.train_s << " s" << (x.from_cache ? " (from cache)" : "")
+    << "\n";
+  o << "status: " << res.status;
+  if (!res.message.empty()) o << " (" << res.message << ")";
+  o << "\n";
+  if (res.status == "ok") {
+    o << "pose T_cam_model (model to camera, mm):\n";
+    for (int r = 0; r < 3; ++r)
+      o << "  " << std::setw(10) << res.T_cam_model.R(r, 0) << " " << std::setw(10) << res.T_cam_model.R(r, 1)
+        << " " << std::setw(10) << res.T_cam_model.R(r, 2) << " | " << std::setw(10) << res.T_cam_model.t[r]
+        << "\n";
+    o << "inliers: " << res.inliers << "  score: " << res.score << "  hypotheses: " << res.hypotheses.size()
+      << "\n";
+  }
+  o << "times (s): preprocess " << res.times.preprocess << ", describe " << res.times.describe << ", match "
+    << res.times.match << ", group " << res.times.group << ", initial pose " << res.times.initial_pose
+    << ", refine " << res.times.refine << ", verify " << res.times.verify << "; total " << res.times.total()
+    << "\n";
+  if (x.ev.has_gt)
+    o << "errors vs ground truth (symmetry-aware): translation " << x.ev.err.translation_mm << " mm, 1-|p.q| "
+      << x.ev.err.rotation << ", angle " << x.ev.err.rotation_deg << " deg -> "
+      << (x.ev.correct ? "correct" : "not correct") << " (" << x.o.scenario << " thresholds " << thr.translation_mm
+      << " mm, " << thr.rotation << ")\n";
+  else if (x.ev.gt_instances == 0 && !x.im.gt.empty())
+    o << "ground truth: the object is not annotated in this image\n";
+  else if (x.im.gt.empty())
+    o << "ground truth: none for this image\n";
+  if (!x.o.overlay.empty()) o << "overlay: " << x.o.overlay << "\n";
+  return o.str();
+}
+
 }  // namespace
 
 static pb::cli::Command recognize_cmd(
     "recognize", "recognize one object in one image of a BOP dataset", [](int argc, char** argv) {
       CLI::App app{"Recognizes one object in one depth image of a BOP-layout dataset and prints its pose, "
                    "inliers, stage times and, where ground truth exists, the errors."};
-      std::string dataset_dir, split, object, method, refine, config, overlay, cache = default_cache_dir(),
-                                                                              scenario = "table";
-      int scene = -1, image = -1, views = 0;
-      long long seed = -1;
-      bool json = false;
-      app.add_option("--dataset", dataset_dir, "BOP dataset root (models/, test/ ...)")->required();
-      app.add_option("--split", split, "split folder (default: test if present, else the first)");
-      app.add_option("--scene", scene, "scene id")->required();
-      app.add_option("--image", image, "image id")->required();
-      app.add_option("--object", object, "object id, obj_XXXXXX or name (models_info.json)")->required();
-      app.add_option("--method", method, "descriptor: fpfh shot cvfh esf cesf ourcvfh ppf (default: config, else fpfh)");
-      app.add_option("--refine", refine, "refinement: none icp icp_lm icp_plane gicp ndt (default: config, else icp)");
-      app.add_option("--views", views, "training views (1, 8, 12 or N on a sphere)")->check(CLI::PositiveNumber);
-      app.add_option("--config", config, "recognition settings YAML (sections descriptor, refinement, views, "
-                                         "preprocess, local, global, ppf, refine, verify, seed)");
-      app.add_option("--seed", seed, "seed of every random choice (overrides the config)")->check(CLI::NonNegativeNumber);
-      app.add_option("--overlay", overlay, "write a PNG: the model at the estimated pose over the colour-mapped depth");
-      app.add_option("--cache", cache, "training cache folder ('' = no cache; default $POSEBENCH_CACHE or ~/.cache/posebench/train)");
-      app.add_option("--scenario", scenario, "thresholds for 'correct': table (50 mm) or warehouse (100 mm)");
-      app.add_flag("--json", json, "print one JSON object");
+      Options o;
+      add_options(app, o);
       PB_CLI_PARSE(app, argc, argv);
 
       pb::RecognitionSettings s;
-      if (!config.empty()) s = pb::parse_recognition_settings(pb::YamlNode::load_file(config), s);
-      if (!method.empty()) s.descriptor = method;
-      if (!refine.empty()) s.refinement = refine;
-      if (views > 0) s.views.views = views;
-      if (seed >= 0) s.seed = static_cast<uint64_t>(seed);
-      {
-        const auto d = pb::descriptor_names(), r = pb::refinement_names();
-        if (std::find(d.begin(), d.end(), s.descriptor) == d.end())
-          throw pb::InputError("", "--method", "unknown descriptor '" + s.descriptor + "'");
-        if (std::find(r.begin(), r.end(), s.refinement) == r.end())
-          throw pb::InputError("", "--refine", "unknown refinement '" + s.refinement + "'");
-      }
-      const pb::ThesisThresholds thr = pb::thesis_thresholds(scenario);
+      settings_from(o, s);
+      const pb::ThesisThresholds thr = pb::thesis_thresholds(o.scenario);
 
-      const pb::BopDataset ds(dataset_dir);
-      if (split.empty()) {
+      const pb::BopDataset ds(o.dataset_dir);
+      if (o.split.empty()) {
         const auto sp = ds.splits();
-        split = std::find(sp.begin(), sp.end(), "test") != sp.end() ? "test" : sp.front();
+        o.split = std::find(sp.begin(), sp.end(), "test") != sp.end() ? "test" : sp.front();
       }
-      const int obj_id = ds.resolve_object(object);
+      const int obj_id = ds.resolve_object(o.object);
       const pb::ModelInfo& info = ds.model_info(obj_id);
-      const pb::SceneInfo sc = ds.load_scene(split, scene);
-      const auto im_it = sc.images.find(image);
+      const pb::SceneInfo sc = ds.load_scene(o.split, o.scene);
+      const auto im_it = sc.images.find(o.image);
       if (im_it == sc.images.end())
-        throw pb::InputError(dataset_dir + "/" + split + "/" + pb::bop_id(scene) + "/scene_camera.json", "image",
-                             "no image " + std::to_string(image) + " in scene " + std::to_string(scene));
+        throw pb::InputError(o.dataset_dir + "/" + o.split + "/" + pb::bop_id(o.scene) + "/scene_camera.json", "image",
+                             "no image " + std::to_string(o.image) + " in scene " + std::to_string(o.scene));
       pb::ImageInfo im = im_it->second;
-      const pb::DepthImage depth = ds.load_depth(split, scene, im);
+      const pb::DepthImage depth = ds.load_depth(o.split, o.scene, im);
       if (im.K.width <= 0 || im.K.height <= 0) {
         im.K.width = depth.width;
         im.K.height = depth.height;
@@ -213,123 +356,16 @@ static pb::cli::Command recognize_cmd(
 
       pb::Timer train_timer;
       pb::TrainOptions topt;
-      topt.cache_dir = cache;
-      topt.model_name = model_name;
+      topt.cache_dir = o.cache;
       bool from_cache = false;
-      const auto model = pb::train_model(mesh, s, topt, &from_cache);
+      const auto model = pb::train_model(pb::training_views(mesh, s.views, model_name), s, topt, &from_cache);
       const double train_s = train_timer.seconds();
       const pb::RecognitionResult res = pb::recognize(depth, im.K, *model, s);
-      const bool ok = res.status == "ok";
-
-      // Ground truth: the instance of the object closest to the estimate.
-      bool has_gt = false;
-      pb::ThesisErrors err;
-      pb::Pose gt_pose;
-      int gt_instances = 0;
-      for (const auto& g : im.gt) gt_instances += g.obj_id == obj_id;
-      if (ok && gt_instances > 0) {
-        const auto syms = pb::symmetry_transformations(info);
-        pb::ThesisErrorOptions eo;
-        eo.thresholds = thr;
-        double best = std::numeric_limits<double>::infinity();
-        for (const auto& g : im.gt) {
-          if (g.obj_id != obj_id) continue;
-          const pb::ThesisErrors e = pb::thesis_errors(res.T_cam_model, g.T_cam_model, syms, eo);
-          const double key = std::max(e.translation_mm / thr.translation_mm, e.rotation / thr.rotation);
-          if (key < best) {
-            best = key;
-            err = e;
-            gt_pose = g.T_cam_model;
-            has_gt = true;
-          }
-        }
-      } else if (gt_instances > 0) {
-        for (const auto& g : im.gt)
-          if (g.obj_id == obj_id) {
-            gt_pose = g.T_cam_model;
-            break;
-          }
-      }
-      const bool correct = has_gt && pb::thesis_correct(err, thr);
-
-      if (!overlay.empty())
-        write_overlay(overlay, depth, im.K, mesh, ok ? &res.T_cam_model : nullptr, gt_instances > 0 ? &gt_pose : nullptr);
-
-      if (json) {
-        nlohmann::ordered_json j;
-        j["status"] = res.status;
-        if (!res.message.empty()) j["message"] = res.message;
-        j["dataset"] = dataset_dir;
-        j["split"] = split;
-        j["scene"] = scene;
-        j["image"] = image;
-        j["object"] = {{"id", obj_id}, {"name", model_name}};
-        j["method"] = s.descriptor;
-        j["refinement"] = s.refinement;
-        if (ok) {
-          std::vector<double> R, t;
-          for (int r = 0; r < 3; ++r)
-            for (int c = 0; c < 3; ++c) R.push_back(res.T_cam_model.R(r, c));
-          for (int r = 0; r < 3; ++r) t.push_back(res.T_cam_model.t[r]);
-          j["R"] = R;
-          j["t"] = t;
-        } else {
-          j["R"] = nullptr;
-          j["t"] = nullptr;
-        }
-        j["score"] = res.score;
-        j["inliers"] = res.inliers;
-        j["hypotheses"] = res.hypotheses.size();
-        j["times"] = times_json(res.times);
-        j["train"] = {{"seconds", train_s}, {"from_cache", from_cache}, {"views", pb::trained_model_info(*model).views}};
-        j["ground_truth_instances"] = gt_instances;
-        if (has_gt)
-          j["errors"] = {{"translation_mm", err.translation_mm},
-                         {"rotation", err.rotation},
-                         {"rotation_deg", err.rotation_deg},
-                         {"symmetry_aware", true},
-                         {"symmetry", err.symmetry},
-                         {"translation_mm_plain", err.translation_mm_plain},
-                         {"rotation_plain", err.rotation_plain},
-                         {"rotation_deg_plain", err.rotation_deg_plain},
-                         {"scenario", scenario},
-                         {"correct", correct}};
-        if (!overlay.empty()) j["overlay"] = overlay;
-        std::cout << j.dump() << "\n";
-        return 0;
-      }
-
-      std::ostringstream o;
-      o << std::setprecision(6);
-      o << "object " << model_name << " (id " << obj_id << ") in " << split << " scene " << scene << " image " << image
-        << ": " << s.descriptor << " + " << s.refinement << "\n";
-      o << "training: " << pb::trained_model_info(*model).views << " views, " << train_s << " s"
-        << (from_cache ? " (from cache)" : "") << "\n";
-      o << "status: " << res.status;
-      if (!res.message.empty()) o << " (" << res.message << ")";
-      o << "\n";
-      if (ok) {
-        o << "pose T_cam_model (model to camera, mm):\n";
-        for (int r = 0; r < 3; ++r)
-          o << "  " << std::setw(10) << res.T_cam_model.R(r, 0) << " " << std::setw(10) << res.T_cam_model.R(r, 1)
-            << " " << std::setw(10) << res.T_cam_model.R(r, 2) << " | " << std::setw(10) << res.T_cam_model.t[r]
-            << "\n";
-        o << "inliers: " << res.inliers << "  score: " << res.score << "  hypotheses: " << res.hypotheses.size()
-          << "\n";
-      }
-      o << "times (s): preprocess " << res.times.preprocess << ", describe " << res.times.describe << ", match "
-        << res.times.match << ", group " << res.times.group << ", initial pose " << res.times.initial_pose
-        << ", refine " << res.times.refine << ", verify " << res.times.verify << "; total " << res.times.total()
-        << "\n";
-      if (has_gt)
-        o << "errors vs ground truth (symmetry-aware): translation " << err.translation_mm << " mm, 1-|p.q| "
-          << err.rotation << ", angle " << err.rotation_deg << " deg -> " << (correct ? "correct" : "not correct")
-          << " (" << scenario << " thresholds " << thr.translation_mm << " mm, " << thr.rotation << ")\n";
-      else if (gt_instances == 0 && !im.gt.empty())
-        o << "ground truth: the object is not annotated in this image\n";
-      else if (im.gt.empty())
-        o << "ground truth: none for this image\n";
-      if (!overlay.empty()) o << "overlay: " << overlay << "\n";
-      std::cout << o.str();
+      const Evaluation ev = evaluate(res, im, obj_id, info, thr);
+      if (!o.overlay.empty())
+        write_overlay(o.overlay, depth, im.K, mesh, res.status == "ok" ? &res.T_cam_model : nullptr,
+                      ev.gt_instances > 0 ? &ev.gt_pose : nullptr);
+      const Outcome x{o, s, res, ev, im, obj_id, model_name, pb::trained_model_info(*model).views, train_s, from_cache};
+      std::cout << (o.json ? json_output(x) : text_output(x, thr));
       return 0;
     });

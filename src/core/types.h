@@ -88,21 +88,4 @@ struct OrganizedCloud {
   size_t valid_count() const;
 };
 
-// A view of a model rendered alone (the thesis's "model views"): an
-// organized cloud in the view's camera frame and the pose that produced it.
-// scenes/views.h renders them; recognition trains on them as data.
-struct TrainingView {
-  Intrinsics K;
-  DepthImage depth;       // mm, 0 where the model is not
-  OrganizedCloud cloud;   // from depth, camera frame
-  Pose T_cam_model;       // model -> this view's camera
-};
-
-// The training views of one model, or none and why (empty or degenerate mesh).
-struct TrainingViews {
-  std::string model_name;            // for messages and cache file names
-  std::vector<TrainingView> views;
-  std::string empty_reason;          // set when views is empty
-};
-
 }  // namespace pb

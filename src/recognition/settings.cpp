@@ -7,7 +7,7 @@
 namespace pb {
 
 const std::vector<std::string>& recognition_sections() {
-  static const std::vector<std::string> v{"preprocess", "local", "global", "ppf", "refine", "verify"};
+  static const std::vector<std::string> v{"views", "preprocess", "local", "global", "ppf", "refine", "verify"};
   return v;
 }
 
@@ -15,6 +15,7 @@ namespace {
 
 template <typename F>
 void for_each_section(RecognitionSettings& s, F&& f) {
+  f("views", s.views);
   f("preprocess", s.preprocess);
   f("local", s.local);
   f("global", s.global);

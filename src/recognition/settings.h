@@ -1,6 +1,6 @@
 // RecognitionSettings: one struct per stage, each mirrored one to one by a
-// YAML section of the same name (preprocess, local, global, ppf, refine,
-// verify), plus the descriptor and refinement names and the seed. Every
+// YAML section of the same name (views, preprocess, local, global, ppf,
+// refine, verify), plus the descriptor and refinement names and the seed. Every
 // field is declared once in its stage header, with its comment and its
 // `fields` entry, from which parsing, key checks and JSON derive
 // (core/settings_fields.h). PCL-free.
@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "core/training_views.h"
 #include "core/yaml.h"
 #include "recognition/global/global.h"
 #include "recognition/local/local.h"
@@ -25,6 +26,8 @@ namespace pb {
 struct RecognitionSettings {
   std::string descriptor = "fpfh";   // fpfh shot cvfh esf cesf ourcvfh ppf (registry.h)
   std::string refinement = "icp";    // none icp icp_lm icp_plane gicp ndt (registry.h)
+  ViewSettings views;                // how the caller renders the training views (scenes/views.h);
+                                     // training reads the views it is given, not these
   PreprocessSettings preprocess;     // scene and training-view preprocessing
   LocalSettings local;               // fpfh, shot
   GlobalSettings global;             // cvfh, esf, cesf, ourcvfh

@@ -9,6 +9,7 @@
 #include "core/random.h"
 #include "io/bop.h"
 #include "recognition/pipeline.h"
+#include "recognition/registry.h"
 
 namespace fs = std::filesystem;
 

@@ -14,8 +14,8 @@
 #include "eval/symmetry.h"
 #include "io/bop.h"
 #include "recognition/pipeline.h"
-#include "recognition/refine_only.h"
 #include "render/renderer.h"
+#include "scenes/views.h"
 
 namespace pb {
 
@@ -69,8 +69,9 @@ nlohmann::json run_trial(const nlohmann::json& trial, const TrialContext& ctx) {
         if (z > 0) z = static_cast<float>(std::max(1.0, z + rng.normal(0.0, noise)));
     }
 
-    RecognitionSettings s = parse_recognition_settings(
-        YamlNode::load_string(trial.at("settings").dump(), "trial " + trial.at("key").get<std::string>()));
+    const YamlNode settings_node =
+        YamlNode::load_string(trial.at("settings").dump(), "trial " + trial.at("key").get<std::string>());
+    RecognitionSettings s = parse_recognition_settings(settings_node);
     // Training is seeded by the settings' own seed (default 1), not by the
     // trial: every trial with the same training settings shares one trained
     // model (in memory and in the disk cache) instead of training its own.
@@ -99,8 +100,8 @@ nlohmann::json run_trial(const nlohmann::json& trial, const TrialContext& ctx) {
     if (!model) {
       TrainOptions opt;
       opt.cache_dir = ctx.cache_dir;
-      opt.model_name = ds.model_info(obj_id).name.empty() ? bop_id(obj_id) : ds.model_info(obj_id).name;
-      model = train_model(*mesh, st, opt, &from_cache);
+      const std::string name = ds.model_info(obj_id).name.empty() ? bop_id(obj_id) : ds.model_info(obj_id).name;
+      model = train_model(training_views(*mesh, st.views, name), st, opt, &from_cache);
     }
     rec["train_s"] = train_timer.seconds();
     rec["train_from_cache"] = from_cache;

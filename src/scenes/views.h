@@ -6,37 +6,11 @@
 #include <string>
 #include <vector>
 
-#include "core/settings_fields.h"
+#include "core/training_views.h"
 #include "core/types.h"
 
 namespace pb {
 
-struct ViewSettings {
-  // 1: one side view; 8: a ring of 8 around the vertical axis; 12: the ring
-  // plus 4 from below (as the thesis); any other N: N viewpoints spread
-  // evenly over a sphere (Fibonacci tessellation).
-  int views = 12;
-  double elevation_deg = 20.0;   // ring elevation above the horizontal plane
-  double side_elevation_deg = 0.0;    // the single side view (views = 1): no top, no bottom
-  double below_elevation_deg = -45.0; // the 4 extra views of views = 12 (from below)
-  double distance_factor = 3.0;  // camera distance = factor * bounding-box diagonal (>= diameter)
-  int resolution = 256;          // square image, pixels
-  double fov_deg = 30.0;         // field of view, degrees
-
-  template <class S, class F>
-  static void fields(S& s, F& f) {
-    f("views", s.views, fields::at_least(1));
-    f("elevation_deg", s.elevation_deg, fields::in_range(-90, 90));
-    f("side_elevation_deg", s.side_elevation_deg, fields::in_range(-90, 90));
-    f("below_elevation_deg", s.below_elevation_deg, fields::in_range(-90, 90));
-    f("distance_factor", s.distance_factor, fields::positive());
-    f("resolution", s.resolution, fields::in_range(8, 4096));
-    f("fov_deg", s.fov_deg, fields::positive());
-  }
-  void validate(const YamlNode& node) const {
-    if (fov_deg >= 170) node["fov_deg"].fail("must be below 170");
-  }
-};
 
 // Unit directions from the model origin to each camera (model frame, z up),
 // in the order render_training_views uses. InputError on bad settings.
