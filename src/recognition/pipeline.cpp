@@ -146,6 +146,18 @@ int nearest_view(const TrainedModel& model, const Pose& init) {
   return best_view;
 }
 
+// The common tail of recognize and refine_from: refine, verify, accept.
+void refine_verify_accept(std::vector<Hypothesis> hyps, const TrainedModel& model, const PointSet& scene,
+                          const RecognitionSettings& s, RecognitionResult& res) {
+  Timer timer;
+  refine_all(hyps, model, scene, s);
+  res.times.refine = timer.seconds();
+  timer.reset();
+  res.hypotheses = verify_and_rank(std::move(hyps), model, scene, s.verify);
+  res.times.verify = timer.seconds();
+  accept_best(model, s.verify, res);
+}
+
 }  // namespace
 
 RecognitionResult recognize(const DepthImage& depth, const Intrinsics& K, const TrainedModel& model,
@@ -168,13 +180,7 @@ RecognitionResult recognize(const DepthImage& depth, const Intrinsics& K, const 
                   " scene points)";
     return res;
   }
-  Timer timer;
-  refine_all(hyps, model, scene, s);
-  res.times.refine = timer.seconds();
-  timer.reset();
-  res.hypotheses = verify_and_rank(std::move(hyps), model, scene, s.verify);
-  res.times.verify = timer.seconds();
-  accept_best(model, s.verify, res);
+  refine_verify_accept(std::move(hyps), model, scene, s, res);
   return res;
 }
 
@@ -191,13 +197,7 @@ RecognitionResult refine_from(const DepthImage& depth, const Intrinsics& K, cons
   std::vector<Hypothesis> hyps(1);
   hyps[0].T_cam_model = init;
   hyps[0].view = nearest_view(model, init);
-  Timer timer;
-  refine_all(hyps, model, scene, s);
-  res.times.refine = timer.seconds();
-  timer.reset();
-  res.hypotheses = verify_and_rank(std::move(hyps), model, scene, s.verify);
-  res.times.verify = timer.seconds();
-  accept_best(model, s.verify, res);
+  refine_verify_accept(std::move(hyps), model, scene, s, res);
   return res;
 }
 

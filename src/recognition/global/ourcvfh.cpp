@@ -3,104 +3,73 @@
 // octant weights, so the cloud is passed in metres and the frames converted
 // back to millimetres.
 #include <pcl/features/our_cvfh.h>
-#include <pcl/point_cloud.h>
-#include <pcl/point_types.h>
-#include <pcl/search/kdtree.h>
 
 #include <algorithm>
 #include <cmath>
 
 #include "recognition/global/internal.h"
+#include "recognition/global/pcl_cvfh.h"
 
 namespace pb::global {
 
-std::vector<Signature> ourcvfh_signatures(const PointSet& cloud, const GlobalSettings& s) {
-  std::vector<Signature> out;
-  if (!cloud.has_normals()) return out;
-  constexpr float kToM = 0.001f;
-  const size_t n = cloud.points.size();
-  const bool has_c = cloud.curvature.size() == n;
-  pcl::PointCloud<pcl::PointXYZ>::Ptr pts(new pcl::PointCloud<pcl::PointXYZ>);
-  pcl::PointCloud<pcl::Normal>::Ptr nrm(new pcl::PointCloud<pcl::Normal>);
-  for (size_t i = 0; i < n; ++i) {
-    const Vec3f& nv = cloud.normals[i];
-    if (!cloud.points[i].allFinite() || !nv.allFinite() || std::abs(nv.norm() - 1.f) > 0.01f) continue;
-    pcl::PointXYZ p;
-    p.getVector3fMap() = cloud.points[i] * kToM;
-    pcl::Normal q;
-    q.getNormalVector3fMap() = nv;
-    q.curvature = has_c && std::isfinite(cloud.curvature[i]) ? cloud.curvature[i] : 0.f;
-    pts->push_back(p);
-    nrm->push_back(q);
-  }
-  // Guard (PCL issues 1449, 1491): too few points for a region and its frame.
-  if (pts->size() < static_cast<size_t>(std::max(s.cvfh_min_region_points, 10))) return out;
+namespace {
 
-  // Guard (PCL issues 1449, 1491): OUR-CVFH keeps, of each stable region,
-  // the points whose normal is within refine_clusters x eps of the region's
-  // mean normal; when that leaves very few points (1 or 2, or points all
-  // equally far from their centroid) its frame is NaN and PCL indexes out of
-  // bounds (reproduced: tests/test_recognition_global_method.cpp).
-  // The same regions are found here first (same algorithm, same metre-scaled
-  // input); if one would be degenerate, every region point is kept instead.
+constexpr float kToM = 0.001f;
+
+// Guard (PCL issues 1449, 1491): OUR-CVFH keeps, of each stable region,
+// the points whose normal is within refine_clusters x eps of the region's
+// mean normal; when that leaves very few points (1 or 2, or points all
+// equally far from their centroid) its frame is NaN and PCL indexes out of
+// bounds (reproduced: tests/test_recognition_global_method.cpp).
+// The same regions are found here first (same algorithm, same metre-scaled
+// input); if one would be degenerate, every region point is kept instead.
+float safe_refine_clusters(const PclInput& in, const GlobalSettings& s) {
+  const auto& pts = *in.points;
+  const auto& nrm = *in.normals;
   float refine = static_cast<float>(s.ourcvfh_refine_clusters);
-  {
-    PointSet scaled;
-    for (size_t i = 0; i < pts->size(); ++i) {
-      scaled.points.push_back((*pts)[i].getVector3fMap());
-      scaled.normals.push_back((*nrm)[i].getNormalVector3fMap());
-      scaled.curvature.push_back((*nrm)[i].curvature);
+  PointSet scaled;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    scaled.points.push_back(pts[i].getVector3fMap());
+    scaled.normals.push_back(nrm[i].getNormalVector3fMap());
+    scaled.curvature.push_back(nrm[i].curvature);
+  }
+  GlobalSettings gm = s;
+  gm.cvfh_cluster_tolerance_mm = s.cvfh_cluster_tolerance_mm * kToM;
+  gm.cvfh_normal_radius_mm = s.cvfh_normal_radius_mm * kToM;
+  const double eps = s.cvfh_eps_angle_deg * M_PI / 180.0;
+  for (const Region& r : stable_regions(scaled, gm)) {
+    std::vector<Vec3f> kept;
+    for (size_t k = 0; k < r.points.size(); ++k) {
+      const double dot = std::clamp(static_cast<double>(r.mean_normal.dot(r.normals[k])), -1.0, 1.0);
+      if (std::abs(std::acos(dot)) < eps * refine) kept.push_back(r.points[k]);
     }
-    GlobalSettings gm = s;
-    gm.cvfh_cluster_tolerance_mm = s.cvfh_cluster_tolerance_mm * kToM;
-    gm.cvfh_normal_radius_mm = s.cvfh_normal_radius_mm * kToM;
-    const double eps = s.cvfh_eps_angle_deg * M_PI / 180.0;
-    for (const Region& r : stable_regions(scaled, gm)) {
-      std::vector<Vec3f> kept;
-      for (size_t k = 0; k < r.points.size(); ++k) {
-        const double dot = std::clamp(static_cast<double>(r.mean_normal.dot(r.normals[k])), -1.0, 1.0);
-        if (std::abs(std::acos(dot)) < eps * refine) kept.push_back(r.points[k]);
+    // Fewer than 5 (not 3): a margin for points at the angle threshold,
+    // where float sums may round differently from PCL's.
+    bool degenerate = kept.size() < 5;
+    if (!degenerate) {
+      Eigen::Vector3d c = Eigen::Vector3d::Zero();
+      for (const auto& p : kept) c += p.cast<double>();
+      c /= static_cast<double>(kept.size());
+      double dmin = 1e30, dmax = 0;
+      for (const auto& p : kept) {
+        const double d = (p.cast<double>() - c).norm();
+        dmin = std::min(dmin, d);
+        dmax = std::max(dmax, d);
       }
-      // Fewer than 5 (not 3): a margin for points at the angle threshold,
-      // where float sums may round differently from PCL's.
-      bool degenerate = kept.size() < 5;
-      if (!degenerate) {
-        Eigen::Vector3d c = Eigen::Vector3d::Zero();
-        for (const auto& p : kept) c += p.cast<double>();
-        c /= static_cast<double>(kept.size());
-        double dmin = 1e30, dmax = 0;
-        for (const auto& p : kept) {
-          const double d = (p.cast<double>() - c).norm();
-          dmin = std::min(dmin, d);
-          dmax = std::max(dmax, d);
-        }
-        degenerate = !(dmax - dmin > 1e-6);
-      }
-      if (degenerate) {
-        refine = static_cast<float>(M_PI / eps) + 1.f;  // every region point passes
-        break;
-      }
+      degenerate = !(dmax - dmin > 1e-6);
+    }
+    if (degenerate) {
+      refine = static_cast<float>(M_PI / eps) + 1.f;  // every region point passes
+      break;
     }
   }
+  return refine;
+}
 
-  pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(new pcl::search::KdTree<pcl::PointXYZ>);
-  pcl::OURCVFHEstimation<pcl::PointXYZ, pcl::Normal, pcl::VFHSignature308> est;
-  est.setInputCloud(pts);
-  est.setInputNormals(nrm);
-  est.setSearchMethod(tree);
-  est.setViewPoint(0.f, 0.f, 0.f);
-  est.setEPSAngleThreshold(static_cast<float>(s.cvfh_eps_angle_deg * M_PI / 180.0));
-  est.setCurvatureThreshold(static_cast<float>(s.cvfh_curvature_threshold));
-  est.setClusterTolerance(static_cast<float>(s.cvfh_cluster_tolerance_mm) * kToM);
-  est.setRadiusNormals(static_cast<float>(s.cvfh_normal_radius_mm) * kToM);
-  est.setMinPoints(static_cast<size_t>(std::max(s.cvfh_min_region_points, 1)));
-  est.setNormalizeBins(s.cvfh_normalize_bins);
-  est.setAxisRatio(static_cast<float>(s.ourcvfh_axis_ratio));
-  est.setMinAxisValue(static_cast<float>(s.ourcvfh_min_axis_value));
-  est.setRefineClusters(refine);
-  pcl::PointCloud<pcl::VFHSignature308> sigs;
-  est.compute(sigs);
-
+// The signatures, regions and frames PCL computed, in millimetres.
+std::vector<Signature> read_signatures(pcl::OURCVFHEstimation<pcl::PointXYZ, pcl::Normal, pcl::VFHSignature308>& est,
+                                       const pcl::PointCloud<pcl::VFHSignature308>& sigs) {
+  std::vector<Signature> out;
   std::vector<Eigen::Vector3f, Eigen::aligned_allocator<Eigen::Vector3f>> centroids, normals;
   est.getCentroidClusters(centroids);
   est.getCentroidNormalClusters(normals);
@@ -154,6 +123,23 @@ std::vector<Signature> ourcvfh_signatures(const PointSet& cloud, const GlobalSet
     out.push_back(std::move(sig));
   }
   return out;
+}
+
+}  // namespace
+
+std::vector<Signature> ourcvfh_signatures(const PointSet& cloud, const GlobalSettings& s) {
+  if (!cloud.has_normals()) return {};
+  const PclInput in = pcl_input(cloud, kToM, true);
+  // Guard (PCL issues 1449, 1491): too few points for a region and its frame.
+  if (in.points->size() < static_cast<size_t>(std::max(s.cvfh_min_region_points, 10))) return {};
+  pcl::OURCVFHEstimation<pcl::PointXYZ, pcl::Normal, pcl::VFHSignature308> est;
+  configure_cvfh_family(est, in, s, kToM);
+  est.setAxisRatio(static_cast<float>(s.ourcvfh_axis_ratio));
+  est.setMinAxisValue(static_cast<float>(s.ourcvfh_min_axis_value));
+  est.setRefineClusters(safe_refine_clusters(in, s));
+  pcl::PointCloud<pcl::VFHSignature308> sigs;
+  est.compute(sigs);
+  return read_signatures(est, sigs);
 }
 
 }  // namespace pb::global

@@ -15,6 +15,7 @@
 #include <set>
 
 #include "recognition/local/internal.h"
+#include "recognition/local/pcl_features.h"
 
 namespace pb::local {
 
@@ -23,29 +24,10 @@ std::vector<float> compute_board_lrf(const PointSet& cloud, const std::vector<in
   std::vector<float> out(keypoints.size() * kLrfDim, std::numeric_limits<float>::quiet_NaN());
   if (keypoints.empty() || !cloud.has_normals()) return out;
 
-  pcl::PointCloud<pcl::PointXYZ>::Ptr surface(new pcl::PointCloud<pcl::PointXYZ>);
-  pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
-  surface->resize(cloud.size());
-  normals->resize(cloud.size());
-  for (size_t i = 0; i < cloud.size(); ++i) {
-    (*surface)[i].getVector3fMap() = cloud.points[i];
-    (*normals)[i].getNormalVector3fMap() = cloud.normals[i];
-    (*normals)[i].curvature = cloud.curvature.size() == cloud.size() ? cloud.curvature[i] : 0.f;
-  }
-  pcl::PointCloud<pcl::PointXYZ>::Ptr input(new pcl::PointCloud<pcl::PointXYZ>);
-  input->resize(keypoints.size());
-  for (size_t i = 0; i < keypoints.size(); ++i) (*input)[i] = (*surface)[keypoints[i]];
-
   pcl::BOARDLocalReferenceFrameEstimation<pcl::PointXYZ, pcl::Normal, pcl::ReferenceFrame> est;
   est.setFindHoles(true);
-  est.setRadiusSearch(radius_mm);
-  est.setInputCloud(input);
-  est.setSearchSurface(surface);
-  est.setInputNormals(normals);
-  est.setSearchMethod(pcl::search::KdTree<pcl::PointXYZ>::Ptr(new pcl::search::KdTree<pcl::PointXYZ>));
   pcl::PointCloud<pcl::ReferenceFrame> rf;
-  est.compute(rf);
-  if (rf.size() != keypoints.size()) return out;
+  if (!estimate_at_keypoints(est, cloud, keypoints, radius_mm, rf)) return out;
   for (size_t i = 0; i < rf.size(); ++i) {
     float row[kLrfDim];
     for (int d = 0; d < 3; ++d) {
@@ -75,13 +57,6 @@ pcl::PointCloud<pcl::ReferenceFrame>::Ptr to_rf(const std::vector<float>& lrf, s
       (*rf)[i].z_axis[d] = lrf[i * kLrfDim + 6 + d];
     }
   return rf;
-}
-
-pcl::PointCloud<pcl::PointXYZ>::Ptr to_cloud(const std::vector<Vec3f>& pts) {
-  pcl::PointCloud<pcl::PointXYZ>::Ptr c(new pcl::PointCloud<pcl::PointXYZ>);
-  c->resize(pts.size());
-  for (size_t i = 0; i < pts.size(); ++i) (*c)[i].getVector3fMap() = pts[i];
-  return c;
 }
 
 }  // namespace
@@ -120,9 +95,9 @@ std::vector<HoughCluster> hough_grouping(const std::vector<Vec3f>& model_kp,
   hough.setHoughThreshold(p.min_votes);
   hough.setUseInterpolation(p.interpolation);
   hough.setUseDistanceWeight(false);
-  hough.setInputCloud(to_cloud(mk));
+  hough.setInputCloud(pcl_adapter::xyz(mk));
   hough.setInputRf(to_rf(ml, mk.size()));
-  hough.setSceneCloud(to_cloud(scene_kp));
+  hough.setSceneCloud(pcl_adapter::xyz(scene_kp));
   hough.setSceneRf(to_rf(scene_lrf, scene_kp.size()));
   hough.setModelSceneCorrespondences(corrs);
 

@@ -4,13 +4,11 @@
 // drops them. Each row depends on its own neighbourhood only, so the result
 // is the same for any thread count.
 #include <pcl/features/shot_omp.h>
-#include <pcl/point_cloud.h>
-#include <pcl/point_types.h>
-#include <pcl/search/kdtree.h>
 
 #include <limits>
 
 #include "recognition/local/internal.h"
+#include "recognition/local/pcl_features.h"
 
 namespace pb::local {
 
@@ -19,29 +17,10 @@ std::vector<float> compute_shot(const PointSet& cloud, const std::vector<int>& k
   std::vector<float> out(keypoints.size() * kShotDim, std::numeric_limits<float>::quiet_NaN());
   if (keypoints.empty() || !cloud.has_normals()) return out;
 
-  pcl::PointCloud<pcl::PointXYZ>::Ptr surface(new pcl::PointCloud<pcl::PointXYZ>);
-  pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
-  surface->resize(cloud.size());
-  normals->resize(cloud.size());
-  for (size_t i = 0; i < cloud.size(); ++i) {
-    (*surface)[i].getVector3fMap() = cloud.points[i];
-    (*normals)[i].getNormalVector3fMap() = cloud.normals[i];
-    (*normals)[i].curvature = cloud.curvature.size() == cloud.size() ? cloud.curvature[i] : 0.f;
-  }
-  pcl::PointCloud<pcl::PointXYZ>::Ptr input(new pcl::PointCloud<pcl::PointXYZ>);
-  input->resize(keypoints.size());
-  for (size_t i = 0; i < keypoints.size(); ++i) (*input)[i] = (*surface)[keypoints[i]];
-
   pcl::SHOTEstimationOMP<pcl::PointXYZ, pcl::Normal, pcl::SHOT352> est;
   est.setNumberOfThreads(threads < 0 ? 0u : static_cast<unsigned>(threads));
-  est.setInputCloud(input);
-  est.setSearchSurface(surface);
-  est.setInputNormals(normals);
-  est.setSearchMethod(pcl::search::KdTree<pcl::PointXYZ>::Ptr(new pcl::search::KdTree<pcl::PointXYZ>));
-  est.setRadiusSearch(radius_mm);
   pcl::PointCloud<pcl::SHOT352> desc;
-  est.compute(desc);
-  if (desc.size() != keypoints.size()) return out;
+  if (!estimate_at_keypoints(est, cloud, keypoints, radius_mm, desc)) return out;
   for (size_t i = 0; i < desc.size(); ++i) {
     // An invalid frame leaves NaN (or, for some paths, an all-zero
     // descriptor): both are unusable.
