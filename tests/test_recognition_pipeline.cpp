@@ -110,6 +110,27 @@ TEST_F(Pipeline, FindsTheLBlockWithFpfhAndIcp) {
   EXPECT_LT(pbtest::angle_deg(r.T_cam_model.R, scene_->T_cam_model.R), 5.0);
 }
 
+// Registration alone (Table 4.9): from a slightly perturbed ground truth the
+// pose is found ("ok", inliers); from a pose 1 m away from the object no
+// model point has a scene point within the inlier threshold, and that is
+// "no_hypothesis" with the reason, not "ok" with 0 inliers.
+TEST_F(Pipeline, RefineFromIsOkOnlyWithInliers) {
+  const pb::RecognitionSettings s = small_settings("fpfh");
+  const auto model = pb::test::train(*mesh_, s);
+  pb::Pose near = scene_->T_cam_model;
+  near.t += pb::Vec3(5, -3, 4);
+  const pb::RecognitionResult ok = pb::refine_from(scene_->depth, scene_->K, *model, s, near);
+  EXPECT_EQ(ok.status, "ok") << ok.message;
+  EXPECT_GT(ok.inliers, 0);
+  EXPECT_LT((ok.T_cam_model.t - scene_->T_cam_model.t).norm(), 10.0);
+  pb::Pose far = scene_->T_cam_model;
+  far.t += pb::Vec3(1000, 0, 0);
+  const pb::RecognitionResult none = pb::refine_from(scene_->depth, scene_->K, *model, s, far);
+  EXPECT_EQ(none.status, "no_hypothesis");
+  EXPECT_EQ(none.inliers, 0);
+  EXPECT_NE(none.message.find("no hypothesis has an inlier"), std::string::npos) << none.message;
+}
+
 TEST_F(Pipeline, NoPointsAfterFilteringIsNoHypothesis) {
   const pb::RecognitionSettings s = small_settings("fpfh");
   const auto model = pb::test::train(*mesh_, s);

@@ -7,6 +7,7 @@
 
 #include <pcl/search/kdtree.h>
 
+#include <limits>
 #include <vector>
 
 #include "recognition/cloud.h"
@@ -24,6 +25,28 @@ bool estimate_at_keypoints(Estimator& est, const PointSet& cloud, const std::vec
   est.setRadiusSearch(radius_mm);
   est.compute(out);
   return out.size() == keypoints.size();
+}
+
+// Descriptors of an OpenMP estimator (FPFH, SHOT) at keypoints, row-major
+// keypoints.size() x dim; NaN rows where PCL gave none, and, if
+// zero_is_invalid, where it gave an all-zero descriptor. `values` maps a
+// signature to its float array.
+template <typename Signature, typename Estimator, typename Values>
+std::vector<float> describe_keypoints(Estimator& est, const PointSet& cloud, const std::vector<int>& keypoints,
+                                      double radius_mm, int threads, int dim, Values values, bool zero_is_invalid) {
+  std::vector<float> out(keypoints.size() * dim, std::numeric_limits<float>::quiet_NaN());
+  if (keypoints.empty() || !cloud.has_normals()) return out;
+  est.setNumberOfThreads(threads < 0 ? 0u : static_cast<unsigned>(threads));
+  pcl::PointCloud<Signature> desc;
+  if (!estimate_at_keypoints(est, cloud, keypoints, radius_mm, desc)) return out;
+  for (size_t i = 0; i < desc.size(); ++i) {
+    const float* v = values(desc[i]);
+    bool any = !zero_is_invalid;
+    for (int d = 0; d < dim && !any; ++d) any = v[d] != 0.f;
+    if (!any) continue;
+    for (int d = 0; d < dim; ++d) out[i * dim + d] = v[d];
+  }
+  return out;
 }
 
 }  // namespace pb::local
