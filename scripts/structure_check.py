@@ -3,9 +3,11 @@
 
     scripts/structure_check.py [--max-file 450] [--max-function 120] [DIR ...]
 
-Prints every C++ file (.h/.cpp) over --max-file lines and every function
-body over --max-function lines (from the line of its opening brace to the
-line of its closing brace), then exits 1 if any, else 0. Default DIR: src.
+Prints every C++ file (.h/.cpp) over --max-file lines, every function body
+over --max-function lines (from the line of its opening brace to the line
+of its closing brace), and every header that includes PCL but is not one of
+recognition's private glue headers (src/recognition/**/pcl_*.h), then exits
+1 if any, else 0. Default DIR: src.
 
 Functions are found by brace matching with comments, strings and character
 literals skipped: a brace opens a function body when the code before it
@@ -107,6 +109,10 @@ def check(dirs, max_file, max_function):
                 n = text.count("\n")
                 if n > max_file:
                     problems.append("%s: %d lines (limit %d)" % (path, n, max_file))
+                if f.endswith((".h", ".hpp")) and re.search(r"#include\s*<pcl/", text):
+                    private_glue = f.startswith("pcl_") and "recognition" in os.path.normpath(path).split(os.sep)
+                    if not private_glue:
+                        problems.append("%s: a header includes PCL (only src/recognition/**/pcl_*.h may)" % path)
                 for name, a, b in functions(text):
                     if b - a + 1 > max_function:
                         problems.append("%s:%d: function %s is %d lines (limit %d)" %

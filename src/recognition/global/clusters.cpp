@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "recognition/pcl_adapter.h"
 #include "recognition/global/internal.h"
 
 namespace pb::global {
@@ -17,9 +18,7 @@ std::vector<std::vector<int>> euclidean_clusters(const std::vector<Vec3f>& point
                                                  int min_points, int max_points) {
   std::vector<std::vector<int>> out;
   if (points.empty() || static_cast<int>(points.size()) < std::max(min_points, 1)) return out;
-  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
-  cloud->resize(points.size());
-  for (size_t i = 0; i < points.size(); ++i) (*cloud)[i].getVector3fMap() = points[i];
+  const auto cloud = pcl_adapter::xyz(points);
   pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(new pcl::search::KdTree<pcl::PointXYZ>);
   tree->setInputCloud(cloud);
   pcl::EuclideanClusterExtraction<pcl::PointXYZ> ec;

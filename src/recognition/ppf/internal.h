@@ -1,10 +1,7 @@
 // Private pieces of the PPF method (ppf/method.cpp, ppf/voting.cpp): the
 // pair feature table, the reference frames of PCL's PPF convention, voting
-// and pose clustering. Includes PCL (private to ppf/).
+// and pose clustering. PCL-free (PCL stays in the .cpp files).
 #pragma once
-
-#include <pcl/features/ppf.h>
-#include <pcl/point_types.h>
 
 #include <Eigen/Geometry>
 #include <cstdint>
@@ -40,9 +37,16 @@ inline uint64_t feature_key(float f1, float f2, float f3, float f4, float angle_
 
 // The trained model: downsampled merged views (model frame, mm), the n x n
 // pair features (row = reference point) and the pairs sorted by feature key.
+// One ordered model pair's feature (pcl::PPFSignature's values): the angles
+// f1..f3, the distance f4 (mm) and the angle alpha_m of the second point
+// about the reference point's normal.
+struct PairFeature {
+  float f1 = 0, f2 = 0, f3 = 0, f4 = 0, alpha_m = 0;
+};
+
 struct Model {
   std::vector<Vec3f> points, normals;
-  std::vector<pcl::PPFSignature> features;
+  std::vector<PairFeature> features;
   std::vector<PairEntry> table;  // empty: nothing to match
   float angle_step = 0, distance_step = 0, diameter = 0;
 };

@@ -39,6 +39,8 @@
 //
 // Units: millimetres throughout (PCL's PPF code is unit-free apart from the
 // distance step, which is a fraction of the model diameter).
+#include <pcl/features/ppf.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -107,7 +109,7 @@ class PpfMethod : public Method {
     m.diameter = in.pod<float>();
     m.points = in.points();
     m.normals = in.points();
-    m.features = in.vec<pcl::PPFSignature>();
+    m.features = in.vec<ppf::PairFeature>();
     const size_t n = m.points.size();
     if (n > 100000 || m.normals.size() != n) in.fail("bad model point count");
     if (m.features.size() != (n >= 3 ? n * n : 0)) in.fail("feature count does not match the model");
@@ -163,7 +165,8 @@ class PpfMethod : public Method {
     est.setInputCloud(cloud);
     est.setInputNormals(cloud);
     est.compute(f);
-    m_.features.assign(f.begin(), f.end());
+    m_.features.resize(f.size());
+    for (size_t i = 0; i < f.size(); ++i) m_.features[i] = {f[i].f1, f[i].f2, f[i].f3, f[i].f4, f[i].alpha_m};
   }
 
   // The feature table: every model pair with a defined feature, sorted by

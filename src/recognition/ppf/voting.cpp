@@ -1,6 +1,7 @@
 // PPF voting and pose clustering (see method.cpp for the algorithm).
 #include <pcl/features/pfh_tools.h>
 #include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/point_types.h>
 
 #include <algorithm>
 #include <cmath>

@@ -13,6 +13,7 @@
 #include <omp.h>
 #endif
 
+#include "recognition/pcl_adapter.h"
 #include "recognition/preprocess/internal.h"
 
 #include <pcl/console/print.h>
@@ -33,10 +34,7 @@ void estimate_normals(PointSet& ps, double radius_mm) {
   ps.normals.clear();
   ps.curvature.clear();
   if (ps.points.empty()) return;
-  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
-  cloud->resize(ps.points.size());
-  for (size_t i = 0; i < ps.points.size(); ++i)
-    (*cloud)[i] = pcl::PointXYZ(ps.points[i].x(), ps.points[i].y(), ps.points[i].z());
+  const auto cloud = pcl_adapter::xyz(ps.points);
   pcl::NormalEstimationOMP<pcl::PointXYZ, pcl::Normal> ne;
 #ifdef _OPENMP
   ne.setNumberOfThreads(static_cast<unsigned>(omp_get_max_threads()));

@@ -1,5 +1,6 @@
 // Verification (thesis 3.1): inliers are model points whose nearest scene
 // point lies within a threshold. PointIndex wraps pcl::KdTreeFLANN.
+#include "recognition/pcl_adapter.h"
 #include "recognition/verify/verify.h"
 
 #include <pcl/kdtree/kdtree_flann.h>
@@ -18,12 +19,9 @@ struct PointIndex::Impl {
 };
 
 PointIndex::PointIndex(const std::vector<Vec3f>& points) : impl_(new Impl) {
-  impl_->cloud->reserve(points.size());
   for (const auto& p : points)
-    if (std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z()))
-      impl_->cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
-  if (impl_->cloud->size() != points.size())
-    throw std::invalid_argument("PointIndex: non-finite point");  // callers pass finite clouds
+    if (!p.allFinite()) throw std::invalid_argument("PointIndex: non-finite point");  // callers pass finite clouds
+  impl_->cloud = pcl_adapter::xyz(points);
   if (!impl_->cloud->empty()) impl_->tree.setInputCloud(impl_->cloud);
 }
 
