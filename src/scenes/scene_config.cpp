@@ -21,6 +21,8 @@ SceneSettings default_scene_settings(Scenario s) {
     st.camera.elevation_deg = {5, 30};
     st.distractors.min_count = 0;
     st.distractors.max_count = 2;
+    st.occlusion.box_depth_mm = {300, 800};
+    st.occlusion.cylinder_min_radius_mm = 150;
   }
   return st;
 }
@@ -72,20 +74,109 @@ int read_int_at_least(const YamlNode& parent, const std::string& key, int fallba
   return v;
 }
 
-}  // namespace
+double read_at_most(const YamlNode& parent, const std::string& key, double fallback, double min_value,
+                    double max_value) {
+  const double v = parent.get_or<double>(key, fallback);
+  if (!std::isfinite(v)) parent[key].fail("must be finite");
+  if (!(v >= min_value)) parent[key].fail("must be at least " + num(min_value) + ", got " + num(v));
+  if (!(v <= max_value)) parent[key].fail("must be at most " + num(max_value) + ", got " + num(v));
+  return v;
+}
 
-SceneSettings parse_scene_settings(const YamlNode& root) {
-  root.check_keys({"scenario", "description", "scene_id", "seed", "images", "sensor", "noise",
-                   "depth_scale", "registry", "target", "target_upright_probability",
-                   "min_target_visib", "distractors", "occlusion", "camera", "table", "warehouse",
-                   "masks", "max_attempts"});
-  const std::string scen = root.get<std::string>("scenario");
-  Scenario scenario;
-  if (scen == "table") scenario = Scenario::table;
-  else if (scen == "warehouse") scenario = Scenario::warehouse;
-  else root["scenario"].fail("unknown scenario '" + scen + "' (table | warehouse)");
+void parse_camera(const YamlNode& c, SceneCameraSettings& cam) {
+  c.check_keys({"distance_mm", "elevation_deg", "look_jitter", "near_mm", "far_mm", "clearance_mm",
+                "depth_clearance_mm"});
+  read_range(c, "distance_mm", cam.distance_mm, true);
+  read_range(c, "elevation_deg", cam.elevation_deg, false, -89.0, 89.0);
+  cam.look_jitter = c.get_nonnegative("look_jitter", cam.look_jitter);
+  if (cam.look_jitter > 1.0) c["look_jitter"].fail("must be at most 1");
+  cam.near_mm = c.get_positive("near_mm", cam.near_mm);
+  cam.far_mm = c.get_positive("far_mm", cam.far_mm);
+  if (!(cam.far_mm > cam.near_mm)) c[c.has("far_mm") ? "far_mm" : "near_mm"].fail("need near_mm < far_mm");
+  cam.clearance_mm = c.get_nonnegative("clearance_mm", cam.clearance_mm);
+  cam.depth_clearance_mm = c.get_nonnegative("depth_clearance_mm", cam.depth_clearance_mm);
+}
 
-  SceneSettings s = default_scene_settings(scenario);
+void parse_distractors(const YamlNode& d, DistractorSettings& ds) {
+  d.check_keys({"pool", "count", "upright_probability", "placement_tries", "spread_min_radii", "image_margin"});
+  if (d.has("pool")) ds.pool = d.get<std::vector<std::string>>("pool");
+  if (d.has("count")) {
+    ValueRange r{double(ds.min_count), double(ds.max_count)};
+    read_range(d, "count", r, false, 0.0, 100.0);
+    if (r.lo != std::floor(r.lo) || r.hi != std::floor(r.hi)) d["count"].fail("must be whole numbers");
+    ds.min_count = static_cast<int>(r.lo);
+    ds.max_count = static_cast<int>(r.hi);
+  }
+  ds.upright_probability = read_probability(d, "upright_probability", ds.upright_probability);
+  ds.placement_tries = read_int_at_least(d, "placement_tries", ds.placement_tries, 1);
+  ds.spread_min_radii = d.get_nonnegative("spread_min_radii", ds.spread_min_radii);
+  ds.image_margin = read_at_most(d, "image_margin", ds.image_margin, 0.0, 10.0);
+}
+
+// The map form of occlusion: {visib_fract, probability, layout details}.
+void parse_occlusion_map(const YamlNode& o, OcclusionSettings& oc) {
+  o.check_keys({"visib_fract", "probability", "box_probability", "box_width", "box_depth_mm",
+                "cylinder_radius", "cylinder_min_radius_mm", "lateral_offset", "extra_distance",
+                "height_factor", "height_margin_mm", "camera_headroom_mm", "min_height_mm", "token_height",
+                "search_iterations", "search_tolerance", "footprint_sides", "cylinder_segments"});
+  oc.enabled = true;
+  read_range(o, "visib_fract", oc.visib_fract, false, 0.0, 1.0);
+  oc.probability = read_probability(o, "probability", oc.probability);
+  oc.box_probability = read_probability(o, "box_probability", oc.box_probability);
+  read_range(o, "box_width", oc.box_width, true);
+  read_range(o, "box_depth_mm", oc.box_depth_mm, true);
+  read_range(o, "cylinder_radius", oc.cylinder_radius, true);
+  oc.cylinder_min_radius_mm = o.get_nonnegative("cylinder_min_radius_mm", oc.cylinder_min_radius_mm);
+  read_range(o, "lateral_offset", oc.lateral_offset, false, -100.0, 100.0);
+  read_range(o, "extra_distance", oc.extra_distance, false, 0.0, 100.0);
+  oc.height_factor = o.get_positive("height_factor", oc.height_factor);
+  oc.height_margin_mm = o.get_nonnegative("height_margin_mm", oc.height_margin_mm);
+  oc.camera_headroom_mm = o.get_nonnegative("camera_headroom_mm", oc.camera_headroom_mm);
+  oc.min_height_mm = o.get_nonnegative("min_height_mm", oc.min_height_mm);
+  oc.token_height = read_at_most(o, "token_height", oc.token_height, 0.0, 1.0);
+  oc.search_iterations = read_int_at_least(o, "search_iterations", oc.search_iterations, 0);
+  oc.search_tolerance = read_at_most(o, "search_tolerance", oc.search_tolerance, 0.0, 1.0);
+  oc.footprint_sides = read_int_at_least(o, "footprint_sides", oc.footprint_sides, 3);
+  oc.cylinder_segments = read_int_at_least(o, "cylinder_segments", oc.cylinder_segments, 3);
+}
+
+void parse_occlusion(const YamlNode& root, OcclusionSettings& oc) {
+  const YamlNode o = root["occlusion"];
+  if (o.is_scalar()) {
+    const std::string v = o.as<std::string>();
+    if (v != "none") o.fail("expected none, a range [lo, hi] or {visib_fract, probability}");
+    oc.enabled = false;
+  } else if (o.is_sequence()) {
+    oc.enabled = true;
+    read_range(root, "occlusion", oc.visib_fract, false, 0.0, 1.0);
+  } else {
+    parse_occlusion_map(o, oc);
+  }
+}
+
+void parse_table(const YamlNode& t, TableSettings& ts) {
+  t.check_keys({"size_mm", "thickness_mm", "gap_mm"});
+  ts.size_mm = t.get_positive("size_mm", ts.size_mm);
+  ts.thickness_mm = t.get_positive("thickness_mm", ts.thickness_mm);
+  ts.gap_mm = t.get_nonnegative("gap_mm", ts.gap_mm);
+}
+
+void parse_warehouse(const YamlNode& w, WarehouseSettings& ws) {
+  w.check_keys({"object_size_mm", "wall_distance_mm", "wall_height_mm", "gap_mm", "wall_yaw_deg",
+                "wall_thickness_mm", "wall_length_mm", "floor_size_mm", "floor_thickness_mm"});
+  read_range(w, "object_size_mm", ws.object_size_mm, true);
+  read_range(w, "wall_distance_mm", ws.wall_distance_mm, true);
+  ws.wall_height_mm = w.get_positive("wall_height_mm", ws.wall_height_mm);
+  ws.gap_mm = w.get_nonnegative("gap_mm", ws.gap_mm);
+  ws.wall_yaw_deg = read_at_most(w, "wall_yaw_deg", ws.wall_yaw_deg, 0.0, 89.0);
+  ws.wall_thickness_mm = w.get_positive("wall_thickness_mm", ws.wall_thickness_mm);
+  ws.wall_length_mm = w.get_positive("wall_length_mm", ws.wall_length_mm);
+  ws.floor_size_mm = w.get_positive("floor_size_mm", ws.floor_size_mm);
+  ws.floor_thickness_mm = w.get_positive("floor_thickness_mm", ws.floor_thickness_mm);
+}
+
+// Top-level keys up to the sensor and noise.
+void parse_identity_and_sensor(const YamlNode& root, SceneSettings& s) {
   s.config_file = root.file();
   if (!s.config_file.empty()) s.name = fs::path(s.config_file).stem().string();
   root.read("description", s.description);
@@ -107,7 +198,23 @@ SceneSettings parse_scene_settings(const YamlNode& root) {
   s.sensor_name = s.sensor.name;
   s.noise = root.has("noise") ? parse_noise(root["noise"], s.sensor.noise) : s.sensor.noise;
   s.depth_scale = root.get_positive("depth_scale", s.sensor.depth_scale);
+}
 
+}  // namespace
+
+SceneSettings parse_scene_settings(const YamlNode& root) {
+  root.check_keys({"scenario", "description", "scene_id", "seed", "images", "sensor", "noise",
+                   "depth_scale", "registry", "target", "target_upright_probability",
+                   "min_target_visib", "distractors", "occlusion", "camera", "table", "warehouse",
+                   "masks", "max_attempts"});
+  const std::string scen = root.get<std::string>("scenario");
+  Scenario scenario;
+  if (scen == "table") scenario = Scenario::table;
+  else if (scen == "warehouse") scenario = Scenario::warehouse;
+  else root["scenario"].fail("unknown scenario '" + scen + "' (table | warehouse)");
+
+  SceneSettings s = default_scene_settings(scenario);
+  parse_identity_and_sensor(root, s);
   if (root.has("registry")) {
     s.registry = root.get<std::string>("registry");
     if (s.registry.empty()) root["registry"].fail("empty path");
@@ -121,63 +228,13 @@ SceneSettings parse_scene_settings(const YamlNode& root) {
       read_probability(root, "target_upright_probability", s.target_upright_probability);
   s.min_target_visib = read_probability(root, "min_target_visib", s.min_target_visib);
 
-  if (root.has("distractors")) {
-    const YamlNode d = root["distractors"];
-    d.check_keys({"pool", "count", "upright_probability"});
-    if (d.has("pool")) s.distractors.pool = d.get<std::vector<std::string>>("pool");
-    if (d.has("count")) {
-      ValueRange r{double(s.distractors.min_count), double(s.distractors.max_count)};
-      read_range(d, "count", r, false, 0.0, 100.0);
-      if (r.lo != std::floor(r.lo) || r.hi != std::floor(r.hi)) d["count"].fail("must be whole numbers");
-      s.distractors.min_count = static_cast<int>(r.lo);
-      s.distractors.max_count = static_cast<int>(r.hi);
-    }
-    s.distractors.upright_probability =
-        read_probability(d, "upright_probability", s.distractors.upright_probability);
-  }
+  if (root.has("distractors")) parse_distractors(root["distractors"], s.distractors);
   if (s.distractors.max_count > 0 && s.distractors.pool.empty())
     root["distractors"].fail("count > 0 needs a non-empty pool");
-
-  if (root.has("occlusion")) {
-    const YamlNode o = root["occlusion"];
-    if (o.is_scalar()) {
-      const std::string v = o.as<std::string>();
-      if (v != "none") o.fail("expected none, a range [lo, hi] or {visib_fract, probability}");
-      s.occlusion.enabled = false;
-    } else if (o.is_sequence()) {
-      s.occlusion.enabled = true;
-      read_range(root, "occlusion", s.occlusion.visib_fract, false, 0.0, 1.0);
-    } else {
-      o.check_keys({"visib_fract", "probability"});
-      s.occlusion.enabled = true;
-      read_range(o, "visib_fract", s.occlusion.visib_fract, false, 0.0, 1.0);
-      s.occlusion.probability = read_probability(o, "probability", s.occlusion.probability);
-    }
-  }
-
-  if (root.has("camera")) {
-    const YamlNode c = root["camera"];
-    c.check_keys({"distance_mm", "elevation_deg", "look_jitter"});
-    read_range(c, "distance_mm", s.camera.distance_mm, true);
-    read_range(c, "elevation_deg", s.camera.elevation_deg, false, -89.0, 89.0);
-    s.camera.look_jitter = c.get_nonnegative("look_jitter", s.camera.look_jitter);
-    if (s.camera.look_jitter > 1.0) c["look_jitter"].fail("must be at most 1");
-  }
-  if (root.has("table")) {
-    const YamlNode t = root["table"];
-    t.check_keys({"size_mm", "thickness_mm", "gap_mm"});
-    s.table.size_mm = t.get_positive("size_mm", s.table.size_mm);
-    s.table.thickness_mm = t.get_positive("thickness_mm", s.table.thickness_mm);
-    s.table.gap_mm = t.get_nonnegative("gap_mm", s.table.gap_mm);
-  }
-  if (root.has("warehouse")) {
-    const YamlNode w = root["warehouse"];
-    w.check_keys({"object_size_mm", "wall_distance_mm", "wall_height_mm", "gap_mm"});
-    read_range(w, "object_size_mm", s.warehouse.object_size_mm, true);
-    read_range(w, "wall_distance_mm", s.warehouse.wall_distance_mm, true);
-    s.warehouse.wall_height_mm = w.get_positive("wall_height_mm", s.warehouse.wall_height_mm);
-    s.warehouse.gap_mm = w.get_nonnegative("gap_mm", s.warehouse.gap_mm);
-  }
+  if (root.has("occlusion")) parse_occlusion(root, s.occlusion);
+  if (root.has("camera")) parse_camera(root["camera"], s.camera);
+  if (root.has("table")) parse_table(root["table"], s.table);
+  if (root.has("warehouse")) parse_warehouse(root["warehouse"], s.warehouse);
   root.read("masks", s.masks);
   s.max_attempts = read_int_at_least(root, "max_attempts", s.max_attempts, 1);
   return s;
@@ -187,9 +244,72 @@ SceneSettings load_scene_settings(const std::string& path) {
   return parse_scene_settings(YamlNode::load_file(path));
 }
 
+namespace {
+
+using nlohmann::ordered_json;
+
+ordered_json range_json(const ValueRange& r) { return ordered_json::array({r.lo, r.hi}); }
+
+// Adds a layout detail to `j` only when it differs from its default, so that
+// posebench_scene.json of a scene set made with the defaults keeps its bytes.
+void put_changed(ordered_json& j, const char* key, double v, double def) {
+  if (v != def) j[key] = v;
+}
+void put_changed(ordered_json& j, const char* key, int v, int def) {
+  if (v != def) j[key] = v;
+}
+void put_changed(ordered_json& j, const char* key, const ValueRange& v, const ValueRange& def) {
+  if (v.lo != def.lo || v.hi != def.hi) j[key] = range_json(v);
+}
+
+void add_layout_details(ordered_json& j, const SceneSettings& s) {
+  const SceneSettings d = default_scene_settings(s.scenario);
+  ordered_json& cam = j["camera"];
+  put_changed(cam, "near_mm", s.camera.near_mm, d.camera.near_mm);
+  put_changed(cam, "far_mm", s.camera.far_mm, d.camera.far_mm);
+  put_changed(cam, "clearance_mm", s.camera.clearance_mm, d.camera.clearance_mm);
+  put_changed(cam, "depth_clearance_mm", s.camera.depth_clearance_mm, d.camera.depth_clearance_mm);
+  ordered_json& ds = j["distractors"];
+  put_changed(ds, "placement_tries", s.distractors.placement_tries, d.distractors.placement_tries);
+  put_changed(ds, "spread_min_radii", s.distractors.spread_min_radii, d.distractors.spread_min_radii);
+  put_changed(ds, "image_margin", s.distractors.image_margin, d.distractors.image_margin);
+  if (s.occlusion.enabled) {
+    const OcclusionSettings& o = s.occlusion;
+    const OcclusionSettings& od = d.occlusion;
+    ordered_json& oj = j["occlusion"];
+    put_changed(oj, "box_probability", o.box_probability, od.box_probability);
+    put_changed(oj, "box_width", o.box_width, od.box_width);
+    put_changed(oj, "box_depth_mm", o.box_depth_mm, od.box_depth_mm);
+    put_changed(oj, "cylinder_radius", o.cylinder_radius, od.cylinder_radius);
+    put_changed(oj, "cylinder_min_radius_mm", o.cylinder_min_radius_mm, od.cylinder_min_radius_mm);
+    put_changed(oj, "lateral_offset", o.lateral_offset, od.lateral_offset);
+    put_changed(oj, "extra_distance", o.extra_distance, od.extra_distance);
+    put_changed(oj, "height_factor", o.height_factor, od.height_factor);
+    put_changed(oj, "height_margin_mm", o.height_margin_mm, od.height_margin_mm);
+    put_changed(oj, "camera_headroom_mm", o.camera_headroom_mm, od.camera_headroom_mm);
+    put_changed(oj, "min_height_mm", o.min_height_mm, od.min_height_mm);
+    put_changed(oj, "token_height", o.token_height, od.token_height);
+    put_changed(oj, "search_iterations", o.search_iterations, od.search_iterations);
+    put_changed(oj, "search_tolerance", o.search_tolerance, od.search_tolerance);
+    put_changed(oj, "footprint_sides", o.footprint_sides, od.footprint_sides);
+    put_changed(oj, "cylinder_segments", o.cylinder_segments, od.cylinder_segments);
+  }
+  if (s.scenario == Scenario::warehouse) {
+    const WarehouseSettings& w = s.warehouse;
+    const WarehouseSettings& wd = d.warehouse;
+    ordered_json& wj = j["warehouse"];
+    put_changed(wj, "wall_yaw_deg", w.wall_yaw_deg, wd.wall_yaw_deg);
+    put_changed(wj, "wall_thickness_mm", w.wall_thickness_mm, wd.wall_thickness_mm);
+    put_changed(wj, "wall_length_mm", w.wall_length_mm, wd.wall_length_mm);
+    put_changed(wj, "floor_size_mm", w.floor_size_mm, wd.floor_size_mm);
+    put_changed(wj, "floor_thickness_mm", w.floor_thickness_mm, wd.floor_thickness_mm);
+  }
+}
+
+}  // namespace
+
 std::string scene_settings_json(const SceneSettings& s) {
-  using nlohmann::ordered_json;
-  auto range = [](const ValueRange& r) { return ordered_json::array({r.lo, r.hi}); };
+  auto range = range_json;
   ordered_json j;
   j["name"] = s.name;
   j["config_file"] = s.config_file.empty() ? "" : fs::path(s.config_file).filename().string();
@@ -245,6 +365,7 @@ std::string scene_settings_json(const SceneSettings& s) {
                       {"wall_distance_mm", range(s.warehouse.wall_distance_mm)},
                       {"wall_height_mm", s.warehouse.wall_height_mm},
                       {"gap_mm", s.warehouse.gap_mm}};
+  add_layout_details(j, s);
   j["masks"] = s.masks;
   j["max_attempts"] = s.max_attempts;
   return j.dump(2);
