@@ -250,60 +250,44 @@ using nlohmann::ordered_json;
 
 ordered_json range_json(const ValueRange& r) { return ordered_json::array({r.lo, r.hi}); }
 
-// Adds a layout detail to `j` only when it differs from its default, so that
-// posebench_scene.json of a scene set made with the defaults keeps its bytes.
-void put_changed(ordered_json& j, const char* key, double v, double def) {
-  if (v != def) j[key] = v;
-}
-void put_changed(ordered_json& j, const char* key, int v, int def) {
-  if (v != def) j[key] = v;
-}
-void put_changed(ordered_json& j, const char* key, const ValueRange& v, const ValueRange& def) {
-  if (v.lo != def.lo || v.hi != def.hi) j[key] = range_json(v);
+// The layout details of a scenario's sections, each listed once.
+ordered_json layout_details(const SceneSettings& s) {
+  const SceneCameraSettings& c = s.camera;
+  const DistractorSettings& d = s.distractors;
+  const OcclusionSettings& o = s.occlusion;
+  const WarehouseSettings& w = s.warehouse;
+  ordered_json j;
+  j["camera"] = {{"near_mm", c.near_mm}, {"far_mm", c.far_mm}, {"clearance_mm", c.clearance_mm},
+                 {"depth_clearance_mm", c.depth_clearance_mm}};
+  j["distractors"] = {{"placement_tries", d.placement_tries}, {"spread_min_radii", d.spread_min_radii},
+                      {"image_margin", d.image_margin}};
+  if (o.enabled)
+    j["occlusion"] = {
+        {"box_probability", o.box_probability},   {"box_width", range_json(o.box_width)},
+        {"box_depth_mm", range_json(o.box_depth_mm)}, {"cylinder_radius", range_json(o.cylinder_radius)},
+        {"cylinder_min_radius_mm", o.cylinder_min_radius_mm}, {"lateral_offset", range_json(o.lateral_offset)},
+        {"extra_distance", range_json(o.extra_distance)}, {"height_factor", o.height_factor},
+        {"height_margin_mm", o.height_margin_mm}, {"camera_headroom_mm", o.camera_headroom_mm},
+        {"min_height_mm", o.min_height_mm},       {"token_height", o.token_height},
+        {"search_iterations", o.search_iterations}, {"search_tolerance", o.search_tolerance},
+        {"footprint_sides", o.footprint_sides},   {"cylinder_segments", o.cylinder_segments}};
+  if (s.scenario == Scenario::warehouse)
+    j["warehouse"] = {{"wall_yaw_deg", w.wall_yaw_deg}, {"wall_thickness_mm", w.wall_thickness_mm},
+                      {"wall_length_mm", w.wall_length_mm}, {"floor_size_mm", w.floor_size_mm},
+                      {"floor_thickness_mm", w.floor_thickness_mm}};
+  return j;
 }
 
+// Adds the layout details that differ from their defaults to their sections
+// of `j`, so that posebench_scene.json of a scene set made with the defaults
+// keeps its bytes.
 void add_layout_details(ordered_json& j, const SceneSettings& s) {
-  const SceneSettings d = default_scene_settings(s.scenario);
-  ordered_json& cam = j["camera"];
-  put_changed(cam, "near_mm", s.camera.near_mm, d.camera.near_mm);
-  put_changed(cam, "far_mm", s.camera.far_mm, d.camera.far_mm);
-  put_changed(cam, "clearance_mm", s.camera.clearance_mm, d.camera.clearance_mm);
-  put_changed(cam, "depth_clearance_mm", s.camera.depth_clearance_mm, d.camera.depth_clearance_mm);
-  ordered_json& ds = j["distractors"];
-  put_changed(ds, "placement_tries", s.distractors.placement_tries, d.distractors.placement_tries);
-  put_changed(ds, "spread_min_radii", s.distractors.spread_min_radii, d.distractors.spread_min_radii);
-  put_changed(ds, "image_margin", s.distractors.image_margin, d.distractors.image_margin);
-  if (s.occlusion.enabled) {
-    const OcclusionSettings& o = s.occlusion;
-    const OcclusionSettings& od = d.occlusion;
-    ordered_json& oj = j["occlusion"];
-    put_changed(oj, "box_probability", o.box_probability, od.box_probability);
-    put_changed(oj, "box_width", o.box_width, od.box_width);
-    put_changed(oj, "box_depth_mm", o.box_depth_mm, od.box_depth_mm);
-    put_changed(oj, "cylinder_radius", o.cylinder_radius, od.cylinder_radius);
-    put_changed(oj, "cylinder_min_radius_mm", o.cylinder_min_radius_mm, od.cylinder_min_radius_mm);
-    put_changed(oj, "lateral_offset", o.lateral_offset, od.lateral_offset);
-    put_changed(oj, "extra_distance", o.extra_distance, od.extra_distance);
-    put_changed(oj, "height_factor", o.height_factor, od.height_factor);
-    put_changed(oj, "height_margin_mm", o.height_margin_mm, od.height_margin_mm);
-    put_changed(oj, "camera_headroom_mm", o.camera_headroom_mm, od.camera_headroom_mm);
-    put_changed(oj, "min_height_mm", o.min_height_mm, od.min_height_mm);
-    put_changed(oj, "token_height", o.token_height, od.token_height);
-    put_changed(oj, "search_iterations", o.search_iterations, od.search_iterations);
-    put_changed(oj, "search_tolerance", o.search_tolerance, od.search_tolerance);
-    put_changed(oj, "footprint_sides", o.footprint_sides, od.footprint_sides);
-    put_changed(oj, "cylinder_segments", o.cylinder_segments, od.cylinder_segments);
-  }
-  if (s.scenario == Scenario::warehouse) {
-    const WarehouseSettings& w = s.warehouse;
-    const WarehouseSettings& wd = d.warehouse;
-    ordered_json& wj = j["warehouse"];
-    put_changed(wj, "wall_yaw_deg", w.wall_yaw_deg, wd.wall_yaw_deg);
-    put_changed(wj, "wall_thickness_mm", w.wall_thickness_mm, wd.wall_thickness_mm);
-    put_changed(wj, "wall_length_mm", w.wall_length_mm, wd.wall_length_mm);
-    put_changed(wj, "floor_size_mm", w.floor_size_mm, wd.floor_size_mm);
-    put_changed(wj, "floor_thickness_mm", w.floor_thickness_mm, wd.floor_thickness_mm);
-  }
+  SceneSettings defaults = default_scene_settings(s.scenario);
+  defaults.occlusion.enabled = s.occlusion.enabled;
+  const ordered_json mine = layout_details(s), def = layout_details(defaults);
+  for (auto section = mine.begin(); section != mine.end(); ++section)
+    for (auto it = section.value().begin(); it != section.value().end(); ++it)
+      if (it.value() != def[section.key()][it.key()]) j[section.key()][it.key()] = it.value();
 }
 
 }  // namespace

@@ -70,14 +70,12 @@ struct SceneCameraSettings {
   // the half field of view at that distance, so the target is not always at
   // the image centre.
   double look_jitter = 0.15;
-  // Clipping planes of the depth renderer (mm, along the optical axis).
-  double near_mm = 50;
-  double far_mm = 40000;
-  // Placement clearance: an object's (or occluder's) bounding sphere must stay
-  // this far (mm) beyond near_mm from the camera centre ...
-  double clearance_mm = 50;
-  // ... and its nearest point this far (mm) beyond near_mm in camera depth.
-  double depth_clearance_mm = 20;
+  // Layout details. Clearances are mm beyond near_mm: an object's (or the
+  // occluder's) bounding sphere must keep them from the camera.
+  double near_mm = 50;              // near clipping plane of the renderer, mm
+  double far_mm = 40000;            // far clipping plane of the renderer, mm
+  double clearance_mm = 50;         // sphere to camera centre (3D distance), mm
+  double depth_clearance_mm = 20;   // sphere's nearest point in camera depth z, mm
 };
 
 struct DistractorSettings {
@@ -93,14 +91,13 @@ struct DistractorSettings {
   // Probability that an object stands upright; otherwise a rest pose is drawn
   // by its quasi-static probability (lying on a side, tipped over...).
   double upright_probability = 0.5;
-  // Random positions tried per object before the layout is given up.
-  int placement_tries = 60;
-  // Objects are scattered over a disc around the target as wide as the view
-  // at the target's distance, but at least this many target footprint radii.
-  double spread_min_radii = 3.0;
-  // An object's origin must project inside the image enlarged by this
-  // fraction of its width / height on each side.
-  double image_margin = 0.05;
+  // Layout details. The scatter disc around the target is as wide as the
+  // view at the target's distance, but at least spread_min_radii target
+  // footprint radii; an object's origin must project inside the image
+  // enlarged by image_margin (fraction of its width / height) on each side.
+  int placement_tries = 60;         // random positions tried per object before the layout is given up
+  double spread_min_radii = 3.0;    // minimum scatter disc radius, in target footprint radii
+  double image_margin = 0.05;       // fraction of the image size, each side
 };
 
 struct OcclusionSettings {
@@ -110,35 +107,30 @@ struct OcclusionSettings {
   // The occluder's size is searched so that the target's visible fraction
   // lands in this range (drawn uniformly per image).
   ValueRange visib_fract{0.4, 0.9};
-  // Shape and place of the occluder. r_t below is the target's footprint
-  // radius (largest distance of its footprint from its origin, mm).
-  double box_probability = 0.65;     // a box; otherwise an upright cylinder
-  ValueRange box_width{0.8, 1.6};    // box width (across the view), in units of 2 r_t
-  // Box depth (along the view), mm. table: 30-80, warehouse: 300-800.
-  ValueRange box_depth_mm{30, 80};
-  ValueRange cylinder_radius{0.5, 1.0};  // cylinder radius, in units of r_t ...
-  // ... but at least this (mm). table: 20, warehouse: 150.
-  double cylinder_min_radius_mm = 20;
-  // Sideways offset of its centre from the camera-target line, in units of r_t.
-  ValueRange lateral_offset{-0.5, 0.5};
-  // Distance added to the closest position (footprints gap_mm apart), in units of r_t.
-  ValueRange extra_distance{0.0, 0.5};
-  // Tallest occluder tried: height_factor * (height hiding the whole target)
-  // + height_margin_mm, but at least camera_headroom_mm below the camera;
-  // below min_height_mm the layout is resampled (mm).
-  double height_factor = 1.3;
-  double height_margin_mm = 20;
-  double camera_headroom_mm = 100;
-  double min_height_mm = 5;
-  // Height search (regula falsi on the target's visible fraction): when the
-  // target is already occluded enough without it, a token occluder of this
-  // fraction of the tallest height; at most search_iterations steps, stopping
-  // once the visible fraction is within search_tolerance of the goal.
-  double token_height = 0.02;
-  int search_iterations = 12;
-  double search_tolerance = 0.02;
-  int footprint_sides = 24;    // polygon approximating a cylinder's footprint (overlap tests)
-  int cylinder_segments = 32;  // segments of the rendered cylinder mesh
+  // Layout details: shape and place of the occluder. r_t is the target's
+  // footprint radius (largest distance of its footprint from its origin).
+  // Its tallest height tried is height_factor * (the height hiding the whole
+  // target) + height_margin_mm, at least camera_headroom_mm below the camera;
+  // below min_height_mm the layout is resampled. The height is searched by
+  // regula falsi on the target's visible fraction (at most search_iterations
+  // steps, stopping within search_tolerance of the goal); a target occluded
+  // enough without it gets a token occluder of token_height * the tallest.
+  double box_probability = 0.65;          // a box, otherwise an upright cylinder
+  ValueRange box_width{0.8, 1.6};         // across the view, in units of 2 r_t
+  ValueRange box_depth_mm{30, 80};        // along the view, mm (warehouse: 300-800)
+  ValueRange cylinder_radius{0.5, 1.0};   // in units of r_t, but at least:
+  double cylinder_min_radius_mm = 20;     // mm (warehouse: 150)
+  ValueRange lateral_offset{-0.5, 0.5};   // centre's offset across the camera-target line, units of r_t
+  ValueRange extra_distance{0.0, 0.5};    // added to the closest position (gap_mm apart), units of r_t
+  double height_factor = 1.3;             // times the height hiding the target (unitless)
+  double height_margin_mm = 20;           // added to that height, mm
+  double camera_headroom_mm = 100;        // tallest height stays this far below the camera, mm
+  double min_height_mm = 5;               // a smaller tallest height: no room, resample, mm
+  double token_height = 0.02;             // token occluder, fraction of the tallest height
+  int search_iterations = 12;             // regula falsi steps at most
+  double search_tolerance = 0.02;         // stop when |visible fraction - goal| is at most this
+  int footprint_sides = 24;               // polygon of a cylinder's footprint (overlap tests)
+  int cylinder_segments = 32;             // segments of the rendered cylinder mesh
 };
 
 struct TableSettings {
@@ -155,13 +147,12 @@ struct WarehouseSettings {
   ValueRange wall_distance_mm{800, 2000};
   double wall_height_mm = 5000;
   double gap_mm = 100;        // minimum distance between object footprints
-  // The wall is turned by up to this angle (deg, either way) from facing the
-  // camera's ground direction.
-  double wall_yaw_deg = 15;
-  double wall_thickness_mm = 200;
-  double wall_length_mm = 30000;
-  double floor_size_mm = 40000;     // edge of the square floor slab
-  double floor_thickness_mm = 100;  // its top is the ground plane z = 0
+  // Layout details of the background.
+  double wall_yaw_deg = 15;         // wall turned by up to this from facing the camera, deg (either way)
+  double wall_thickness_mm = 200;   // wall thickness, mm
+  double wall_length_mm = 30000;    // wall length, mm
+  double floor_size_mm = 40000;     // edge of the square floor slab, mm
+  double floor_thickness_mm = 100;  // floor slab thickness (its top is z = 0), mm
 };
 
 struct SceneSettings {
