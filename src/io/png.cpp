@@ -170,21 +170,28 @@ void write_png(const std::string& path, int width, int height, int bit_depth, in
   atomic_write_bytes(path, out.data(), out.size());
 }
 
+// Reads and decodes a PNG that must be single-channel gray with `bit_depth`
+// bits; `expected` says what was wanted in the error message.
+Decoded read_gray_png(const std::string& path, const std::string& field, int bit_depth,
+                      const std::string& expected) {
+  const auto bytes = read_all(path, field);
+  check_signature(bytes, path, field);
+  Decoded d;
+  PngErr err{};
+  if (!decode(MemReader{bytes.data(), bytes.size(), 0}, &d, &err))
+    throw InputError(path, field, std::string("broken PNG: ") + err.msg);
+  if (d.color_type != PNG_COLOR_TYPE_GRAY || d.bit_depth != bit_depth)
+    throw InputError(path, field,
+                     expected + ", got " + std::to_string(d.bit_depth) + "-bit " + color_name(d.color_type));
+  return d;
+}
+
 }  // namespace
 
 DepthImage read_depth_png(const std::string& path, double depth_scale) {
   if (!(depth_scale > 0) || !std::isfinite(depth_scale))
     throw InputError(path, "depth_scale", "must be positive, got " + std::to_string(depth_scale));
-  const auto bytes = read_all(path, "depth");
-  check_signature(bytes, path, "depth");
-  Decoded d;
-  PngErr err{};
-  if (!decode(MemReader{bytes.data(), bytes.size(), 0}, &d, &err))
-    throw InputError(path, "depth", std::string("broken PNG: ") + err.msg);
-  if (d.color_type != PNG_COLOR_TYPE_GRAY || d.bit_depth != 16)
-    throw InputError(path, "depth",
-                     "expected a 16-bit single-channel (gray) depth PNG, got " + std::to_string(d.bit_depth) +
-                         "-bit " + color_name(d.color_type));
+  const Decoded d = read_gray_png(path, "depth", 16, "expected a 16-bit single-channel (gray) depth PNG");
   DepthImage img(static_cast<int>(d.width), static_cast<int>(d.height));
   for (png_uint_32 y = 0; y < d.height; ++y) {
     const unsigned char* row = d.rows[y];
@@ -221,16 +228,7 @@ void write_depth_png(const std::string& path, const DepthImage& depth, double de
 }
 
 std::vector<uint8_t> read_gray8_png(const std::string& path, int* width, int* height) {
-  const auto bytes = read_all(path, "image");
-  check_signature(bytes, path, "image");
-  Decoded d;
-  PngErr err{};
-  if (!decode(MemReader{bytes.data(), bytes.size(), 0}, &d, &err))
-    throw InputError(path, "image", std::string("broken PNG: ") + err.msg);
-  if (d.color_type != PNG_COLOR_TYPE_GRAY || d.bit_depth != 8)
-    throw InputError(path, "image",
-                     "expected an 8-bit gray PNG, got " + std::to_string(d.bit_depth) + "-bit " +
-                         color_name(d.color_type));
+  const Decoded d = read_gray_png(path, "image", 8, "expected an 8-bit gray PNG");
   std::vector<uint8_t> px(static_cast<size_t>(d.width) * d.height);
   for (png_uint_32 y = 0; y < d.height; ++y) std::memcpy(px.data() + y * d.width, d.rows[y], d.width);
   *width = static_cast<int>(d.width);
