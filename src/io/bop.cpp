@@ -365,15 +365,10 @@ SceneInfo read_scene_json(const std::string& scene_dir) {
                        std::to_string(list.j.size()) + " entries but scene_gt.json has " +
                            std::to_string(im.gt.size()));
     for (size_t i = 0; i < list.j.size(); ++i) {
-      const JRef e = list.at(i);
-      GtInfo g;
-      g.bbox_obj = e.key("bbox_obj").int4();
-      g.bbox_visib = e.key("bbox_visib").int4();
-      g.px_count_all = e.key("px_count_all").integer();
-      g.px_count_valid = e.key("px_count_valid").integer();
-      g.px_count_visib = e.key("px_count_visib").integer();
-      g.visib_fract = e.key("visib_fract").num();
-      im.gt_info.push_back(g);
+      const JRef e = list.at(i);  // braced initialization reads the keys in this order
+      im.gt_info.push_back(GtInfo{e.key("bbox_obj").int4(), e.key("bbox_visib").int4(),
+                                  e.key("px_count_all").integer(), e.key("px_count_valid").integer(),
+                                  e.key("px_count_visib").integer(), e.key("visib_fract").num()});
     }
   });
   return scene;

@@ -61,20 +61,22 @@ struct Decoded {
   std::vector<png_bytep> rows;
 };
 
+// Sets err->msg for an error before libpng could report one; returns false.
+bool fail(PngErr* err, const char* msg) {
+  std::snprintf(err->msg, sizeof(err->msg), "%s", msg);
+  return false;
+}
+
 // Decodes `src`; returns false with err->msg set on any libpng error
 // (truncated data included).
 bool decode(const MemReader& src, Decoded* out, PngErr* err) {
   MemReader reader = src;
   png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, err, on_error, on_warning);
-  if (!png) {
-    std::snprintf(err->msg, sizeof(err->msg), "cannot create the PNG reader");
-    return false;
-  }
+  if (!png) return fail(err, "cannot create the PNG reader");
   png_infop info = png_create_info_struct(png);
   if (!info) {
     png_destroy_read_struct(&png, nullptr, nullptr);
-    std::snprintf(err->msg, sizeof(err->msg), "cannot create the PNG reader");
-    return false;
+    return fail(err, "cannot create the PNG reader");
   }
   if (setjmp(err->jump)) {
     png_destroy_read_struct(&png, &info, nullptr);
@@ -107,15 +109,11 @@ bool decode(const MemReader& src, Decoded* out, PngErr* err) {
 bool encode(std::vector<unsigned char>* out, int width, int height, int bit_depth, int color_type,
             png_bytep* rows, PngErr* err) {
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, err, on_error, on_warning);
-  if (!png) {
-    std::snprintf(err->msg, sizeof(err->msg), "cannot create the PNG writer");
-    return false;
-  }
+  if (!png) return fail(err, "cannot create the PNG writer");
   png_infop info = png_create_info_struct(png);
   if (!info) {
     png_destroy_write_struct(&png, nullptr);
-    std::snprintf(err->msg, sizeof(err->msg), "cannot create the PNG writer");
-    return false;
+    return fail(err, "cannot create the PNG writer");
   }
   if (setjmp(err->jump)) {
     png_destroy_write_struct(&png, &info);
