@@ -131,3 +131,60 @@ TEST(SceneConfig, RegistryRelativeToConfig) {
   EXPECT_EQ(s.registry, "/a/b/models/models.yaml");
   EXPECT_EQ(s.name, "cfg");
 }
+
+TEST(SceneConfig, LayoutDetailsDefaultsAndParsing) {
+  const SceneSettings t = parse("scenario: table\n");
+  EXPECT_EQ(t.camera.near_mm, 50);
+  EXPECT_EQ(t.camera.far_mm, 40000);
+  EXPECT_EQ(t.distractors.placement_tries, 60);
+  EXPECT_EQ(t.occlusion.box_depth_mm.lo, 30);
+  EXPECT_EQ(t.occlusion.box_depth_mm.hi, 80);
+  EXPECT_EQ(t.occlusion.cylinder_min_radius_mm, 20);
+  EXPECT_EQ(t.occlusion.search_iterations, 12);
+  const SceneSettings w = parse("scenario: warehouse\ndistractors: {pool: [pallet]}\n");
+  EXPECT_EQ(w.occlusion.box_depth_mm.lo, 300);
+  EXPECT_EQ(w.occlusion.box_depth_mm.hi, 800);
+  EXPECT_EQ(w.occlusion.cylinder_min_radius_mm, 150);
+  EXPECT_EQ(w.warehouse.wall_yaw_deg, 15);
+
+  const SceneSettings s = parse(R"(
+scenario: warehouse
+distractors: {pool: [pallet], placement_tries: 10, image_margin: 0}
+camera: {near_mm: 100, far_mm: 20000, clearance_mm: 0}
+occlusion: {visib_fract: [0.5, 0.8], box_probability: 1, box_depth_mm: [100, 200], lateral_offset: [-1, 0],
+            search_iterations: 20, cylinder_segments: 64}
+warehouse: {wall_yaw_deg: 0, floor_thickness_mm: 50}
+)");
+  EXPECT_EQ(s.distractors.placement_tries, 10);
+  EXPECT_EQ(s.distractors.image_margin, 0);
+  EXPECT_EQ(s.camera.near_mm, 100);
+  EXPECT_EQ(s.camera.far_mm, 20000);
+  EXPECT_EQ(s.camera.clearance_mm, 0);
+  EXPECT_EQ(s.occlusion.box_probability, 1);
+  EXPECT_EQ(s.occlusion.box_depth_mm.lo, 100);
+  EXPECT_EQ(s.occlusion.lateral_offset.lo, -1);
+  EXPECT_EQ(s.occlusion.search_iterations, 20);
+  EXPECT_EQ(s.occlusion.cylinder_segments, 64);
+  EXPECT_EQ(s.warehouse.wall_yaw_deg, 0);
+  EXPECT_EQ(s.warehouse.floor_thickness_mm, 50);
+
+  error_of("scenario: table\ncamera: {near_mm: 100, far_mm: 50}\n", "camera.far_mm");
+  error_of("scenario: table\noccluson: {box_probability: 2}\n", "occluson");
+  error_of("scenario: table\nocclusion: {box_probability: 2}\n", "occlusion.box_probability");
+  error_of("scenario: table\nocclusion: {box_colour: red}\n", "occlusion.box_colour");
+  error_of("scenario: table\nocclusion: {footprint_sides: 2}\n", "occlusion.footprint_sides");
+  error_of("scenario: table\ndistractors: {placement_tries: 0}\n", "distractors.placement_tries");
+  error_of("scenario: table\nwarehouse: {wall_yaw_deg: 95}\n", "warehouse.wall_yaw_deg");
+}
+
+TEST(SceneConfig, LayoutDetailsInJsonOnlyWhenChanged) {
+  const std::string base = "scenario: table\nocclusion: {visib_fract: [0.4, 0.9]}\n";
+  const std::string def = scene_settings_json(parse(base));
+  EXPECT_EQ(def.find("near_mm"), std::string::npos) << def;
+  EXPECT_EQ(def.find("box_probability"), std::string::npos) << def;
+  const std::string changed = scene_settings_json(
+      parse("scenario: table\nocclusion: {visib_fract: [0.4, 0.9], box_probability: 0.5}\ncamera: {near_mm: 60}\n"));
+  EXPECT_NE(changed.find("\"box_probability\": 0.5"), std::string::npos) << changed;
+  EXPECT_NE(changed.find("\"near_mm\": 60"), std::string::npos) << changed;
+  EXPECT_EQ(changed.find("far_mm"), std::string::npos) << changed;
+}

@@ -16,6 +16,7 @@
 #include <unordered_map>
 
 #include "core/error.h"
+#include "core/hash.h"
 #include "io/png.h"
 
 namespace pb {
@@ -28,13 +29,12 @@ struct VertexKey {
     return std::memcmp(this, &o, sizeof(VertexKey)) == 0;
   }
 };
+// The map only looks vertices up (indices follow first appearance, the map
+// is never iterated), so the hash does not affect the output.
 struct VertexKeyHash {
   size_t operator()(const VertexKey& k) const {
-    uint32_t b[3];
-    std::memcpy(b, &k, sizeof(b));
-    uint64_t h = 1469598103934665603ull;
-    for (uint32_t w : b) h = (h ^ w) * 1099511628211ull;
-    return static_cast<size_t>(h);
+    static_assert(sizeof(VertexKey) == 3 * sizeof(float), "VertexKey must have no padding");
+    return static_cast<size_t>(Fnv1a64().bytes(&k, sizeof k).digest());
   }
 };
 

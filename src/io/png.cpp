@@ -61,20 +61,22 @@ struct Decoded {
   std::vector<png_bytep> rows;
 };
 
+// Sets err->msg for an error before libpng could report one; returns false.
+bool fail(PngErr* err, const char* msg) {
+  std::snprintf(err->msg, sizeof(err->msg), "%s", msg);
+  return false;
+}
+
 // Decodes `src`; returns false with err->msg set on any libpng error
 // (truncated data included).
 bool decode(const MemReader& src, Decoded* out, PngErr* err) {
   MemReader reader = src;
   png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, err, on_error, on_warning);
-  if (!png) {
-    std::snprintf(err->msg, sizeof(err->msg), "cannot create the PNG reader");
-    return false;
-  }
+  if (!png) return fail(err, "cannot create the PNG reader");
   png_infop info = png_create_info_struct(png);
   if (!info) {
     png_destroy_read_struct(&png, nullptr, nullptr);
-    std::snprintf(err->msg, sizeof(err->msg), "cannot create the PNG reader");
-    return false;
+    return fail(err, "cannot create the PNG reader");
   }
   if (setjmp(err->jump)) {
     png_destroy_read_struct(&png, &info, nullptr);
@@ -107,15 +109,11 @@ bool decode(const MemReader& src, Decoded* out, PngErr* err) {
 bool encode(std::vector<unsigned char>* out, int width, int height, int bit_depth, int color_type,
             png_bytep* rows, PngErr* err) {
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, err, on_error, on_warning);
-  if (!png) {
-    std::snprintf(err->msg, sizeof(err->msg), "cannot create the PNG writer");
-    return false;
-  }
+  if (!png) return fail(err, "cannot create the PNG writer");
   png_infop info = png_create_info_struct(png);
   if (!info) {
     png_destroy_write_struct(&png, nullptr);
-    std::snprintf(err->msg, sizeof(err->msg), "cannot create the PNG writer");
-    return false;
+    return fail(err, "cannot create the PNG writer");
   }
   if (setjmp(err->jump)) {
     png_destroy_write_struct(&png, &info);
@@ -170,21 +168,28 @@ void write_png(const std::string& path, int width, int height, int bit_depth, in
   atomic_write_bytes(path, out.data(), out.size());
 }
 
+// Reads and decodes a PNG that must be single-channel gray with `bit_depth`
+// bits; `expected` says what was wanted in the error message.
+Decoded read_gray_png(const std::string& path, const std::string& field, int bit_depth,
+                      const std::string& expected) {
+  const auto bytes = read_all(path, field);
+  check_signature(bytes, path, field);
+  Decoded d;
+  PngErr err{};
+  if (!decode(MemReader{bytes.data(), bytes.size(), 0}, &d, &err))
+    throw InputError(path, field, std::string("broken PNG: ") + err.msg);
+  if (d.color_type != PNG_COLOR_TYPE_GRAY || d.bit_depth != bit_depth)
+    throw InputError(path, field,
+                     expected + ", got " + std::to_string(d.bit_depth) + "-bit " + color_name(d.color_type));
+  return d;
+}
+
 }  // namespace
 
 DepthImage read_depth_png(const std::string& path, double depth_scale) {
   if (!(depth_scale > 0) || !std::isfinite(depth_scale))
     throw InputError(path, "depth_scale", "must be positive, got " + std::to_string(depth_scale));
-  const auto bytes = read_all(path, "depth");
-  check_signature(bytes, path, "depth");
-  Decoded d;
-  PngErr err{};
-  if (!decode(MemReader{bytes.data(), bytes.size(), 0}, &d, &err))
-    throw InputError(path, "depth", std::string("broken PNG: ") + err.msg);
-  if (d.color_type != PNG_COLOR_TYPE_GRAY || d.bit_depth != 16)
-    throw InputError(path, "depth",
-                     "expected a 16-bit single-channel (gray) depth PNG, got " + std::to_string(d.bit_depth) +
-                         "-bit " + color_name(d.color_type));
+  const Decoded d = read_gray_png(path, "depth", 16, "expected a 16-bit single-channel (gray) depth PNG");
   DepthImage img(static_cast<int>(d.width), static_cast<int>(d.height));
   for (png_uint_32 y = 0; y < d.height; ++y) {
     const unsigned char* row = d.rows[y];
@@ -221,16 +226,7 @@ void write_depth_png(const std::string& path, const DepthImage& depth, double de
 }
 
 std::vector<uint8_t> read_gray8_png(const std::string& path, int* width, int* height) {
-  const auto bytes = read_all(path, "image");
-  check_signature(bytes, path, "image");
-  Decoded d;
-  PngErr err{};
-  if (!decode(MemReader{bytes.data(), bytes.size(), 0}, &d, &err))
-    throw InputError(path, "image", std::string("broken PNG: ") + err.msg);
-  if (d.color_type != PNG_COLOR_TYPE_GRAY || d.bit_depth != 8)
-    throw InputError(path, "image",
-                     "expected an 8-bit gray PNG, got " + std::to_string(d.bit_depth) + "-bit " +
-                         color_name(d.color_type));
+  const Decoded d = read_gray_png(path, "image", 8, "expected an 8-bit gray PNG");
   std::vector<uint8_t> px(static_cast<size_t>(d.width) * d.height);
   for (png_uint_32 y = 0; y < d.height; ++y) std::memcpy(px.data() + y * d.width, d.rows[y], d.width);
   *width = static_cast<int>(d.width);

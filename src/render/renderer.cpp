@@ -28,6 +28,12 @@ struct DepthRenderer::Impl {
   std::vector<uint8_t> colors;    // scratch: 3 vertices x RGBA per face
   std::vector<Plane> planes;      // scratch: per global face id
   std::vector<uint8_t> plane_done;
+
+  // Draws every face flat in its id colour (base: see face_id_bases).
+  void draw(const std::vector<RenderItem>& items, const std::vector<uint64_t>& base);
+  // The plane of global face gid (of item `item`), computed once per render.
+  const Plane& face_plane(const std::vector<RenderItem>& items, const std::vector<uint64_t>& base, size_t item,
+                          uint64_t gid);
 };
 
 namespace {
@@ -53,7 +59,102 @@ Mat4 projection(const Intrinsics& K, double n, double f) {
   return P;
 }
 
+// Global face ids: item i owns ids base[i]+1 .. base[i]+faces (0 = background).
+std::vector<uint64_t> face_id_bases(const std::vector<RenderItem>& items) {
+  std::vector<uint64_t> base(items.size() + 1, 0);
+  for (size_t i = 0; i < items.size(); ++i) {
+    const Mesh* m = items[i].mesh;
+    if (!m) throw std::invalid_argument("RenderItem without a mesh");
+    const int nv = static_cast<int>(m->vertices.size());
+    for (const auto& face : m->faces)
+      if (face.minCoeff() < 0 || face.maxCoeff() >= nv)
+        throw std::invalid_argument("mesh face index out of range");
+    base[i + 1] = base[i] + m->faces.size();
+  }
+  if (base.back() >= 0xFFFFFFFFull) throw std::invalid_argument("too many triangles to render");
+  return base;
+}
+
+// Fixed-function state for id rendering, cleared buffers, projection P.
+void begin_frame(int W, int H, const Mat4& P) {
+  glViewport(0, 0, W, H);
+  glDisable(GL_DITHER);
+  glDisable(GL_LIGHTING);
+  glDisable(GL_BLEND);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_MULTISAMPLE);
+  glDisable(GL_TEXTURE_2D);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glShadeModel(GL_FLAT);
+  glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glClearColor(0.f, 0.f, 0.f, 0.f);
+  glClearDepth(1.0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glMatrixMode(GL_PROJECTION);
+  glLoadMatrixd(P.data());  // Eigen is column-major, as GL expects
+}
+
 }  // namespace
+
+void DepthRenderer::Impl::draw(const std::vector<RenderItem>& items, const std::vector<uint64_t>& base) {
+  glEnableClientState(GL_VERTEX_ARRAY);
+  glEnableClientState(GL_COLOR_ARRAY);
+  for (size_t i = 0; i < items.size(); ++i) {
+    const Mesh& m = *items[i].mesh;
+    if (m.faces.empty()) continue;
+    const Mat4 T = items[i].T_cam_model.matrix();
+    glMatrixMode(GL_MODELVIEW);
+    glLoadMatrixd(T.data());
+    const size_t nf = m.faces.size();
+    positions.resize(nf * 9);
+    colors.resize(nf * 12);
+    float* pos = positions.data();
+    uint8_t* col = colors.data();
+    for (size_t k = 0; k < nf; ++k) {
+      const uint32_t id = static_cast<uint32_t>(base[i] + k + 1);
+      const uint8_t rgba[4] = {static_cast<uint8_t>(id & 0xFF), static_cast<uint8_t>((id >> 8) & 0xFF),
+                               static_cast<uint8_t>((id >> 16) & 0xFF), static_cast<uint8_t>(id >> 24)};
+      for (int c = 0; c < 3; ++c) {
+        const Vec3f& p = m.vertices[m.faces[k][c]];
+        pos[9 * k + 3 * c + 0] = p.x();
+        pos[9 * k + 3 * c + 1] = p.y();
+        pos[9 * k + 3 * c + 2] = p.z();
+        for (int j = 0; j < 4; ++j) col[12 * k + 4 * c + j] = rgba[j];
+      }
+    }
+    glVertexPointer(3, GL_FLOAT, 0, pos);
+    glColorPointer(4, GL_UNSIGNED_BYTE, 0, col);
+    glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(nf * 3));
+  }
+  glDisableClientState(GL_COLOR_ARRAY);
+  glDisableClientState(GL_VERTEX_ARRAY);
+}
+
+const DepthRenderer::Impl::Plane& DepthRenderer::Impl::face_plane(const std::vector<RenderItem>& items,
+                                                                  const std::vector<uint64_t>& base, size_t item,
+                                                                  uint64_t gid) {
+  Plane& pl = planes[gid];
+  if (plane_done[gid]) return pl;
+  const Mesh& m = *items[item].mesh;
+  const Eigen::Vector3i& fc = m.faces[gid - base[item]];
+  const Pose& T = items[item].T_cam_model;
+  const Vec3 a = T * m.vertices[fc[0]].cast<double>();
+  const Vec3 b = T * m.vertices[fc[1]].cast<double>();
+  const Vec3 c = T * m.vertices[fc[2]].cast<double>();
+  Vec3 nn = (b - a).cross(c - a);
+  const double len = nn.norm();
+  pl.valid = len > 0 && std::isfinite(len);
+  if (pl.valid) {
+    nn /= len;
+    pl.n = nn;
+    pl.d = nn.dot(a);
+  }
+  plane_done[gid] = 1;
+  return pl;
+}
 
 DepthRenderer::DepthRenderer(const Intrinsics& K, RenderSettings settings)
     : impl_(std::make_unique<Impl>()), K_(K), settings_(settings) {
@@ -78,76 +179,13 @@ DepthRenderer::~DepthRenderer() {
 RenderOutput DepthRenderer::render(const std::vector<RenderItem>& items) {
   const int W = K_.width, H = K_.height;
   const double n = settings_.near_mm, f = settings_.far_mm;
-
-  // Global face ids: item i owns ids base[i]+1 .. base[i]+faces (0 = background).
-  std::vector<uint64_t> base(items.size() + 1, 0);
-  for (size_t i = 0; i < items.size(); ++i) {
-    const Mesh* m = items[i].mesh;
-    if (!m) throw std::invalid_argument("RenderItem without a mesh");
-    const int nv = static_cast<int>(m->vertices.size());
-    for (const auto& face : m->faces)
-      if (face.minCoeff() < 0 || face.maxCoeff() >= nv)
-        throw std::invalid_argument("mesh face index out of range");
-    base[i + 1] = base[i] + m->faces.size();
-  }
-  if (base.back() >= 0xFFFFFFFFull) throw std::invalid_argument("too many triangles to render");
+  const std::vector<uint64_t> base = face_id_bases(items);
 
   if (!OSMesaMakeCurrent(impl_->ctx, impl_->color.data(), GL_UNSIGNED_BYTE, W, H))
     throw std::runtime_error("OSMesaMakeCurrent failed");
   ReleaseCurrent release;
-
-  glViewport(0, 0, W, H);
-  glDisable(GL_DITHER);
-  glDisable(GL_LIGHTING);
-  glDisable(GL_BLEND);
-  glDisable(GL_CULL_FACE);
-  glDisable(GL_MULTISAMPLE);
-  glDisable(GL_TEXTURE_2D);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LESS);
-  glDepthMask(GL_TRUE);
-  glShadeModel(GL_FLAT);
-  glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glClearColor(0.f, 0.f, 0.f, 0.f);
-  glClearDepth(1.0);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-
-  const Mat4 P = projection(K_, n, f);  // Eigen is column-major, as GL expects
-  glMatrixMode(GL_PROJECTION);
-  glLoadMatrixd(P.data());
-  glEnableClientState(GL_VERTEX_ARRAY);
-  glEnableClientState(GL_COLOR_ARRAY);
-
-  for (size_t i = 0; i < items.size(); ++i) {
-    const Mesh& m = *items[i].mesh;
-    if (m.faces.empty()) continue;
-    const Mat4 T = items[i].T_cam_model.matrix();
-    glMatrixMode(GL_MODELVIEW);
-    glLoadMatrixd(T.data());
-    const size_t nf = m.faces.size();
-    impl_->positions.resize(nf * 9);
-    impl_->colors.resize(nf * 12);
-    float* pos = impl_->positions.data();
-    uint8_t* col = impl_->colors.data();
-    for (size_t k = 0; k < nf; ++k) {
-      const uint32_t id = static_cast<uint32_t>(base[i] + k + 1);
-      const uint8_t rgba[4] = {static_cast<uint8_t>(id & 0xFF), static_cast<uint8_t>((id >> 8) & 0xFF),
-                               static_cast<uint8_t>((id >> 16) & 0xFF), static_cast<uint8_t>(id >> 24)};
-      for (int c = 0; c < 3; ++c) {
-        const Vec3f& p = m.vertices[m.faces[k][c]];
-        pos[9 * k + 3 * c + 0] = p.x();
-        pos[9 * k + 3 * c + 1] = p.y();
-        pos[9 * k + 3 * c + 2] = p.z();
-        for (int j = 0; j < 4; ++j) col[12 * k + 4 * c + j] = rgba[j];
-      }
-    }
-    glVertexPointer(3, GL_FLOAT, 0, pos);
-    glColorPointer(4, GL_UNSIGNED_BYTE, 0, col);
-    glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(nf * 3));
-  }
-  glDisableClientState(GL_COLOR_ARRAY);
-  glDisableClientState(GL_VERTEX_ARRAY);
+  begin_frame(W, H, projection(K_, n, f));
+  impl_->draw(items, base);
   glFinish();
   glReadPixels(0, 0, W, H, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, impl_->depth.data());
   const GLenum err = glGetError();
@@ -159,13 +197,10 @@ RenderOutput DepthRenderer::render(const std::vector<RenderItem>& items) {
   if (settings_.normals) out.normals.assign(static_cast<size_t>(W) * H, Vec3f::Zero());
 
   // Face planes in the camera frame, computed lazily for the visible faces.
-  using Plane = Impl::Plane;
-  std::vector<Plane>& planes = impl_->planes;
-  std::vector<uint8_t>& plane_done = impl_->plane_done;
   const bool need_planes = settings_.exact_depth || settings_.normals;
   if (need_planes) {
-    planes.resize(base.back());
-    plane_done.assign(base.back(), 0);
+    impl_->planes.resize(base.back());
+    impl_->plane_done.assign(base.back(), 0);
   }
 
   const double zA = f + n, zB = f - n, zC = 2.0 * f * n;
@@ -186,25 +221,7 @@ RenderOutput DepthRenderer::render(const std::vector<RenderItem>& items) {
       double z = zC / (zA - z_ndc * zB);
       out.labels[px] = items[item].label;
       if (need_planes) {
-        if (!plane_done[gid]) {
-          const Mesh& m = *items[item].mesh;
-          const Eigen::Vector3i& fc = m.faces[gid - base[item]];
-          const Pose& T = items[item].T_cam_model;
-          const Vec3 a = T * m.vertices[fc[0]].cast<double>();
-          const Vec3 b = T * m.vertices[fc[1]].cast<double>();
-          const Vec3 c = T * m.vertices[fc[2]].cast<double>();
-          Vec3 nn = (b - a).cross(c - a);
-          const double len = nn.norm();
-          Plane& pl = planes[gid];
-          pl.valid = len > 0 && std::isfinite(len);
-          if (pl.valid) {
-            nn /= len;
-            pl.n = nn;
-            pl.d = nn.dot(a);
-          }
-          plane_done[gid] = 1;
-        }
-        const Plane& pl = planes[gid];
+        const Impl::Plane& pl = impl_->face_plane(items, base, item, gid);
         if (pl.valid) {
           const Vec3 ray((u - K_.cx) / K_.fx, (v - K_.cy) / K_.fy, 1.0);
           const double denom = pl.n.dot(ray);

@@ -85,8 +85,8 @@ class SceneGenerator {
   const SceneModel& model(const std::string& name) const;
 
  private:
-  SceneGenerator();
   struct Impl;
+  explicit SceneGenerator(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
 

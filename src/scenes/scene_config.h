@@ -25,6 +25,20 @@
 //   masks: true
 //   max_attempts: 200
 // A scalar where a range is expected means a fixed value.
+//
+// Layout details (optional, rarely changed; the defaults are the values the
+// generator always used, see the field comments below):
+//   camera: {near_mm, far_mm, clearance_mm, depth_clearance_mm}
+//   distractors: {placement_tries, spread_min_radii, image_margin}
+//   occlusion: {box_probability, box_width, box_depth_mm, cylinder_radius,
+//               cylinder_min_radius_mm, lateral_offset, extra_distance,
+//               height_factor, height_margin_mm, camera_headroom_mm,
+//               min_height_mm, token_height, search_iterations,
+//               search_tolerance, footprint_sides, cylinder_segments}
+//   warehouse: {wall_yaw_deg, wall_thickness_mm, wall_length_mm,
+//               floor_size_mm, floor_thickness_mm}
+// posebench_scene.json lists a layout detail only when it differs from its
+// default (so scene sets made with the defaults keep their bytes).
 #pragma once
 
 #include <cstdint>
@@ -56,6 +70,12 @@ struct SceneCameraSettings {
   // the half field of view at that distance, so the target is not always at
   // the image centre.
   double look_jitter = 0.15;
+  // Layout details. Clearances are mm beyond near_mm: an object's (or the
+  // occluder's) bounding sphere must keep them from the camera.
+  double near_mm = 50;              // near clipping plane of the renderer, mm
+  double far_mm = 40000;            // far clipping plane of the renderer, mm
+  double clearance_mm = 50;         // sphere to camera centre (3D distance), mm
+  double depth_clearance_mm = 20;   // sphere's nearest point in camera depth z, mm
 };
 
 struct DistractorSettings {
@@ -71,6 +91,13 @@ struct DistractorSettings {
   // Probability that an object stands upright; otherwise a rest pose is drawn
   // by its quasi-static probability (lying on a side, tipped over...).
   double upright_probability = 0.5;
+  // Layout details. The scatter disc around the target is as wide as the
+  // view at the target's distance, but at least spread_min_radii target
+  // footprint radii; an object's origin must project inside the image
+  // enlarged by image_margin (fraction of its width / height) on each side.
+  int placement_tries = 60;         // random positions tried per object before the layout is given up
+  double spread_min_radii = 3.0;    // minimum scatter disc radius, in target footprint radii
+  double image_margin = 0.05;       // fraction of the image size, each side
 };
 
 struct OcclusionSettings {
@@ -80,6 +107,30 @@ struct OcclusionSettings {
   // The occluder's size is searched so that the target's visible fraction
   // lands in this range (drawn uniformly per image).
   ValueRange visib_fract{0.4, 0.9};
+  // Layout details: shape and place of the occluder. r_t is the target's
+  // footprint radius (largest distance of its footprint from its origin).
+  // Its tallest height tried is height_factor * (the height hiding the whole
+  // target) + height_margin_mm, at least camera_headroom_mm below the camera;
+  // below min_height_mm the layout is resampled. The height is searched by
+  // regula falsi on the target's visible fraction (at most search_iterations
+  // steps, stopping within search_tolerance of the goal); a target occluded
+  // enough without it gets a token occluder of token_height * the tallest.
+  double box_probability = 0.65;          // a box, otherwise an upright cylinder
+  ValueRange box_width{0.8, 1.6};         // across the view, in units of 2 r_t
+  ValueRange box_depth_mm{30, 80};        // along the view, mm (warehouse: 300-800)
+  ValueRange cylinder_radius{0.5, 1.0};   // in units of r_t, but at least:
+  double cylinder_min_radius_mm = 20;     // mm (warehouse: 150)
+  ValueRange lateral_offset{-0.5, 0.5};   // centre's offset across the camera-target line, units of r_t
+  ValueRange extra_distance{0.0, 0.5};    // added to the closest position (gap_mm apart), units of r_t
+  double height_factor = 1.3;             // times the height hiding the target (unitless)
+  double height_margin_mm = 20;           // added to that height, mm
+  double camera_headroom_mm = 100;        // tallest height stays this far below the camera, mm
+  double min_height_mm = 5;               // a smaller tallest height: no room, resample, mm
+  double token_height = 0.02;             // token occluder, fraction of the tallest height
+  int search_iterations = 12;             // regula falsi steps at most
+  double search_tolerance = 0.02;         // stop when |visible fraction - goal| is at most this
+  int footprint_sides = 24;               // polygon of a cylinder's footprint (overlap tests)
+  int cylinder_segments = 32;             // segments of the rendered cylinder mesh
 };
 
 struct TableSettings {
@@ -96,6 +147,12 @@ struct WarehouseSettings {
   ValueRange wall_distance_mm{800, 2000};
   double wall_height_mm = 5000;
   double gap_mm = 100;        // minimum distance between object footprints
+  // Layout details of the background.
+  double wall_yaw_deg = 15;         // wall turned by up to this from facing the camera, deg (either way)
+  double wall_thickness_mm = 200;   // wall thickness, mm
+  double wall_length_mm = 30000;    // wall length, mm
+  double floor_size_mm = 40000;     // edge of the square floor slab, mm
+  double floor_thickness_mm = 100;  // floor slab thickness (its top is z = 0), mm
 };
 
 struct SceneSettings {
