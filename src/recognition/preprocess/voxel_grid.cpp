@@ -13,11 +13,12 @@ namespace {
 
 using Key = std::array<int64_t, 3>;  // cell index, in sort priority order
 
+// The spatial hash of Teschner et al. 2003 (hash-table buckets only, never
+// persisted: the output order comes from sorting the keys).
 struct KeyHash {
   size_t operator()(const Key& k) const {
-    uint64_t h = 1469598103934665603ull;  // mixing only (not persisted)
-    for (int64_t v : k) h = (h ^ static_cast<uint64_t>(v)) * 1099511628211ull;
-    return static_cast<size_t>(h);
+    return static_cast<size_t>((static_cast<uint64_t>(k[0]) * 73856093u) ^ (static_cast<uint64_t>(k[1]) * 19349663u) ^
+                               (static_cast<uint64_t>(k[2]) * 83492791u));
   }
 };
 
