@@ -8,12 +8,16 @@
 
 namespace {
 
-nlohmann::json rec(const std::string& scene, const std::string& desc, bool ok, double t_err, double r_err,
+pb::TrialRecord rec(const std::string& scene, const std::string& desc, bool ok, double t_err, double r_err,
                    double time) {
-  nlohmann::json r = {{"scene", scene}, {"descriptor", desc}, {"refinement", "icp"},
-                      {"params", nlohmann::json::object()}, {"added_noise_mm", 0.0},
-                      {"status", ok ? "ok" : "no_hypothesis"}, {"times", {{"total", time}}}};
-  if (ok) r["errors"] = {{"translation_mm", t_err}, {"rotation_1mpq", r_err}, {"rotation_deg", 1.0}};
+  pb::TrialRecord r;
+  r.scene = scene;
+  r.descriptor = desc;
+  r.refinement = "icp";
+  r.status = ok ? "ok" : "no_hypothesis";
+  r.times = pb::StageTimesRecord{};
+  r.times->total = time;
+  if (ok) r.errors = pb::ThesisErrorsRecord{t_err, r_err, 1.0, 0, t_err, r_err};
   return r;
 }
 
@@ -28,7 +32,7 @@ nlohmann::json experiment() {
 }
 
 TEST(Report, CellsMatchHandComputedAggregates) {
-  std::vector<nlohmann::json> records = {
+  std::vector<pb::TrialRecord> records = {
       rec("table_synthetic", "cvfh", true, 10.0, 0.01, 0.2),   // correct
       rec("table_synthetic", "cvfh", true, 30.0, 0.03, 0.4),   // correct
       rec("table_synthetic", "cvfh", true, 60.0, 0.01, 0.3),   // translation too large
@@ -67,9 +71,8 @@ TEST(Report, BopAverageRecallFromRecordedErrors) {
   // 10..50 px (9 of 10); VSD 0.07 for every tau: correct for thresholds
   // 0.10..0.50 (9 of 10).
   auto r = rec("table_synthetic", "cvfh", true, 10.0, 0.01, 0.2);
-  r["bop"] = {{"mssd_mm", 12.0}, {"mspd_px", 7.0}, {"vsd", std::vector<double>(10, 0.07)},
-              {"diameter", 100.0}, {"image_width", 640}};
-  const pb::Report rep = pb::build_report(experiment(), {r}, {});
+  r.bop = pb::BopErrorsRecord{12.0, 7.0, std::vector<double>(10, 0.07), 100.0, 640};
+  const pb::Report rep = pb::build_report(experiment(), std::vector<pb::TrialRecord>{r}, {});
   const auto& rows = rep.tables.at(0).rows;
   auto value = [&](const std::string& m) {
     for (const auto& row : rows)
@@ -85,11 +88,11 @@ TEST(Report, BopAverageRecallFromRecordedErrors) {
 TEST(Report, NoiseSweepMakesOnePlotSeriesPerMethod) {
   auto exp = experiment();
   exp["added_noise_mm"] = {0.0, 5.0};
-  std::vector<nlohmann::json> records;
+  std::vector<pb::TrialRecord> records;
   for (double n : {0.0, 5.0})
     for (int i = 0; i < 2; ++i) {
       auto r = rec("table_synthetic", "cvfh", n == 0.0 || i == 0, 10, 0.01, 0.1);
-      r["added_noise_mm"] = n;
+      r.added_noise_mm = n;
       records.push_back(r);
     }
   const pb::Report r = pb::build_report(exp, records, {});

@@ -81,11 +81,10 @@ static pb::cli::Command report_cmd("report", "tables (md, csv, tex) and plots fr
   {
     std::map<std::string, std::vector<pb::BopResultRow>> files;
     for (const auto& r : records) {
-      if (r.value("status", "") != "ok" || !r.contains("estimate")) continue;
-      std::string method = "posebench-" + r.value("descriptor", std::string("x")) + "-" +
-                           r.value("refinement", std::string("x"));
-      const auto params = r.value("params", nlohmann::json::object());
-      const double noise = r.value("added_noise_mm", 0.0);
+      if (r.status != "ok" || !r.estimate) continue;
+      std::string method = "posebench-" + r.descriptor + "-" + r.refinement;
+      const auto& params = r.params;
+      const double noise = r.added_noise_mm;
       std::string cond;
       for (auto it = params.begin(); it != params.end(); ++it) cond += "-" + it.key() + "=" + it.value().dump();
       if (noise > 0) cond += "-noise=" + nlohmann::json(noise).dump();
@@ -94,20 +93,17 @@ static pb::cli::Command report_cmd("report", "tables (md, csv, tex) and plots fr
       method += cond;
       for (char& c : method)
         if (c == '_' || c == '/' || c == '"' || c == ' ') c = '.';
-      std::string dataset = r.value("scene", std::string("scene"));
+      std::string dataset = r.scene;
       dataset.erase(std::remove_if(dataset.begin(), dataset.end(), [](char c) { return c == '_' || c == '-'; }),
                     dataset.end());
-      const std::string name = method + "_" + dataset + "-" + r.value("split", std::string("test")) + ".csv";
+      const std::string name = method + "_" + dataset + "-" + r.split + ".csv";
       pb::BopResultRow row;
-      row.scene_id = r.value("scene_id", 0);
-      row.im_id = r.value("im_id", 0);
-      row.obj_id = r.value("obj_id", 0);
-      row.score = r.value("score", 1.0);
-      const auto R = r["estimate"]["R"].get<std::vector<double>>();
-      const auto t = r["estimate"]["t"].get<std::vector<double>>();
-      for (int i = 0; i < 9; ++i) row.T_cam_model.R(i / 3, i % 3) = R.at(i);
-      row.T_cam_model.t = pb::Vec3(t.at(0), t.at(1), t.at(2));
-      row.time_s = r.contains("times") ? r["times"].value("total", -1.0) : -1.0;
+      row.scene_id = r.scene_id;
+      row.im_id = r.im_id;
+      row.obj_id = r.obj_id.value_or(0);
+      row.score = r.score.value_or(1.0);
+      row.T_cam_model = r.estimate->pose();
+      row.time_s = r.times ? r.times->total : -1.0;
       files[name].push_back(row);
     }
     if (!files.empty()) fs::create_directories(fs::path(dir) / "bop");

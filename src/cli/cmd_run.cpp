@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "cli/command.h"
+#include "io/png.h"
 #include "runner/runner.h"
 
 static std::string self_path() {
@@ -26,6 +27,10 @@ static pb::cli::Command run_cmd("run", "run an experiment (YAML): trials in para
   app.add_option("--cache", opt.cache_dir, "training cache folder ('' = none)");
   app.add_option("--scenes", opt.scenes_dir, "where generated scene sets go");
   app.add_flag("--quiet,-q", opt.quiet, "no progress output");
+  std::string summary_file;
+  app.add_option("--json-summary", summary_file,
+                 "write what this invocation did as JSON (trials, already recorded, ran, statuses, wall time, "
+                 "jobs, load) to FILE; OUT/runs.jsonl keeps one such line per invocation that ran trials");
   PB_CLI_PARSE(app, argc, argv);
   opt.binary = self_path();
   const pb::ExperimentConfig cfg = pb::load_experiment(config);
@@ -35,6 +40,12 @@ static pb::cli::Command run_cmd("run", "run an experiment (YAML): trials in para
             << s.already_done << " already recorded, " << s.ran << " run now (ok " << s.ok << ", no hypothesis "
             << s.no_hypothesis << ", error " << s.errors << ", timeout " << s.timeouts << ") in " << s.seconds
             << " s\nrecords: " << out << "/records.jsonl\n";
+  if (!summary_file.empty()) {
+    nlohmann::json j = pb::summary_json(s);
+    j["experiment"] = cfg.name;
+    j["out"] = out;
+    pb::atomic_write_text(summary_file, j.dump(2) + "\n");
+  }
   return 0;
 });
 

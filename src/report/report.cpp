@@ -10,6 +10,7 @@
 #include "core/yaml.h"
 #include "eval/bop_metrics.h"
 #include "eval/errors.h"
+#include "eval/record.h"
 
 namespace pb {
 
@@ -17,8 +18,8 @@ namespace {
 
 const double kNaN = std::nan("");
 
-std::string column_of(const nlohmann::json& rec, const std::string& mode) {
-  const std::string d = rec.value("descriptor", ""), r = rec.value("refinement", "");
+std::string column_of(const TrialRecord& rec, const std::string& mode) {
+  const std::string &d = rec.descriptor, &r = rec.refinement;
   if (mode == "refinement") return r;
   if (mode == "descriptor") return d;
   return d + "+" + r;
@@ -26,56 +27,55 @@ std::string column_of(const nlohmann::json& rec, const std::string& mode) {
 
 // The condition a record belongs to: its grid point and noise level, minus
 // the plotted variable.
-std::string condition_of(const nlohmann::json& rec, const std::string& plot_x) {
-  nlohmann::json c = rec.value("params", nlohmann::json::object());
-  if (plot_x != "added_noise_mm") c["added_noise_mm"] = rec.value("added_noise_mm", 0.0);
+std::string condition_of(const TrialRecord& rec, const std::string& plot_x) {
+  nlohmann::json c = rec.params;
+  if (plot_x != "added_noise_mm") c["added_noise_mm"] = rec.added_noise_mm;
   if (!plot_x.empty() && c.contains(plot_x)) c.erase(plot_x);
   return c.dump();
 }
 
-double x_of(const nlohmann::json& rec, const std::string& plot_x) {
-  if (plot_x == "added_noise_mm") return rec.value("added_noise_mm", 0.0);
-  const auto p = rec.value("params", nlohmann::json::object());
+double x_of(const TrialRecord& rec, const std::string& plot_x) {
+  if (plot_x == "added_noise_mm") return rec.added_noise_mm;
+  const auto& p = rec.params;
   if (p.contains(plot_x) && p[plot_x].is_number()) return p[plot_x].get<double>();
   return kNaN;
 }
 
-ThesisTrial to_trial(const nlohmann::json& rec) {
+ThesisTrial to_trial(const TrialRecord& rec) {
   ThesisTrial t;
-  t.has_pose = rec.value("status", "") == "ok" && rec.contains("errors");
+  t.has_pose = rec.status == "ok" && rec.errors.has_value();
   if (t.has_pose) {
-    const auto& e = rec["errors"];
-    t.errors.translation_mm = e.value("translation_mm", kNaN);
-    t.errors.rotation = e.value("rotation_1mpq", kNaN);
-    t.errors.rotation_deg = e.value("rotation_deg", kNaN);
+    t.errors.translation_mm = rec.errors->translation_mm;
+    t.errors.rotation = rec.errors->rotation_1mpq;
+    t.errors.rotation_deg = rec.errors->rotation_deg;
   }
-  if (rec.contains("times")) t.time_s = rec["times"].value("total", -1.0);
+  if (rec.times) t.time_s = rec.times->total;
   return t;
 }
 
 // BOP average recalls of a cell: each record is one image with one target
 // (the object of interest) and at most one estimate.
-BopScores bop_of(const std::vector<const nlohmann::json*>& recs) {
+BopScores bop_of(const std::vector<const TrialRecord*>& recs) {
   std::vector<BopImageErrors> images;
   for (const auto* r : recs) {
     BopImageErrors im;
-    im.scene_id = r->value("scene_id", 0);
+    im.scene_id = r->scene_id;
     im.im_id = static_cast<int>(images.size());
     BopTarget tgt;
-    tgt.obj_id = r->value("obj_id", 1);
+    tgt.obj_id = r->obj_id.value_or(1);
     im.gts.push_back(tgt);
-    if (r->value("status", "") == "ok" && r->contains("bop")) {
-      const auto& b = (*r)["bop"];
-      im.image_width = b.value("image_width", 640);
+    if (r->status == "ok" && r->bop) {
+      const BopErrorsRecord& b = *r->bop;
+      im.image_width = b.image_width;
       BopEstimateErrors est;
       est.obj_id = tgt.obj_id;
-      est.score = r->value("score", 1.0);
-      est.diameter = b.value("diameter", 0.0);
+      est.score = r->score.value_or(1.0);
+      est.diameter = b.diameter;
       BopPairErrors pair;
       pair.gt = 0;
-      pair.mssd_mm = b.value("mssd_mm", HUGE_VAL);
-      pair.mspd_px = b.value("mspd_px", HUGE_VAL);
-      pair.vsd = b.value("vsd", std::vector<double>{});
+      pair.mssd_mm = b.mssd_mm;
+      pair.mspd_px = b.mspd_px;
+      pair.vsd = b.vsd;
       est.pairs.push_back(pair);
       im.estimates.push_back(est);
     }
@@ -143,155 +143,166 @@ std::string fmt(double v, const std::string& measure) {
 
 }  // namespace
 
-Report build_report(const nlohmann::json& exp, const std::vector<nlohmann::json>& records,
-                    const ReportOptions& opt) {
+namespace {
+
+// How the records of an experiment are laid out in tables.
+struct Layout {
+  std::string mode;      // columns: descriptor | refinement | method (descriptor+refinement)
+  std::string plot_x;    // the swept variable plotted ("" = none)
+  std::string ref_id;    // thesis table compared with
+  std::vector<std::string> columns, scenes;
+  std::map<std::string, std::string> scenario_of;
+};
+
+Layout layout_of(const nlohmann::json& exp, const std::vector<TrialRecord>& records, const ReportOptions& opt) {
+  Layout l;
+  const auto rcfg = exp.value("report", nlohmann::json::object());
+  const bool reg_only = exp.value("registration_only", false);
+  l.mode = rcfg.value("columns", "");
+  const auto descs = exp.value("descriptors", std::vector<std::string>{});
+  const auto refs = exp.value("refinements", std::vector<std::string>{});
+  if (l.mode.empty())
+    l.mode = reg_only ? "refinement" : (refs.size() > 1 && descs.size() > 1) ? "method"
+                                     : refs.size() > 1                      ? "refinement"
+                                                                            : "descriptor";
+  l.plot_x = opt.plot_x.empty() ? rcfg.value("plot_x", "") : opt.plot_x;
+  if (l.plot_x.empty()) {
+    if (exp.value("added_noise_mm", nlohmann::json::array()).size() > 1) l.plot_x = "added_noise_mm";
+    for (const auto& g : exp.value("grid", nlohmann::json::array()))
+      if (l.plot_x.empty() && g.size() == 2 && g[1].size() > 1) l.plot_x = g[0].get<std::string>();
+  }
+  l.ref_id = opt.reference_table.empty() ? rcfg.value("reference_table", "") : opt.reference_table;
+  // Column order: as configured, then any other found in the records.
+  std::vector<std::string> found;
+  for (const auto& r : records) {
+    const std::string c = column_of(r, l.mode);
+    if (std::find(found.begin(), found.end(), c) == found.end()) found.push_back(c);
+  }
+  for (const auto& d : descs)
+    for (const auto& f : refs) {
+      const std::string c = l.mode == "descriptor" ? d : l.mode == "refinement" ? f : d + "+" + f;
+      if (std::find(found.begin(), found.end(), c) != found.end() &&
+          std::find(l.columns.begin(), l.columns.end(), c) == l.columns.end())
+        l.columns.push_back(c);
+    }
+  for (const auto& c : found)
+    if (std::find(l.columns.begin(), l.columns.end(), c) == l.columns.end()) l.columns.push_back(c);
+  for (const auto& s : exp.value("scenes", nlohmann::json::array())) {
+    l.scenes.push_back(s.value("name", ""));
+    l.scenario_of[s.value("name", "")] = s.value("scenario", "table");
+  }
+  return l;
+}
+
+const std::vector<std::string>& table_measures() {
+  static const std::vector<std::string> m{"robustness", "translation_mm", "rotation_1mpq", "time", "bop_ar",
+                                          "bop_ar_vsd", "bop_ar_mssd", "bop_ar_mspd"};
+  return m;
+}
+
+// The rows of one scene set in one condition's table.
+void add_scene_rows(const std::string& scene, const std::vector<const TrialRecord*>& recs_of_cond,
+                    const Layout& l, const nlohmann::json& exp, const Reference& ref, ReportTable& t) {
+  std::map<std::string, ThesisAggregate> agg;
+  std::map<std::string, BopScores> bop;
+  std::map<std::string, int> count;
+  for (const auto& col : l.columns) {
+    std::vector<ThesisTrial> trials;
+    std::vector<const TrialRecord*> recs;
+    for (const auto* r : recs_of_cond)
+      if (r->scene == scene && column_of(*r, l.mode) == col) {
+        trials.push_back(to_trial(*r));
+        recs.push_back(r);
+      }
+    if (!recs.empty()) bop[col] = bop_of(recs);
+    count[col] = static_cast<int>(trials.size());
+    // Correctness was decided by the runner with the experiment's
+    // thresholds; recompute here from the stored errors with the same ones.
+    agg[col] = thesis_aggregate(trials, thresholds_for(exp, l.scenario_of.at(scene)));
+  }
+  bool any = false;
+  for (const auto& col : l.columns) any |= count[col] > 0;
+  if (!any) return;
+  for (const auto& m : table_measures()) {
+    ReportRow row;
+    row.scenario = scene;
+    row.measure = m;
+    row.detail = m.rfind("bop_ar_", 0) == 0;
+    for (const auto& col : l.columns) {
+      const ThesisAggregate& a = agg[col];
+      ReportCell cell;
+      cell.trials = count[col];
+      const bool has_bop = bop.count(col) > 0;
+      const BopScores b = has_bop ? bop[col] : BopScores{};
+      cell.value = m == "robustness"       ? (a.trials ? a.robustness : kNaN)
+                   : m == "translation_mm" ? a.translation_mean_mm
+                   : m == "rotation_1mpq"  ? a.rotation_mean
+                   : m == "time"           ? a.time_mean_s
+                   : !has_bop              ? kNaN
+                   : m == "bop_ar"         ? b.ar
+                   : m == "bop_ar_vsd"     ? b.ar_vsd
+                   : m == "bop_ar_mssd"    ? b.ar_mssd
+                                           : b.ar_mspd;
+      const std::string method = l.mode == "method" ? col.substr(0, col.find('+')) : col;
+      cell.reference = ref_value(ref, scene, m, method);
+      row.cells.push_back(cell);
+    }
+    t.rows.push_back(row);
+  }
+}
+
+// Robustness and time against the plotted variable, one series per method
+// and scene set.
+ReportPlot plot_of(const std::vector<TrialRecord>& records, const Layout& l, const nlohmann::json& exp) {
+  ReportPlot p;
+  p.name = l.plot_x == "added_noise_mm" ? "robustness_vs_noise" : "robustness_vs_" + l.plot_x;
+  std::replace(p.name.begin(), p.name.end(), '.', '_');
+  p.x_label = l.plot_x == "added_noise_mm" ? "added noise sigma (mm)" : l.plot_x;
+  for (const auto& scene : l.scenes)
+    for (const auto& col : l.columns) {
+      std::map<double, std::vector<ThesisTrial>> pts;
+      for (const auto& r : records)
+        if (r.scene == scene && column_of(r, l.mode) == col) {
+          const double x = x_of(r, l.plot_x);
+          if (std::isfinite(x)) pts[x].push_back(to_trial(r));
+        }
+      if (pts.empty()) continue;
+      ReportSeries s;
+      s.label = col + " (" + scene + ")";
+      for (const auto& [x, trials] : pts) {
+        const ThesisAggregate a = thesis_aggregate(trials, thresholds_for(exp, l.scenario_of.at(scene)));
+        s.x.push_back(x);
+        s.robustness.push_back(a.robustness);
+        s.time.push_back(a.time_mean_s);
+      }
+      p.series.push_back(s);
+    }
+  return p;
+}
+
+}  // namespace
+
+Report build_report(const nlohmann::json& exp, const std::vector<TrialRecord>& records, const ReportOptions& opt) {
   Report rep;
   rep.experiment = exp.value("name", "");
   rep.records = records.size();
-  for (const auto& r : records) ++rep.status_counts[r.value("status", "?")];
+  for (const auto& r : records) ++rep.status_counts[r.status];
+  const Layout l = layout_of(exp, records, opt);
+  const Reference ref = load_reference(opt.reference_file, l.ref_id);
 
-  const auto rcfg = exp.value("report", nlohmann::json::object());
-  const bool reg_only = exp.value("registration_only", false);
-  std::string mode = rcfg.value("columns", "");
-  if (mode.empty()) {
-    const auto refs = exp.value("refinements", nlohmann::json::array());
-    const auto descs = exp.value("descriptors", nlohmann::json::array());
-    mode = reg_only ? "refinement" : (refs.size() > 1 && descs.size() > 1) ? "method"
-                                     : refs.size() > 1                      ? "refinement"
-                                                                            : "descriptor";
-  }
-  std::string plot_x = opt.plot_x.empty() ? rcfg.value("plot_x", "") : opt.plot_x;
-  if (plot_x.empty()) {
-    if (exp.value("added_noise_mm", nlohmann::json::array()).size() > 1) plot_x = "added_noise_mm";
-    for (const auto& g : exp.value("grid", nlohmann::json::array()))
-      if (plot_x.empty() && g.size() == 2 && g[1].size() > 1) plot_x = g[0].get<std::string>();
-  }
-  const std::string ref_id = opt.reference_table.empty() ? rcfg.value("reference_table", "") : opt.reference_table;
-  const Reference ref = load_reference(opt.reference_file, ref_id);
-
-  // Column order: as configured.
-  std::vector<std::string> columns;
-  auto add_col = [&](const std::string& c) {
-    if (std::find(columns.begin(), columns.end(), c) == columns.end()) columns.push_back(c);
-  };
-  for (const auto& r : records) add_col(column_of(r, mode));
-  {
-    std::vector<std::string> ordered;
-    const auto descs = exp.value("descriptors", std::vector<std::string>{});
-    const auto refs = exp.value("refinements", std::vector<std::string>{});
-    for (const auto& d : descs)
-      for (const auto& f : refs) {
-        const std::string c = mode == "descriptor" ? d : mode == "refinement" ? f : d + "+" + f;
-        if (std::find(columns.begin(), columns.end(), c) != columns.end() &&
-            std::find(ordered.begin(), ordered.end(), c) == ordered.end())
-          ordered.push_back(c);
-      }
-    for (const auto& c : columns)
-      if (std::find(ordered.begin(), ordered.end(), c) == ordered.end()) ordered.push_back(c);
-    columns = ordered;
-  }
-  std::vector<std::string> scenes;
-  for (const auto& s : exp.value("scenes", nlohmann::json::array())) scenes.push_back(s.value("name", ""));
-  std::map<std::string, std::string> scenario_of;
-  for (const auto& s : exp.value("scenes", nlohmann::json::array()))
-    scenario_of[s.value("name", "")] = s.value("scenario", "table");
-
-  // Tables: one per condition (grid point and noise level, except the plotted variable).
-  std::map<std::string, std::vector<const nlohmann::json*>> by_cond;
-  std::vector<std::string> cond_order;
-  for (const auto& r : records) {
-    const std::string c = condition_of(r, "");
-    if (!by_cond.count(c)) cond_order.push_back(c);
-    by_cond[c].push_back(&r);
-  }
-  std::sort(cond_order.begin(), cond_order.end());
-  for (const auto& cond : cond_order) {
+  // Tables: one per condition (grid point and noise level).
+  std::map<std::string, std::vector<const TrialRecord*>> by_cond;
+  for (const auto& r : records) by_cond[condition_of(r, "")].push_back(&r);
+  for (const auto& [cond, recs] : by_cond) {
     ReportTable t;
-    t.reference_id = ref_id;
-    t.title = ref.title.empty() ? rep.experiment : "Table " + ref_id + ": " + ref.title;
+    t.reference_id = l.ref_id;
+    t.title = ref.title.empty() ? rep.experiment : "Table " + l.ref_id + ": " + ref.title;
     if (cond != "{}" && cond != "{\"added_noise_mm\":0.0}") t.condition = cond;
-    t.columns = columns;
-    const std::vector<std::string> measures =
-        std::vector<std::string>{"robustness", "translation_mm", "rotation_1mpq", "time", "bop_ar",
-                                 "bop_ar_vsd", "bop_ar_mssd", "bop_ar_mspd"};
-    for (const auto& scene : scenes) {
-      std::map<std::string, ThesisAggregate> agg;
-      std::map<std::string, BopScores> bop;
-      std::map<std::string, int> count;
-      for (const auto& col : columns) {
-        std::vector<ThesisTrial> trials;
-        std::vector<const nlohmann::json*> recs;
-        for (const auto* r : by_cond[cond])
-          if (r->value("scene", "") == scene && column_of(*r, mode) == col) {
-            trials.push_back(to_trial(*r));
-            recs.push_back(r);
-          }
-        if (!recs.empty()) bop[col] = bop_of(recs);
-        count[col] = static_cast<int>(trials.size());
-        // Correctness was decided by the runner with the experiment's
-        // thresholds; recompute here from the stored errors with the same ones.
-        agg[col] = thesis_aggregate(trials, thresholds_for(exp, scenario_of[scene]));
-      }
-      bool any = false;
-      for (const auto& col : columns) any |= count[col] > 0;
-      if (!any) continue;
-      for (const auto& m : measures) {
-        ReportRow row;
-        row.scenario = scene;
-        row.measure = m;
-        row.detail = m.rfind("bop_ar_", 0) == 0;
-        for (const auto& col : columns) {
-          const ThesisAggregate& a = agg[col];
-          ReportCell cell;
-          cell.trials = count[col];
-          const bool has_bop = bop.count(col) > 0;
-          const BopScores b = has_bop ? bop[col] : BopScores{};
-          cell.value = m == "robustness"       ? (a.trials ? a.robustness : kNaN)
-                       : m == "translation_mm" ? a.translation_mean_mm
-                       : m == "rotation_1mpq"  ? a.rotation_mean
-                       : m == "time"           ? a.time_mean_s
-                       : !has_bop              ? kNaN
-                       : m == "bop_ar"         ? b.ar
-                       : m == "bop_ar_vsd"     ? b.ar_vsd
-                       : m == "bop_ar_mssd"    ? b.ar_mssd
-                                               : b.ar_mspd;
-          const std::string method = mode == "method" ? col.substr(0, col.find('+')) : col;
-          cell.reference = ref_value(ref, scene, m, method);
-          row.cells.push_back(cell);
-        }
-        t.rows.push_back(row);
-      }
-    }
+    t.columns = l.columns;
+    for (const auto& scene : l.scenes) add_scene_rows(scene, recs, l, exp, ref, t);
     rep.tables.push_back(t);
   }
-
-  // Plots: robustness and time against the plotted variable.
-  if (!plot_x.empty()) {
-    ReportPlot p;
-    p.name = plot_x == "added_noise_mm" ? "robustness_vs_noise" : "robustness_vs_" + plot_x;
-    std::replace(p.name.begin(), p.name.end(), '.', '_');
-    p.x_label = plot_x == "added_noise_mm" ? "added noise sigma (mm)" : plot_x;
-    for (const auto& scene : scenes)
-      for (const auto& col : columns) {
-        std::map<double, std::vector<ThesisTrial>> pts;
-        for (const auto& r : records)
-          if (r.value("scene", "") == scene && column_of(r, mode) == col) {
-            const double x = x_of(r, plot_x);
-            if (std::isfinite(x)) pts[x].push_back(to_trial(r));
-          }
-        if (pts.empty()) continue;
-        ReportSeries s;
-        s.label = col + " (" + scene + ")";
-        for (const auto& [x, trials] : pts) {
-          const ThesisAggregate a = thesis_aggregate(trials, thresholds_for(exp, scenario_of[scene]));
-          s.x.push_back(x);
-          s.robustness.push_back(a.robustness);
-          s.time.push_back(a.time_mean_s);
-        }
-        p.series.push_back(s);
-      }
-    rep.plots.push_back(p);
-  }
+  if (!l.plot_x.empty()) rep.plots.push_back(plot_of(records, l, exp));
   return rep;
 }
 

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "eval/record.h"
+
 namespace pb {
 
 struct ReportCell {
@@ -57,7 +59,7 @@ struct ReportOptions {
 };
 
 // Builds the report from experiment.json + records (ResultStore format).
-Report build_report(const nlohmann::json& experiment, const std::vector<nlohmann::json>& records,
+Report build_report(const nlohmann::json& experiment, const std::vector<TrialRecord>& records,
                     const ReportOptions& opt);
 
 std::string to_markdown(const Report& r);

@@ -6,6 +6,8 @@
 #include <set>
 
 #include "core/error.h"
+#include "core/hash.h"
+#include "io/symmetry_yaml.h"
 #include "core/random.h"
 #include "io/bop.h"
 #include "recognition/pipeline.h"
@@ -14,49 +16,6 @@
 namespace fs = std::filesystem;
 
 namespace pb {
-
-std::string hash_hex(const std::string& text) {
-  uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : text) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
-}
-
-// YAML -> JSON (scalars typed by their YAML reading: bool, int, float, string).
-static nlohmann::json to_json(const YAML::Node& n) {
-  if (n.IsMap()) {
-    nlohmann::json j = nlohmann::json::object();
-    for (const auto& kv : n) j[kv.first.as<std::string>()] = to_json(kv.second);
-    return j;
-  }
-  if (n.IsSequence()) {
-    nlohmann::json j = nlohmann::json::array();
-    for (const auto& e : n) j.push_back(to_json(e));
-    return j;
-  }
-  if (!n.IsDefined() || n.IsNull()) return nullptr;
-  const std::string s = n.Scalar();
-  if (n.Tag() == "!") return s;  // quoted
-  bool b;
-  if (YAML::convert<bool>::decode(n, b) && s != "0" && s != "1") return b;
-  try {
-    size_t pos = 0;
-    long long v = std::stoll(s, &pos);
-    if (pos == s.size()) return v;
-  } catch (...) {
-  }
-  try {
-    size_t pos = 0;
-    double v = std::stod(s, &pos);
-    if (pos == s.size()) return v;
-  } catch (...) {
-  }
-  return s;
-}
 
 // Sets a dotted path ("global.top_k") in a settings JSON object.
 static void set_path(nlohmann::json& j, const std::string& path, const nlohmann::json& v) {
@@ -92,13 +51,17 @@ static std::string resolve(const std::string& base_file, const std::string& p) {
   return (fs::path(base_file).parent_path() / p).string();
 }
 
-ExperimentConfig load_experiment(const std::string& path) {
-  const YamlNode root = YamlNode::load_file(path);
-  root.check_keys({"name", "seed", "object", "scenes", "descriptors", "refinements", "grid", "added_noise_mm",
-                   "settings", "thresholds", "timeout_s", "registration_only", "perturb_deg", "perturb_mm",
-                   "description", "report"});
-  ExperimentConfig c;
-  c.file = path;
+namespace {
+
+void check_refinements(const YamlNode& node, const std::vector<std::string>& names) {
+  const auto known = refinement_names();
+  for (const auto& r : names)
+    if (std::find(known.begin(), known.end(), r) == known.end()) node.fail("unknown refinement '" + r + "'");
+}
+
+// name, seed, object, descriptors, refinements, noise, time limit, registration_only.
+void parse_header(const YamlNode& root, const std::string& path, ExperimentConfig& c) {
+
   c.name = root.get_or<std::string>("name", fs::path(path).stem().string());
   c.seed = root.get_or<unsigned long long>("seed", 1);
   c.object = root.get<std::string>("object");
@@ -108,7 +71,6 @@ ExperimentConfig load_experiment(const std::string& path) {
   c.timeout_s = root.get_positive("timeout_s", c.timeout_s);
 
   const auto known_desc = descriptor_names();
-  const auto known_ref = refinement_names();
   if (c.registration_only) {
     c.descriptors = root.get_or<std::vector<std::string>>("descriptors", {"none"});
   } else {
@@ -119,13 +81,14 @@ ExperimentConfig load_experiment(const std::string& path) {
         root["descriptors"].fail("unknown descriptor '" + d + "'");
   }
   c.refinements = root.get_or<std::vector<std::string>>("refinements", c.refinements);
-  for (const auto& r : c.refinements)
-    if (std::find(known_ref.begin(), known_ref.end(), r) == known_ref.end())
-      root["refinements"].fail("unknown refinement '" + r + "'");
+  check_refinements(root["refinements"], c.refinements);
   c.added_noise_mm = root.get_or<std::vector<double>>("added_noise_mm", c.added_noise_mm);
   for (double n : c.added_noise_mm)
     if (!(n >= 0)) root["added_noise_mm"].fail("noise levels must be non-negative");
 
+}
+
+void parse_thresholds(const YamlNode& root, ExperimentConfig& c) {
   if (root.has("thresholds")) {
     const YamlNode t = root["thresholds"];
     t.check_keys({"table_translation_mm", "warehouse_translation_mm", "rotation_1mpq"});
@@ -135,11 +98,14 @@ ExperimentConfig load_experiment(const std::string& path) {
     c.thresholds.rotation_1mpq = t.get_positive("rotation_1mpq", c.thresholds.rotation_1mpq);
   }
 
-  // Base settings: validated through the recognition settings parser on the
-  // original node, so errors carry the right line.
+}
+
+// Base settings and the grid: validated through the recognition settings
+// parser on the original node, so errors carry the right line.
+void parse_settings_and_grid(const YamlNode& root, const std::string& path, ExperimentConfig& c) {
   if (root.has("settings")) {
     parse_recognition_settings(root["settings"]);
-    c.settings = to_json(root["settings"].raw());
+    c.settings = yaml_to_json(root["settings"].raw());
   }
 
   if (root.has("grid")) {
@@ -150,7 +116,7 @@ ExperimentConfig load_experiment(const std::string& path) {
       if (!v.is_sequence() || v.size() == 0) v.fail("expected a non-empty list of values");
       std::vector<nlohmann::json> vals;
       for (size_t i = 0; i < v.size(); ++i) {
-        vals.push_back(to_json(v.at(i).raw()));
+        vals.push_back(yaml_to_json(v.at(i).raw()));
         nlohmann::json probe = c.settings;
         set_path(probe, key, vals.back());
         try {
@@ -163,52 +129,79 @@ ExperimentConfig load_experiment(const std::string& path) {
     }
   }
 
-  if (root.has("report")) {
-    const YamlNode r = root["report"];
-    r.check_keys({"reference_table", "plot_x", "columns"});
-    c.report = to_json(r.raw());
-  }
+}
 
-  const YamlNode scenes = root["scenes"];
-  if (!scenes.is_sequence() || scenes.size() == 0) scenes.fail("expected a non-empty list of scenes");
-  std::set<std::string> names;
-  for (size_t i = 0; i < scenes.size(); ++i) {
-    const YamlNode s = scenes.at(i);
-    s.check_keys({"name", "generate", "dataset", "split", "scene_ids", "images", "scenario", "generator",
-                  "settings", "refinements"});
-    SceneSource src;
-    src.generate = resolve(path, s.get_or<std::string>("generate", ""));
-    src.dataset = resolve(path, s.get_or<std::string>("dataset", ""));
-    if (src.generate.empty() == src.dataset.empty())
-      s.fail("give exactly one of 'generate' (a scene config) or 'dataset' (a BOP dataset)");
-    if (!src.generate.empty() && !fs::exists(src.generate))
-      s["generate"].fail("scene config not found: " + src.generate);
-    src.name = s.get_or<std::string>(
-        "name", fs::path(src.generate.empty() ? src.dataset : src.generate).stem().string());
-    if (!names.insert(src.name).second) s["name"].fail("duplicate scene name '" + src.name + "'");
-    src.split = s.get_or<std::string>("split", "test");
-    src.scene_ids = s.get_or<std::vector<int>>("scene_ids", {});
-    src.images = s.get_or<int>("images", 0);
-    if (src.images < 0) s["images"].fail("must be non-negative");
-    src.scenario = s.get_or<std::string>(
-        "scenario", src.name.rfind("warehouse", 0) == 0 ? std::string("warehouse") : std::string("table"));
-    if (src.scenario != "table" && src.scenario != "warehouse")
-      s["scenario"].fail("must be 'table' or 'warehouse'");
-    src.refinements = s.get_or<std::vector<std::string>>("refinements", {});
-    for (const auto& r : src.refinements)
-      if (std::find(known_ref.begin(), known_ref.end(), r) == known_ref.end())
-        s["refinements"].fail("unknown refinement '" + r + "'");
-    if (s.has("generator")) {
-      if (src.generate.empty()) s["generator"].fail("only valid with 'generate'");
-      src.generator_overrides = to_json(s["generator"].raw());
-    }
-    if (s.has("settings")) {
-      parse_recognition_settings(s["settings"]);
-      src.settings = to_json(s["settings"].raw());
-    }
-    c.scenes.push_back(src);
+SceneSource parse_scene(const YamlNode& s, const std::string& path, std::set<std::string>& names) {
+  s.check_keys({"name", "generate", "dataset", "split", "scene_ids", "images", "scenario", "generator",
+                "settings", "refinements"});
+  SceneSource src;
+  src.generate = resolve(path, s.get_or<std::string>("generate", ""));
+  src.dataset = resolve(path, s.get_or<std::string>("dataset", ""));
+  if (src.generate.empty() == src.dataset.empty())
+    s.fail("give exactly one of 'generate' (a scene config) or 'dataset' (a BOP dataset)");
+  if (!src.generate.empty() && !fs::exists(src.generate))
+    s["generate"].fail("scene config not found: " + src.generate);
+  src.name = s.get_or<std::string>(
+      "name", fs::path(src.generate.empty() ? src.dataset : src.generate).stem().string());
+  if (!names.insert(src.name).second) s["name"].fail("duplicate scene name '" + src.name + "'");
+  src.split = s.get_or<std::string>("split", "test");
+  src.scene_ids = s.get_or<std::vector<int>>("scene_ids", {});
+  src.images = s.get_or<int>("images", 0);
+  if (src.images < 0) s["images"].fail("must be non-negative");
+  src.scenario = s.get_or<std::string>(
+      "scenario", src.name.rfind("warehouse", 0) == 0 ? std::string("warehouse") : std::string("table"));
+  if (src.scenario != "table" && src.scenario != "warehouse")
+    s["scenario"].fail("must be 'table' or 'warehouse'");
+  src.refinements = s.get_or<std::vector<std::string>>("refinements", {});
+  check_refinements(s["refinements"], src.refinements);
+  if (s.has("generator")) {
+    if (src.generate.empty()) s["generator"].fail("only valid with 'generate'");
+    src.generator_overrides = yaml_to_json(s["generator"].raw());
   }
+  if (s.has("settings")) {
+    parse_recognition_settings(s["settings"]);
+    src.settings = yaml_to_json(s["settings"].raw());
+  }
+  return src;
+}
 
+// Extra judgements: named symmetry sets each record is also judged with
+// (the thesis's "faces on faces" for the milk carton).
+void parse_judgements(const YamlNode& root, ExperimentConfig& c) {
+  if (!root.has("judgements")) return;
+  const YamlNode js = root["judgements"];
+  if (!js.is_map()) js.fail("expected a mapping of name -> {description, symmetries_discrete, symmetries_continuous}");
+  for (const auto& name : js.keys()) {
+    const YamlNode j = js[name];
+    j.check_keys({"description", "symmetries_discrete", "symmetries_continuous"});
+    Judgement jd;
+    jd.name = name;
+    jd.description = j.get_or<std::string>("description", "");
+    read_symmetries(j, jd.symmetries_discrete, jd.symmetries_continuous);
+    c.judgements.push_back(jd);
+  }
+}
+
+nlohmann::json judgements_json(const std::vector<Judgement>& js) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& j : js) {
+    nlohmann::json d = nlohmann::json::array(), cont = nlohmann::json::array();
+    for (const Mat4& m : j.symmetries_discrete) {
+      std::vector<double> v;
+      for (int r = 0; r < 4; ++r)
+        for (int k = 0; k < 4; ++k) v.push_back(m(r, k));
+      d.push_back(v);
+    }
+    for (const auto& cs : j.symmetries_continuous)
+      cont.push_back({{"axis", {cs.axis.x(), cs.axis.y(), cs.axis.z()}},
+                      {"offset", {cs.offset.x(), cs.offset.y(), cs.offset.z()}}});
+    out.push_back({{"name", j.name}, {"symmetries_discrete", d}, {"symmetries_continuous", cont}});
+  }
+  return out;
+}
+
+// The parsed config as JSON: what experiment.json keeps and the hash covers.
+nlohmann::json canonical(const ExperimentConfig& c) {
   nlohmann::json canon;
   canon["name"] = c.name;
   canon["seed"] = c.seed;
@@ -230,8 +223,35 @@ ExperimentConfig load_experiment(const std::string& path) {
                                {"refinements", s.refinements},
                                {"settings", s.settings}});
   canon["report"] = c.report;
-  c.canonical = canon;
-  c.hash = hash_hex(canon.dump());
+  if (!c.judgements.empty()) canon["judgements"] = judgements_json(c.judgements);
+  return canon;
+}
+
+}  // namespace
+
+ExperimentConfig load_experiment(const std::string& path) {
+  const YamlNode root = YamlNode::load_file(path);
+  root.check_keys({"name", "seed", "object", "scenes", "descriptors", "refinements", "grid", "added_noise_mm",
+                   "settings", "thresholds", "timeout_s", "registration_only", "perturb_deg", "perturb_mm",
+                   "description", "report", "judgements"});
+  ExperimentConfig c;
+  c.file = path;
+  parse_header(root, path, c);
+  parse_thresholds(root, c);
+  parse_settings_and_grid(root, path, c);
+  if (root.has("report")) {
+    const YamlNode r = root["report"];
+    r.check_keys({"reference_table", "plot_x", "columns"});
+    c.report = yaml_to_json(r.raw());
+  }
+
+  const YamlNode scenes = root["scenes"];
+  if (!scenes.is_sequence() || scenes.size() == 0) scenes.fail("expected a non-empty list of scenes");
+  std::set<std::string> names;
+  for (size_t i = 0; i < scenes.size(); ++i) c.scenes.push_back(parse_scene(scenes.at(i), path, names));
+  parse_judgements(root, c);
+  c.canonical = canonical(c);
+  c.hash = hash_hex(c.canonical.dump());
   return c;
 }
 
@@ -285,8 +305,9 @@ std::vector<Trial> expand_trials(const ExperimentConfig& cfg) {
                 std::snprintf(buf, sizeof buf, "%d/%d", sid, im_id);
                 t.key = src.name + "/" + buf + "/" + d + "/" + r + "/" + p.dump() + "/noise=" +
                         nlohmann::json(noise).dump();
-                const uint64_t h = std::stoull(hash_hex(t.key), nullptr, 16);
-                t.seed = derive_seed(cfg.seed, {h});
+                // The trial's random stream: stream_id keeps the seeds (and so
+                // every result) of the releases before the one hash.
+                t.seed = derive_seed(cfg.seed, {stream_id(t.key)});
                 trials.push_back(std::move(t));
               }
       }

@@ -12,7 +12,9 @@
 #include <string>
 #include <vector>
 
+#include "core/hash.h"
 #include "core/yaml.h"
+#include "io/bop.h"
 
 namespace pb {
 
@@ -39,6 +41,17 @@ struct Thresholds {
   double rotation_1mpq = 0.05;              // thesis: 1 - |p.q| < 0.05
 };
 
+// A second judgement of every pose (experiment `judgements:`): the thesis's
+// errors and thresholds over another symmetry set than the model's own, e.g.
+// the milk carton's "faces on faces" (the 8 rotations of its body). Each
+// record carries judgements.NAME.
+struct Judgement {
+  std::string name;
+  std::string description;
+  std::vector<Mat4> symmetries_discrete;                 // model frame, mm
+  std::vector<ContinuousSymmetry> symmetries_continuous;
+};
+
 struct ExperimentConfig {
   std::string file;                 // the YAML it came from
   std::string name;                 // experiment name (default: file stem)
@@ -58,6 +71,7 @@ struct ExperimentConfig {
   // How to report: {reference_table: "4.1", plot_x: "added_noise_mm",
   // columns: descriptor | refinement | method}. Part of the hash.
   nlohmann::json report = nlohmann::json::object();
+  std::vector<Judgement> judgements;
   std::string hash;                 // hash of the canonical config (results folder guard)
   nlohmann::json canonical;         // the parsed config as JSON
 };
@@ -82,6 +96,5 @@ struct Trial {
 // their dataset materialized (see prepare_scenes in runner.h).
 std::vector<Trial> expand_trials(const ExperimentConfig& cfg);
 
-std::string hash_hex(const std::string& text);  // FNV-1a 64, 16 hex digits
 
 }  // namespace pb

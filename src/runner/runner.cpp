@@ -8,7 +8,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <deque>
 #include <filesystem>
 #include <fstream>
@@ -19,6 +21,7 @@
 #include "core/timer.h"
 #include "core/yaml.h"
 #include "io/png.h"
+#include "runner/pool.h"
 #include "runner/store.h"
 #include "runner/trial.h"
 
@@ -26,34 +29,9 @@ namespace fs = std::filesystem;
 
 namespace pb {
 
-static nlohmann::json yaml_to_json_file(const std::string& path) {
-  // The generator configs are YAML; merge overrides at the JSON level and
-  // write JSON (a YAML subset) for the generator to read.
-  const YamlNode n = YamlNode::load_file(path);
-  std::function<nlohmann::json(const YAML::Node&)> conv = [&](const YAML::Node& y) -> nlohmann::json {
-    if (y.IsMap()) {
-      nlohmann::json j = nlohmann::json::object();
-      for (const auto& kv : y) j[kv.first.as<std::string>()] = conv(kv.second);
-      return j;
-    }
-    if (y.IsSequence()) {
-      nlohmann::json j = nlohmann::json::array();
-      for (const auto& e : y) j.push_back(conv(e));
-      return j;
-    }
-    if (!y.IsDefined() || y.IsNull()) return nullptr;
-    const std::string s = y.Scalar();
-    if (y.Tag() == "!") return s;
-    if (s == "true" || s == "false") return s == "true";
-    char* end = nullptr;
-    const long long iv = std::strtoll(s.c_str(), &end, 10);
-    if (!s.empty() && *end == '\0') return iv;
-    const double dv = std::strtod(s.c_str(), &end);
-    if (!s.empty() && *end == '\0') return dv;
-    return s;
-  };
-  return conv(n.raw());
-}
+// The generator configs are YAML; overrides merge at the JSON level and the
+// result is written as JSON (a YAML subset) for the generator to read.
+static nlohmann::json yaml_to_json_file(const std::string& path) { return yaml_to_json(YamlNode::load_file(path).raw()); }
 
 static int run_command(const std::vector<std::string>& args, const std::string& log_path) {
   const pid_t pid = fork();
@@ -108,62 +86,7 @@ void prepare_scenes(ExperimentConfig& cfg, const RunOptions& opt) {
   }
 }
 
-static nlohmann::json trial_json(const Trial& t) {
-  return {{"key", t.key},           {"scene", t.scene_name},   {"scenario", t.scenario},
-          {"dataset", t.dataset},   {"split", t.split},        {"scene_id", t.scene_id},
-          {"im_id", t.im_id},       {"descriptor", t.descriptor}, {"refinement", t.refinement},
-          {"params", t.params},     {"added_noise_mm", t.added_noise_mm}, {"settings", t.settings},
-          {"seed", t.seed}};
-}
-
 namespace {
-
-struct Worker {
-  pid_t pid = -1;
-  int in_fd = -1;   // we write trials here
-  int out_fd = -1;  // we read records here
-  std::string buf;
-  long trial = -1;  // index into trials, -1 idle
-  Timer started;
-};
-
-Worker spawn_worker(const std::string& binary, const std::string& ctx_line, const std::string& log_path) {
-  int to_child[2], from_child[2];
-  if (pipe(to_child) != 0 || pipe(from_child) != 0) throw std::runtime_error("pipe failed");
-  const pid_t pid = fork();
-  if (pid < 0) throw std::runtime_error("fork failed");
-  if (pid == 0) {
-    dup2(to_child[0], 0);
-    dup2(from_child[1], 1);
-    const int fd = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-    if (fd >= 0) dup2(fd, 2);
-    close(to_child[1]);
-    close(from_child[0]);
-    execl(binary.c_str(), binary.c_str(), "worker", static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  close(to_child[0]);
-  close(from_child[1]);
-  Worker w;
-  w.pid = pid;
-  w.in_fd = to_child[1];
-  w.out_fd = from_child[0];
-  fcntl(w.out_fd, F_SETFD, FD_CLOEXEC);
-  fcntl(w.in_fd, F_SETFD, FD_CLOEXEC);
-  const std::string line = ctx_line + "\n";
-  if (write(w.in_fd, line.data(), line.size()) != static_cast<ssize_t>(line.size()))
-    throw std::runtime_error("cannot talk to worker");
-  return w;
-}
-
-void stop_worker(Worker& w, bool kill_it) {
-  if (w.in_fd >= 0) close(w.in_fd);
-  if (w.out_fd >= 0) close(w.out_fd);
-  if (kill_it) kill(w.pid, SIGKILL);
-  int status = 0;
-  waitpid(w.pid, &status, 0);
-  w = Worker{};
-}
 
 std::string fmt_duration(double s) {
   if (!std::isfinite(s) || s < 0) return "?";
@@ -176,10 +99,80 @@ std::string fmt_duration(double s) {
   return buf;
 }
 
+// Progress on stderr: a bar with ETA on a terminal, a line every 10 s otherwise.
+class Progress {
+ public:
+  Progress(bool quiet, size_t to_run) : quiet_(quiet), to_run_(to_run), tty_(isatty(2)) {}
+  void update(const RunSummary& sum, bool final) {
+    if (quiet_) return;
+    const double el = timer_.seconds();
+    const double frac = to_run_ ? static_cast<double>(sum.ran) / to_run_ : 1.0;
+    const double eta = sum.ran ? el / sum.ran * (to_run_ - sum.ran) : NAN;
+    char line[256];
+    if (tty_) {
+      const int width = 30, filled = static_cast<int>(frac * width);
+      std::string bar(filled, '#');
+      bar += std::string(width - filled, '.');
+      std::snprintf(line, sizeof line, "\r[%s] %zu/%zu %3.0f%%  elapsed %s  ETA %s  ok %zu none %zu err %zu tmo %zu ",
+                    bar.c_str(), sum.ran, to_run_, 100 * frac, fmt_duration(el).c_str(),
+                    fmt_duration(eta).c_str(), sum.ok, sum.no_hypothesis, sum.errors, sum.timeouts);
+      std::cerr << line << (final ? "\n" : "") << std::flush;
+    } else if (final || last_print_.seconds() > 10) {
+      std::snprintf(line, sizeof line, "posebench run: %zu/%zu trials (%.0f%%), elapsed %s, ETA %s\n", sum.ran,
+                    to_run_, 100 * frac, fmt_duration(el).c_str(), fmt_duration(eta).c_str());
+      std::cerr << line;
+      last_print_.reset();
+    }
+  }
+
+ private:
+  bool quiet_;
+  size_t to_run_;
+  bool tty_;
+  Timer timer_, last_print_;
+};
+
+void count(const TrialRecord& rec, RunSummary& sum) {
+  ++sum.ran;
+  if (rec.status == "ok") ++sum.ok;
+  else if (rec.status == "no_hypothesis") ++sum.no_hypothesis;
+  else if (rec.status == "timeout") ++sum.timeouts;
+  else ++sum.errors;
+}
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return buf;
+}
+
+double load15() {
+  std::ifstream in("/proc/loadavg");
+  double a = NAN, b = NAN, c = NAN;
+  in >> a >> b >> c;
+  return c;
+}
+
 }  // namespace
+
+nlohmann::json summary_json(const RunSummary& s) {
+  return {{"started", s.started},
+          {"wall_s", s.seconds},
+          {"total", s.total},
+          {"already_recorded", s.already_done},
+          {"ran", s.ran},
+          {"status_counts", {{"ok", s.ok}, {"no_hypothesis", s.no_hypothesis}, {"error", s.errors},
+                             {"timeout", s.timeouts}}},
+          {"jobs", s.jobs},
+          {"omp_threads", s.omp_threads},
+          {"load15_end", std::isfinite(s.load15_end) ? nlohmann::json(s.load15_end) : nlohmann::json(nullptr)},
+          {"host_cores", s.host_cores}};
+}
 
 RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
   RunSummary sum;
+  sum.started = utc_now();
   Timer timer;
   const std::string out = opt.out_dir.empty() ? "results/" + cfg.name : opt.out_dir;
   // Guard the folder before doing anything expensive, but create it only
@@ -189,192 +182,55 @@ RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
   const std::vector<Trial> trials = expand_trials(cfg);
   ResultStore store(out, cfg.canonical, cfg.hash);
   sum.total = trials.size();
+  sum.jobs = opt.jobs;
+  sum.host_cores = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN));
+  const char* omp = std::getenv("OMP_NUM_THREADS");
+  sum.omp_threads = omp && *omp ? std::atoi(omp) : sum.host_cores;
 
+  std::vector<TrialRecord> inputs;
   std::deque<long> pending;
-  for (long i = 0; i < static_cast<long>(trials.size()); ++i)
-    if (!store.has(trials[i].key)) pending.push_back(i);
+  for (long i = 0; i < static_cast<long>(trials.size()); ++i) {
+    inputs.push_back(trial_record(trials[static_cast<size_t>(i)]));
+    if (!store.has(trials[static_cast<size_t>(i)].key)) pending.push_back(i);
+  }
   sum.already_done = trials.size() - pending.size();
   if (!opt.quiet && sum.already_done)
     std::cerr << "posebench run: resuming: " << sum.already_done << " of " << sum.total
               << " trials already recorded\n";
-  if (pending.empty()) {
-    sum.seconds = timer.seconds();
-    return sum;
+  if (!pending.empty()) {
+    PoolOptions po;
+    po.binary = opt.binary;
+    po.context = context_json(cfg, opt.cache_dir).dump();
+    po.log_path = (fs::path(out) / "workers.log").string();
+    po.jobs = opt.jobs;
+    po.timeout_s = cfg.timeout_s;
+    Progress progress(opt.quiet, pending.size());
+    run_in_workers(po, inputs, pending, [&](long, const TrialRecord& rec) {
+      store.append(rec);
+      count(rec, sum);
+      progress.update(sum, false);
+    });
+    progress.update(sum, true);
   }
-
-  nlohmann::json ctx = {{"object", cfg.object},
-                        {"cache_dir", opt.cache_dir},
-                        {"table_translation_mm", cfg.thresholds.table_translation_mm},
-                        {"warehouse_translation_mm", cfg.thresholds.warehouse_translation_mm},
-                        {"rotation_1mpq", cfg.thresholds.rotation_1mpq},
-                        {"registration_only", cfg.registration_only},
-                        {"perturb_deg", cfg.perturb_deg},
-                        {"perturb_mm", cfg.perturb_mm}};
-  const std::string ctx_line = ctx.dump();
-  const std::string log_path = (fs::path(out) / "workers.log").string();
-  signal(SIGPIPE, SIG_IGN);
-
-  const int njobs = std::max(1, std::min<int>(opt.jobs, static_cast<int>(pending.size())));
-  std::vector<Worker> workers;
-  for (int i = 0; i < njobs; ++i) workers.push_back(spawn_worker(opt.binary, ctx_line, log_path));
-
-  const bool tty = isatty(2);
-  Timer last_print;
-  const size_t to_run = pending.size();
-  auto progress = [&](bool final) {
-    if (opt.quiet) return;
-    const double el = timer.seconds();
-    const double frac = to_run ? static_cast<double>(sum.ran) / to_run : 1.0;
-    const double eta = sum.ran ? el / sum.ran * (to_run - sum.ran) : NAN;
-    char line[256];
-    if (tty) {
-      const int width = 30, filled = static_cast<int>(frac * width);
-      std::string bar(filled, '#');
-      bar += std::string(width - filled, '.');
-      std::snprintf(line, sizeof line, "\r[%s] %zu/%zu %3.0f%%  elapsed %s  ETA %s  ok %zu none %zu err %zu tmo %zu ",
-                    bar.c_str(), sum.ran, to_run, 100 * frac, fmt_duration(el).c_str(),
-                    fmt_duration(eta).c_str(), sum.ok, sum.no_hypothesis, sum.errors, sum.timeouts);
-      std::cerr << line << (final ? "\n" : "") << std::flush;
-    } else if (final || last_print.seconds() > 10) {
-      std::snprintf(line, sizeof line, "posebench run: %zu/%zu trials (%.0f%%), elapsed %s, ETA %s\n", sum.ran,
-                    to_run, 100 * frac, fmt_duration(el).c_str(), fmt_duration(eta).c_str());
-      std::cerr << line;
-      last_print.reset();
-    }
-  };
-
-  auto record = [&](const nlohmann::json& rec) {
-    store.append(rec);
-    ++sum.ran;
-    const std::string st = rec.value("status", "error");
-    if (st == "ok") ++sum.ok;
-    else if (st == "no_hypothesis") ++sum.no_hypothesis;
-    else if (st == "timeout") ++sum.timeouts;
-    else ++sum.errors;
-    progress(false);
-  };
-  auto failed_record = [&](long ti, const std::string& status, const std::string& msg) {
-    nlohmann::json rec = trial_json(trials[ti]);
-    rec["status"] = status;
-    rec["message"] = msg;
-    rec["correct"] = false;
-    return rec;
-  };
-
-  size_t active = 0;
-  auto dispatch = [&](Worker& w) {
-    if (pending.empty() || w.pid < 0) return;
-    const long ti = pending.front();
-    pending.pop_front();
-    const std::string line = trial_json(trials[ti]).dump() + "\n";
-    w.trial = ti;
-    w.started.reset();
-    if (write(w.in_fd, line.data(), line.size()) != static_cast<ssize_t>(line.size())) {
-      // The worker died before taking the trial: requeue and respawn.
-      pending.push_front(ti);
-      w.trial = -1;
-      stop_worker(w, true);
-      w = spawn_worker(opt.binary, ctx_line, log_path);
-      return;
-    }
-    ++active;
-  };
-  for (auto& w : workers) dispatch(w);
-
-  while (active > 0) {
-    std::vector<pollfd> fds;
-    for (auto& w : workers) fds.push_back({w.out_fd, POLLIN, 0});
-    poll(fds.data(), fds.size(), 200);
-    for (size_t i = 0; i < workers.size(); ++i) {
-      Worker& w = workers[i];
-      if (w.pid < 0) continue;
-      bool dead = false;
-      if (fds[i].revents & (POLLIN | POLLHUP | POLLERR)) {
-        char chunk[65536];
-        const ssize_t n = read(w.out_fd, chunk, sizeof chunk);
-        if (n > 0)
-          w.buf.append(chunk, static_cast<size_t>(n));
-        else
-          dead = true;
-      }
-      size_t nl;
-      while ((nl = w.buf.find('\n')) != std::string::npos) {
-        const std::string line = w.buf.substr(0, nl);
-        w.buf.erase(0, nl + 1);
-        if (w.trial < 0) continue;
-        nlohmann::json rec;
-        try {
-          rec = nlohmann::json::parse(line);
-        } catch (const nlohmann::json::exception&) {
-          rec = failed_record(w.trial, "error", "worker wrote an unreadable record");
-        }
-        const long ti = w.trial;
-        w.trial = -1;
-        --active;
-        rec["key"] = trials[ti].key;
-        record(rec);
-        dispatch(w);
-      }
-      if (dead) {
-        const long ti = w.trial;
-        int status = 0;
-        close(w.in_fd);
-        close(w.out_fd);
-        waitpid(w.pid, &status, 0);
-        w = Worker{};
-        if (ti >= 0) {
-          --active;
-          std::string why = WIFSIGNALED(status) ? "worker crashed (signal " + std::to_string(WTERMSIG(status)) + ")"
-                                                : "worker exited (code " + std::to_string(WEXITSTATUS(status)) + ")";
-          record(failed_record(ti, "error", why + "; see " + log_path));
-        }
-        if (!pending.empty()) {
-          w = spawn_worker(opt.binary, ctx_line, log_path);
-          dispatch(w);
-        }
-        continue;
-      }
-      if (w.trial >= 0 && w.started.seconds() > cfg.timeout_s) {
-        const long ti = w.trial;
-        stop_worker(w, true);
-        --active;
-        record(failed_record(ti, "timeout", "exceeded the time limit of " + std::to_string(cfg.timeout_s) + " s"));
-        if (!pending.empty()) {
-          w = spawn_worker(opt.binary, ctx_line, log_path);
-          dispatch(w);
-        }
-      }
-    }
-  }
-  for (auto& w : workers)
-    if (w.pid >= 0) stop_worker(w, false);
-  progress(true);
   sum.seconds = timer.seconds();
+  sum.load15_end = load15();
+  if (sum.ran > 0) store.append_run(summary_json(sum));
   return sum;
 }
 
 int worker_main() {
   std::string line;
   if (!std::getline(std::cin, line)) return 0;
-  const nlohmann::json c = nlohmann::json::parse(line);
-  TrialContext ctx;
-  ctx.object = c.at("object");
-  ctx.cache_dir = c.value("cache_dir", "");
-  ctx.table_translation_mm = c.value("table_translation_mm", 50.0);
-  ctx.warehouse_translation_mm = c.value("warehouse_translation_mm", 100.0);
-  ctx.rotation_1mpq = c.value("rotation_1mpq", 0.05);
-  ctx.registration_only = c.value("registration_only", false);
-  ctx.perturb_deg = c.value("perturb_deg", 10.0);
-  ctx.perturb_mm = c.value("perturb_mm", 20.0);
+  const TrialContext ctx = context_from_json(nlohmann::json::parse(line));
   while (std::getline(std::cin, line)) {
     if (line.empty()) continue;
-    nlohmann::json rec;
+    nlohmann::json out;
     try {
-      rec = run_trial(nlohmann::json::parse(line), ctx);
+      out = run_trial(record_from_json(nlohmann::json::parse(line), "runner input", 0), ctx);
     } catch (const std::exception& e) {
-      rec = {{"status", "error"}, {"message", e.what()}};
+      out = {{"status", "error"}, {"message", e.what()}};  // unreadable input: the runner records the error
     }
-    std::cout << rec.dump() << "\n" << std::flush;
+    std::cout << out.dump() << "\n" << std::flush;
   }
   return 0;
 }

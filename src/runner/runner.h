@@ -3,6 +3,8 @@
 // store, resumes. PCL-free.
 #pragma once
 
+#include <nlohmann/json.hpp>
+
 #include <string>
 
 #include "runner/experiment.h"
@@ -18,13 +20,21 @@ struct RunOptions {
   bool quiet = false;              // no progress output
 };
 
+// What one `posebench run` did: OUT/runs.jsonl gets one line of it per
+// invocation that ran trials, `run --json-summary FILE` writes it to FILE.
 struct RunSummary {
+  std::string started;     // UTC, ISO 8601
   size_t total = 0;        // trials of the experiment
   size_t already_done = 0; // found in the store at start (resume)
   size_t ran = 0;          // run now
   size_t ok = 0, no_hypothesis = 0, errors = 0, timeouts = 0;  // of those run now
-  double seconds = 0;
+  double seconds = 0;      // wall time of the invocation, scene generation included
+  int jobs = 1;            // worker processes
+  int omp_threads = 0;     // OMP_NUM_THREADS of the workers (unset: the core count)
+  double load15_end = 0;   // the machine's 15-minute load average at the end (NaN if unknown)
+  int host_cores = 0;
 };
+nlohmann::json summary_json(const RunSummary& s);
 
 // Renders every `generate:` scene source that is not yet materialized (into
 // scenes_dir/<name>_<hash8>, by running `posebench generate`) and points its

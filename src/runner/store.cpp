@@ -18,8 +18,8 @@ std::string ResultStore::records_path() const { return (fs::path(dir_) / "record
 
 // Parses records.jsonl. Returns the records and the byte length of the valid
 // prefix (a torn final line from a killed run is excluded).
-static std::vector<nlohmann::json> parse_records(const std::string& path, size_t* valid_bytes) {
-  std::vector<nlohmann::json> out;
+static std::vector<TrialRecord> parse_records(const std::string& path, size_t* valid_bytes) {
+  std::vector<TrialRecord> out;
   *valid_bytes = 0;
   std::ifstream in(path, std::ios::binary);
   if (!in) return out;
@@ -34,11 +34,13 @@ static std::vector<nlohmann::json> parse_records(const std::string& path, size_t
     if (nl == std::string::npos) break;  // torn last line: no newline yet
     const std::string line = text.substr(pos, nl - pos);
     if (!line.empty()) {
+      nlohmann::json j;
       try {
-        out.push_back(nlohmann::json::parse(line));
+        j = nlohmann::json::parse(line);
       } catch (const nlohmann::json::exception& e) {
         throw InputError(path, "line " + std::to_string(line_no), std::string("corrupt record: ") + e.what());
       }
+      out.push_back(record_from_json(j, path, line_no));
     }
     pos = nl + 1;
     *valid_bytes = pos;
@@ -46,7 +48,7 @@ static std::vector<nlohmann::json> parse_records(const std::string& path, size_t
   return out;
 }
 
-std::vector<nlohmann::json> ResultStore::read_records(const std::string& dir) {
+std::vector<TrialRecord> ResultStore::read_records(const std::string& dir) {
   const std::string path = (fs::path(dir) / "records.jsonl").string();
   if (!fs::exists(path)) throw InputError(path, "", "no records: not a posebench results folder (run `posebench run` first)");
   size_t valid = 0;
@@ -89,31 +91,42 @@ ResultStore::ResultStore(const std::string& dir, const nlohmann::json& experimen
   records_ = parse_records(records_path(), &valid);
   if (fs::exists(records_path()) && fs::file_size(records_path()) != valid)
     fs::resize_file(records_path(), valid);  // drop a torn last line
-  for (size_t i = 0; i < records_.size(); ++i) index_.emplace(records_[i].value("key", ""), i);
+  for (size_t i = 0; i < records_.size(); ++i) index_.emplace(records_[i].key, i);
 }
 
 bool ResultStore::has(const std::string& key) const { return index_.count(key) > 0; }
 
-void ResultStore::append(const nlohmann::json& record) {
-  std::lock_guard<std::mutex> lock(mu_);
-  const std::string key = record.value("key", "");
-  if (index_.count(key)) return;
-  const std::string line = record.dump() + "\n";
-  const int fd = ::open(records_path().c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-  if (fd < 0) throw std::runtime_error("cannot open " + records_path() + " for appending");
+namespace {
+
+// Appends `line` to `path` and flushes it to the disk.
+void append_durably(const std::string& path, const std::string& line) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+  if (fd < 0) throw std::runtime_error("cannot open " + path + " for appending");
   size_t off = 0;
   while (off < line.size()) {
     const ssize_t n = ::write(fd, line.data() + off, line.size() - off);
     if (n <= 0) {
       ::close(fd);
-      throw std::runtime_error("write failed: " + records_path());
+      throw std::runtime_error("write failed: " + path);
     }
     off += static_cast<size_t>(n);
   }
   ::fdatasync(fd);
   ::close(fd);
-  index_.emplace(key, records_.size());
+}
+
+}  // namespace
+
+void ResultStore::append(const TrialRecord& record) {
+  std::lock_guard<std::mutex> lock(mu_);
+  if (index_.count(record.key)) return;
+  append_durably(records_path(), nlohmann::json(record).dump() + "\n");
+  index_.emplace(record.key, records_.size());
   records_.push_back(record);
+}
+
+void ResultStore::append_run(const nlohmann::json& run) const {
+  append_durably((fs::path(dir_) / "runs.jsonl").string(), run.dump() + "\n");
 }
 
 }  // namespace pb

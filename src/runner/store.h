@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "eval/record.h"
+
 namespace pb {
 
 class ResultStore {
@@ -26,17 +28,23 @@ class ResultStore {
 
   bool has(const std::string& key) const;
   size_t size() const { return records_.size(); }
-  void append(const nlohmann::json& record);  // thread-safe; durable on return
-  const std::vector<nlohmann::json>& records() const { return records_; }
+  void append(const TrialRecord& record);  // thread-safe; durable on return
+  const std::vector<TrialRecord>& records() const { return records_; }
   const std::string& dir() const { return dir_; }
   std::string records_path() const;
 
   // Reads DIR/records.jsonl without opening for writing (the reporter).
-  static std::vector<nlohmann::json> read_records(const std::string& dir);
+  // Strict: a record with an unknown or missing key is an InputError naming
+  // the file, the line and the key.
+  static std::vector<TrialRecord> read_records(const std::string& dir);
+
+  // Appends one line to DIR/runs.jsonl (one per `posebench run` invocation
+  // that ran trials).
+  void append_run(const nlohmann::json& run) const;
 
  private:
   std::string dir_;
-  std::vector<nlohmann::json> records_;
+  std::vector<TrialRecord> records_;
   std::map<std::string, size_t> index_;
   std::mutex mu_;
 };

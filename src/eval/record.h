@@ -1,0 +1,91 @@
+// The trial record: one typed struct shared by the runner (which writes it to
+// records.jsonl), the reporter (which reads it) and the scripts (which read
+// it through the schema `posebench schema record` prints). Reading is
+// strict: an unknown key or a missing required key is an InputError naming
+// the file, the line and the key, never a silent default. PCL-free.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/types.h"
+
+namespace pb {
+
+struct PoseRecord {            // {"R": [9, row-major], "t": [3, mm]}
+  std::array<double, 9> R{};
+  std::array<double, 3> t{};
+  static PoseRecord from(const Pose& T);
+  Pose pose() const;
+};
+
+struct StageTimesRecord {      // seconds per stage of the online computation
+  double preprocess = 0, describe = 0, match = 0, group = 0, initial_pose = 0, refine = 0, verify = 0, total = 0;
+};
+
+struct ThesisErrorsRecord {    // eval/errors.h, symmetry-aware, and against the GT itself ("plain")
+  double translation_mm = 0, rotation_1mpq = 0, rotation_deg = 0;
+  int symmetry = 0;            // index of the chosen symmetry (0 = identity)
+  double translation_mm_plain = 0, rotation_1mpq_plain = 0;
+};
+
+struct BopErrorsRecord {       // eval/bop_metrics.h, bop19 settings
+  double mssd_mm = 0, mspd_px = 0;
+  std::vector<double> vsd;     // one per tau
+  double diameter = 0;         // mm
+  int image_width = 0;         // px
+};
+
+struct JudgementRecord {       // the thesis's judgement over an extra symmetry set
+  bool correct = false;
+  double translation_mm = 0, rotation_1mpq = 0;
+};
+
+struct TrialRecord {
+  // The trial (runner/experiment.h Trial): always present.
+  std::string key, scene, scenario, dataset, split;
+  int scene_id = 0, im_id = 0;
+  std::string descriptor, refinement;
+  nlohmann::json params = nlohmann::json::object();    // grid point: dotted path -> value
+  double added_noise_mm = 0;
+  nlohmann::json settings = nlohmann::json::object();  // the trial's settings sections, as configured
+  uint64_t seed = 0;
+  // The outcome: always present.
+  std::string status;          // ok | no_hypothesis | error | timeout
+  bool correct = false;        // the thesis's judgement (false without a pose or ground truth)
+  double wall_s = 0;           // wall time of the whole trial in its worker (s)
+  // Present when the trial got that far.
+  std::optional<std::string> message;
+  std::optional<int> obj_id;
+  std::optional<nlohmann::json> settings_resolved;  // every field, after defaults
+  std::optional<double> train_s;
+  std::optional<bool> train_from_cache;
+  std::optional<StageTimesRecord> times;
+  std::optional<int> hypotheses;
+  std::optional<PoseRecord> init;      // registration_only: the perturbed start
+  std::optional<PoseRecord> estimate;  // status ok
+  std::optional<double> score;
+  std::optional<int> inliers;
+  std::optional<PoseRecord> gt;        // the first instance of the object in the image
+  std::optional<double> visib_fract;
+  std::optional<ThesisErrorsRecord> errors;
+  std::optional<BopErrorsRecord> bop;
+  std::map<std::string, JudgementRecord> judgements;  // experiment `judgements:`; omitted when empty
+};
+
+void to_json(nlohmann::json& j, const TrialRecord& r);
+// Strict: InputError(file, "line N: KEY", ...) for an unknown key, a missing
+// required key or a value of the wrong type.
+TrialRecord record_from_json(const nlohmann::json& j, const std::string& file, int line);
+
+// The schema (`posebench schema record`): {"fields": {name: {"type",
+// "required", "fields"?}}, "notes": [...]}.
+nlohmann::json record_schema();
+
+}  // namespace pb

@@ -1,0 +1,205 @@
+#include "runner/pool.h"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <stdexcept>
+
+#include "core/timer.h"
+
+namespace pb {
+
+namespace {
+
+struct Worker {
+  pid_t pid = -1;
+  int in_fd = -1;   // we write trials here
+  int out_fd = -1;  // we read records here
+  std::string buf;
+  long trial = -1;  // index into trials, -1 idle
+  Timer started;
+};
+
+Worker spawn_worker(const std::string& binary, const std::string& ctx_line, const std::string& log_path) {
+  int to_child[2], from_child[2];
+  if (pipe(to_child) != 0 || pipe(from_child) != 0) throw std::runtime_error("pipe failed");
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("fork failed");
+  if (pid == 0) {
+    dup2(to_child[0], 0);
+    dup2(from_child[1], 1);
+    const int fd = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+    if (fd >= 0) dup2(fd, 2);
+    close(to_child[1]);
+    close(from_child[0]);
+    execl(binary.c_str(), binary.c_str(), "worker", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  close(to_child[0]);
+  close(from_child[1]);
+  Worker w;
+  w.pid = pid;
+  w.in_fd = to_child[1];
+  w.out_fd = from_child[0];
+  fcntl(w.out_fd, F_SETFD, FD_CLOEXEC);
+  fcntl(w.in_fd, F_SETFD, FD_CLOEXEC);
+  const std::string line = ctx_line + "\n";
+  if (write(w.in_fd, line.data(), line.size()) != static_cast<ssize_t>(line.size()))
+    throw std::runtime_error("cannot talk to worker");
+  return w;
+}
+
+void stop_worker(Worker& w, bool kill_it) {
+  if (w.in_fd >= 0) close(w.in_fd);
+  if (w.out_fd >= 0) close(w.out_fd);
+  if (kill_it) kill(w.pid, SIGKILL);
+  int status = 0;
+  waitpid(w.pid, &status, 0);
+  w = Worker{};
+}
+
+// The pool's state: the workers, what is pending, what is running.
+class Pool {
+ public:
+  Pool(const PoolOptions& opt, const std::vector<TrialRecord>& inputs, std::deque<long> pending,
+       const std::function<void(long, const TrialRecord&)>& on_record)
+      : opt_(opt), inputs_(inputs), pending_(std::move(pending)), on_record_(on_record) {}
+
+  void run() {
+    signal(SIGPIPE, SIG_IGN);
+    const int n = std::max(1, std::min<int>(opt_.jobs, static_cast<int>(pending_.size())));
+    for (int i = 0; i < n; ++i) workers_.push_back(spawn());
+    for (auto& w : workers_) dispatch(w);
+    while (active_ > 0) {
+      std::vector<pollfd> fds;
+      for (auto& w : workers_) fds.push_back({w.out_fd, POLLIN, 0});
+      poll(fds.data(), fds.size(), 200);
+      for (size_t i = 0; i < workers_.size(); ++i) service(workers_[i], fds[i].revents);
+    }
+    for (auto& w : workers_)
+      if (w.pid >= 0) stop_worker(w, false);
+  }
+
+ private:
+  Worker spawn() { return spawn_worker(opt_.binary, opt_.context, opt_.log_path); }
+
+  // The input record with a failure outcome.
+  TrialRecord failed(long ti, const std::string& status, const std::string& msg, double wall_s) const {
+    TrialRecord rec = inputs_[static_cast<size_t>(ti)];
+    rec.status = status;
+    rec.message = msg;
+    rec.correct = false;
+    rec.wall_s = wall_s;
+    return rec;
+  }
+
+  void finish(Worker& w, const TrialRecord& rec) {
+    const long ti = w.trial;
+    w.trial = -1;
+    --active_;
+    on_record_(ti, rec);
+  }
+
+  void dispatch(Worker& w) {
+    if (pending_.empty() || w.pid < 0) return;
+    const long ti = pending_.front();
+    pending_.pop_front();
+    const std::string line = nlohmann::json(inputs_[static_cast<size_t>(ti)]).dump() + "\n";
+    w.trial = ti;
+    w.started.reset();
+    if (write(w.in_fd, line.data(), line.size()) != static_cast<ssize_t>(line.size())) {
+      // The worker died before taking the trial: requeue and respawn.
+      pending_.push_front(ti);
+      w.trial = -1;
+      stop_worker(w, true);
+      w = spawn();
+      return;
+    }
+    ++active_;
+  }
+
+  // Reads what the worker wrote; handles its records, its death, its time-out.
+  void service(Worker& w, short revents) {
+    if (w.pid < 0) return;
+    bool dead = false;
+    if (revents & (POLLIN | POLLHUP | POLLERR)) {
+      char chunk[65536];
+      const ssize_t n = read(w.out_fd, chunk, sizeof chunk);
+      if (n > 0)
+        w.buf.append(chunk, static_cast<size_t>(n));
+      else
+        dead = true;
+    }
+    size_t nl;
+    while ((nl = w.buf.find('\n')) != std::string::npos) {
+      const std::string line = w.buf.substr(0, nl);
+      w.buf.erase(0, nl + 1);
+      if (w.trial < 0) continue;
+      finish(w, parse(w, line));
+      dispatch(w);
+    }
+    if (dead) return on_death(w);
+    if (w.trial >= 0 && w.started.seconds() > opt_.timeout_s) {
+      const TrialRecord rec = failed(w.trial, "timeout", "exceeded the time limit of " +
+                                                             std::to_string(opt_.timeout_s) + " s",
+                                     w.started.seconds());
+      stop_worker(w, true);
+      finish(w, rec);
+      respawn(w);
+    }
+  }
+
+  // The worker's record, checked strictly; an unreadable one is an error record.
+  TrialRecord parse(const Worker& w, const std::string& line) const {
+    try {
+      TrialRecord rec = record_from_json(nlohmann::json::parse(line), "worker output", 0);
+      rec.key = inputs_[static_cast<size_t>(w.trial)].key;
+      return rec;
+    } catch (const std::exception& e) {
+      return failed(w.trial, "error", std::string("worker wrote an unreadable record: ") + e.what(),
+                    w.started.seconds());
+    }
+  }
+
+  void on_death(Worker& w) {
+    int status = 0;
+    close(w.in_fd);
+    close(w.out_fd);
+    waitpid(w.pid, &status, 0);
+    const long ti = w.trial;
+    const double wall = w.started.seconds();
+    w.pid = -1;
+    if (ti >= 0) {
+      const std::string why = WIFSIGNALED(status) ? "worker crashed (signal " + std::to_string(WTERMSIG(status)) + ")"
+                                                  : "worker exited (code " + std::to_string(WEXITSTATUS(status)) + ")";
+      finish(w, failed(ti, "error", why + "; see " + opt_.log_path, wall));
+    }
+    w = Worker{};
+    respawn(w);
+  }
+
+  void respawn(Worker& w) {
+    if (pending_.empty()) return;
+    w = spawn();
+    dispatch(w);
+  }
+
+  const PoolOptions& opt_;
+  const std::vector<TrialRecord>& inputs_;
+  std::deque<long> pending_;
+  const std::function<void(long, const TrialRecord&)>& on_record_;
+  std::vector<Worker> workers_;
+  size_t active_ = 0;
+};
+
+}  // namespace
+
+void run_in_workers(const PoolOptions& opt, const std::vector<TrialRecord>& inputs, std::deque<long> pending,
+                    const std::function<void(long, const TrialRecord&)>& on_record) {
+  Pool(opt, inputs, std::move(pending), on_record).run();
+}
+
+}  // namespace pb
