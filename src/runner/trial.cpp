@@ -1,6 +1,7 @@
 #include "runner/trial.h"
 
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <memory>
 
@@ -183,7 +184,7 @@ nlohmann::json context_json(const ExperimentConfig& cfg, const std::string& cach
                       {"registration_only", cfg.registration_only},
                       {"perturb_deg", cfg.perturb_deg},
                       {"perturb_mm", cfg.perturb_mm},
-                      {"experiment", cfg.file}};
+                      {"experiment", std::filesystem::absolute(cfg.file).string()}};
   return j;
 }
 
