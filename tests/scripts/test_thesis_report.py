@@ -40,13 +40,17 @@ class Run:
             os.environ.update(old)
         self.err = err.getvalue()
         path = os.path.join(self.out, "README.md")
-        self.lines = open(path).read().splitlines() if os.path.exists(path) else []
+        self.lines = []
+        if os.path.exists(path):
+            with open(path) as f:
+                self.lines = f.read().splitlines()
         shutil.rmtree(self.tmp)
 
 
 def rewrite_records(raw, name, change):
     path = os.path.join(raw, name, "records.jsonl")
-    records = [json.loads(line) for line in open(path)]
+    with open(path) as f:
+        records = [json.loads(line) for line in f]
     for r in records:
         change(r)
     with open(path, "w") as f:
@@ -93,11 +97,13 @@ class StrictRecords(unittest.TestCase):
     def test_misspelt_key_is_exit_2_naming_file_line_and_key(self):
         def misspell(raw):
             path = os.path.join(raw, "table_4_1", "records.jsonl")
-            lines = open(path).read().splitlines()
+            with open(path) as f:
+                lines = f.read().splitlines()
             r = json.loads(lines[1])
             r["statsu"] = r.pop("status")
             lines[1] = json.dumps(r)
-            open(path, "w").write("\n".join(lines) + "\n")
+            with open(path, "w") as f:
+                f.write("\n".join(lines) + "\n")
         run = Run(misspell)
         self.assertEqual(run.code, 2)
         self.assertIn("table_4_1/records.jsonl: line 2: unknown key 'statsu'", run.err)
