@@ -34,21 +34,8 @@ static std::string find_plot_script() {
   return fs::exists("scripts/plot.py") ? "scripts/plot.py" : "";
 }
 
-static pb::cli::Command report_cmd("report", "tables (md, csv, tex) and plots from a results folder", [](int argc, char** argv) {
-  CLI::App app{"Writes REPORT.{md,csv,tex} into the results folder (thesis values beside each cell) and, "
-               "with --plots, PNG plots via scripts/plot.py (matplotlib)."};
-  std::string dir, formats = "md,csv,tex";
-  pb::ReportOptions opt;
-  bool plots = false;
-  app.add_option("results", dir, "results folder of `posebench run`")->required();
-  app.add_option("--format", formats, "comma-separated: md, csv, tex");
-  app.add_flag("--plots", plots, "also write PNG plots");
-  app.add_option("--reference", opt.reference_file, "thesis reference values (YAML)");
-  app.add_option("--table", opt.reference_table, "thesis table id to compare with (e.g. 4.1)");
-  app.add_option("--plot-x", opt.plot_x, "grid path or added_noise_mm to plot against");
-  PB_CLI_PARSE(app, argc, argv);
-  if (opt.reference_file.empty()) opt.reference_file = find_reference();
-
+// experiment.json of a results folder (the canonical config the run wrote).
+static nlohmann::json read_experiment_json(const std::string& dir) {
   const fs::path exp_path = fs::path(dir) / "experiment.json";
   if (!fs::exists(exp_path)) throw pb::InputError(exp_path.string(), "", "not a posebench results folder");
   nlohmann::json exp;
@@ -58,9 +45,12 @@ static pb::cli::Command report_cmd("report", "tables (md, csv, tex) and plots fr
   } catch (const nlohmann::json::exception& e) {
     throw pb::InputError(exp_path.string(), "", std::string("malformed: ") + e.what());
   }
-  const auto records = pb::ResultStore::read_records(dir);
-  const pb::Report rep = pb::build_report(exp, records, opt);
+  return exp;
+}
 
+// REPORT.{md,csv,tex} for the comma-separated `formats`; the Markdown also
+// goes to stdout.
+static void write_tables(const pb::Report& rep, const std::string& dir, const std::string& formats) {
   std::stringstream fs_(formats);
   std::string f;
   while (std::getline(fs_, f, ',')) {
@@ -76,59 +66,88 @@ static pb::cli::Command report_cmd("report", "tables (md, csv, tex) and plots fr
       throw pb::InputError("", "--format", "unknown format '" + f + "' (md, csv, tex)");
     }
   }
-  // BOP results CSVs (one per method and scene set, every condition), so the
-  // BOP toolkit itself can score them.
-  {
-    std::map<std::string, std::vector<pb::BopResultRow>> files;
-    for (const auto& r : records) {
-      if (r.status != "ok" || !r.estimate) continue;
-      std::string method = "posebench-" + r.descriptor + "-" + r.refinement;
-      const auto& params = r.params;
-      const double noise = r.added_noise_mm;
-      std::string cond;
-      for (auto it = params.begin(); it != params.end(); ++it) cond += "-" + it.key() + "=" + it.value().dump();
-      if (noise > 0) cond += "-noise=" + nlohmann::json(noise).dump();
-      // BOP parses METHOD_DATASET-SPLIT.csv: no '_' in the method, no '_' or
-      // '-' in the dataset name.
-      method += cond;
-      for (char& c : method)
-        if (c == '_' || c == '/' || c == '"' || c == ' ') c = '.';
-      std::string dataset = r.scene;
-      dataset.erase(std::remove_if(dataset.begin(), dataset.end(), [](char c) { return c == '_' || c == '-'; }),
-                    dataset.end());
-      const std::string name = method + "_" + dataset + "-" + r.split + ".csv";
-      pb::BopResultRow row;
-      row.scene_id = r.scene_id;
-      row.im_id = r.im_id;
-      row.obj_id = r.obj_id.value_or(0);
-      row.score = r.score.value_or(1.0);
-      row.T_cam_model = r.estimate->pose();
-      row.time_s = r.times ? r.times->total : -1.0;
-      files[name].push_back(row);
-    }
-    if (!files.empty()) fs::create_directories(fs::path(dir) / "bop");
-    for (auto& [name, rows] : files) {
-      std::sort(rows.begin(), rows.end(), [](const pb::BopResultRow& a, const pb::BopResultRow& b) {
-        return std::tie(a.scene_id, a.im_id, a.obj_id) < std::tie(b.scene_id, b.im_id, b.obj_id);
-      });
-      pb::write_bop_results_csv((fs::path(dir) / "bop" / name).string(), rows);
-    }
+}
+
+// The BOP results file a record's estimate goes to: METHOD_DATASET-SPLIT.csv,
+// one per method, condition (grid point, noise) and scene set. BOP parses
+// the name: no '_' in the method, no '_' or '-' in the dataset name.
+static std::string bop_csv_name(const pb::TrialRecord& r) {
+  std::string method = "posebench-" + r.descriptor + "-" + r.refinement;
+  for (auto it = r.params.begin(); it != r.params.end(); ++it) method += "-" + it.key() + "=" + it.value().dump();
+  if (r.added_noise_mm > 0) method += "-noise=" + nlohmann::json(r.added_noise_mm).dump();
+  for (char& c : method)
+    if (c == '_' || c == '/' || c == '"' || c == ' ') c = '.';
+  std::string dataset = r.scene;
+  dataset.erase(std::remove_if(dataset.begin(), dataset.end(), [](char c) { return c == '_' || c == '-'; }),
+                dataset.end());
+  return method + "_" + dataset + "-" + r.split + ".csv";
+}
+
+// BOP results CSVs in DIR/bop (every estimate), so the BOP toolkit itself
+// can score them.
+static void write_bop_csvs(const std::vector<pb::TrialRecord>& records, const std::string& dir) {
+  std::map<std::string, std::vector<pb::BopResultRow>> files;
+  for (const auto& r : records) {
+    if (r.status != "ok" || !r.estimate) continue;
+    pb::BopResultRow row;
+    row.scene_id = r.scene_id;
+    row.im_id = r.im_id;
+    row.obj_id = r.obj_id.value_or(0);
+    row.score = r.score.value_or(1.0);
+    row.T_cam_model = r.estimate->pose();
+    row.time_s = r.times ? r.times->total : -1.0;
+    files[bop_csv_name(r)].push_back(row);
   }
-  if (plots) {
-    const std::string data = (fs::path(dir) / "plots.json").string();
-    pb::atomic_write_text(data, pb::plots_json(rep).dump(2) + "\n");
-    const std::string script = find_plot_script();
-    if (script.empty()) throw pb::InputError("scripts/plot.py", "", "plot script not found");
-    if (rep.plots.empty()) {
-      std::cerr << "posebench report: nothing to plot (no swept variable)\n";
-    } else {
-      const std::string py = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-      const std::string cmd = py + " '" + script + "' '" + data + "' '" + (fs::path(dir) / "plots").string() + "'";
-      if (std::system(cmd.c_str()) != 0) {
-        std::cerr << "posebench report: plotting failed (python3-matplotlib missing?)\n";
-        return 1;
-      }
-    }
+  if (!files.empty()) fs::create_directories(fs::path(dir) / "bop");
+  for (auto& [name, rows] : files) {
+    std::sort(rows.begin(), rows.end(), [](const pb::BopResultRow& a, const pb::BopResultRow& b) {
+      return std::tie(a.scene_id, a.im_id, a.obj_id) < std::tie(b.scene_id, b.im_id, b.obj_id);
+    });
+    pb::write_bop_results_csv((fs::path(dir) / "bop" / name).string(), rows);
+  }
+}
+
+// DIR/plots.json and, through scripts/plot.py, DIR/plots/*.png. Returns the
+// exit code (1 when the script fails).
+static int write_plots(const pb::Report& rep, const std::string& dir) {
+  const std::string data = (fs::path(dir) / "plots.json").string();
+  pb::atomic_write_text(data, pb::plots_json(rep).dump(2) + "\n");
+  const std::string script = find_plot_script();
+  if (script.empty()) throw pb::InputError("scripts/plot.py", "", "plot script not found");
+  if (rep.plots.empty()) {
+    std::cerr << "posebench report: nothing to plot (no swept variable)\n";
+    return 0;
+  }
+  const std::string py = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  const std::string cmd = py + " '" + script + "' '" + data + "' '" + (fs::path(dir) / "plots").string() + "'";
+  if (std::system(cmd.c_str()) != 0) {
+    std::cerr << "posebench report: plotting failed (python3-matplotlib missing?)\n";
+    return 1;
   }
   return 0;
+}
+
+static pb::cli::Command report_cmd("report", "tables (md, csv, tex) and plots from a results folder", [](int argc, char** argv) {
+  CLI::App app{"Writes REPORT.{md,csv,tex} into the results folder (thesis values beside each cell) and, "
+               "with --plots, PNG plots via scripts/plot.py (matplotlib)."};
+  std::string dir, formats = "md,csv,tex";
+  pb::ReportOptions opt;
+  bool plots = false;
+  app.add_option("results", dir, "results folder of `posebench run`")->required();
+  app.add_option("--format", formats, "comma-separated: md, csv, tex");
+  app.add_flag("--plots", plots, "also write PNG plots");
+  app.add_option("--reference", opt.reference_file, "thesis reference values (YAML)");
+  app.add_option("--table", opt.reference_table, "thesis table id to compare with (e.g. 4.1)");
+  app.add_option("--plot-x", opt.plot_x, "grid path or added_noise_mm to plot against");
+  PB_CLI_PARSE(app, argc, argv);
+  if (opt.reference_file.empty()) opt.reference_file = find_reference();
+
+  const nlohmann::json exp = read_experiment_json(dir);
+  // Strict: a record with an unknown or missing key is an InputError naming
+  // records.jsonl, the line and the key (exit 2, nothing written).
+  const auto records = pb::ResultStore::read_records(dir);
+  const pb::Report rep = pb::build_report(exp, records, opt);
+  write_tables(rep, dir, formats);
+  write_bop_csvs(records, dir);
+  return plots ? write_plots(rep, dir) : 0;
 });

@@ -89,6 +89,14 @@ bool thesis_correct(const ThesisErrors& e, const ThesisThresholds& thr) {
   return e.translation_mm < thr.translation_mm && e.rotation < thr.rotation;
 }
 
+ThesisJudgement thesis_judge(const Pose& T_est, const Pose& T_gt, const std::vector<Pose>& symmetries,
+                             const ThesisThresholds& thr) {
+  ThesisJudgement j;
+  j.errors = thesis_errors(T_est, T_gt, symmetries, {thr});
+  j.correct = thesis_correct(j.errors, thr);
+  return j;
+}
+
 namespace {
 
 void mean_std(const std::vector<double>& v, double* mean, double* sd) {

@@ -69,6 +69,18 @@ ThesisErrors thesis_errors(const Pose& T_est, const Pose& T_gt, const std::vecto
 // in the thesis).
 bool thesis_correct(const ThesisErrors& e, const ThesisThresholds& thr);
 
+// The thesis's judgement of one estimate over one symmetry set: thesis_errors
+// with the symmetry chosen by `thr`, and thesis_correct with the same `thr`.
+// The runner judges every pose with the model's own symmetry set and with
+// each extra set of the experiment's `judgements:` (e.g. the milk carton's
+// faces on faces, configs/thesis/table_4_5.yaml).
+struct ThesisJudgement {
+  ThesisErrors errors;
+  bool correct = false;
+};
+ThesisJudgement thesis_judge(const Pose& T_est, const Pose& T_gt, const std::vector<Pose>& symmetries,
+                             const ThesisThresholds& thr);
+
 // One trial (one estimate of the object in one image) for the aggregates.
 struct ThesisTrial {
   bool has_pose = false;  // false for no_hypothesis, timeout or error: counts as not correct

@@ -27,81 +27,89 @@ template <typename T>
 struct is_map<std::map<std::string, T>> : std::true_type {};
 
 // --- the field lists -------------------------------------------------------
-// f(key, member, required?)
+// f(key, member, when the key is required)
+
+enum class Req {
+  always,    // in every record
+  optional,  // when the trial got that far
+  when_ok,   // in every record with status ok
+  when_gt,   // in every record with status ok and ground truth (`gt`): the judged ones
+};
+constexpr Req kAlways = Req::always, kOptional = Req::optional, kWhenOk = Req::when_ok, kWhenGt = Req::when_gt;
 
 template <typename S, typename F>
 void fields(S& r, F& f, PoseRecord*) {
-  f("R", r.R, true);
-  f("t", r.t, true);
+  f("R", r.R, kAlways);
+  f("t", r.t, kAlways);
 }
 template <typename S, typename F>
 void fields(S& r, F& f, StageTimesRecord*) {
-  f("preprocess", r.preprocess, true);
-  f("describe", r.describe, true);
-  f("match", r.match, true);
-  f("group", r.group, true);
-  f("initial_pose", r.initial_pose, true);
-  f("refine", r.refine, true);
-  f("verify", r.verify, true);
-  f("total", r.total, true);
+  f("preprocess", r.preprocess, kAlways);
+  f("describe", r.describe, kAlways);
+  f("match", r.match, kAlways);
+  f("group", r.group, kAlways);
+  f("initial_pose", r.initial_pose, kAlways);
+  f("refine", r.refine, kAlways);
+  f("verify", r.verify, kAlways);
+  f("total", r.total, kAlways);
 }
 template <typename S, typename F>
 void fields(S& r, F& f, ThesisErrorsRecord*) {
-  f("translation_mm", r.translation_mm, true);
-  f("rotation_1mpq", r.rotation_1mpq, true);
-  f("rotation_deg", r.rotation_deg, true);
-  f("symmetry", r.symmetry, true);
-  f("translation_mm_plain", r.translation_mm_plain, true);
-  f("rotation_1mpq_plain", r.rotation_1mpq_plain, true);
+  f("translation_mm", r.translation_mm, kAlways);
+  f("rotation_1mpq", r.rotation_1mpq, kAlways);
+  f("rotation_deg", r.rotation_deg, kAlways);
+  f("symmetry", r.symmetry, kAlways);
+  f("translation_mm_plain", r.translation_mm_plain, kAlways);
+  f("rotation_1mpq_plain", r.rotation_1mpq_plain, kAlways);
 }
 template <typename S, typename F>
 void fields(S& r, F& f, BopErrorsRecord*) {
-  f("mssd_mm", r.mssd_mm, true);
-  f("mspd_px", r.mspd_px, true);
-  f("vsd", r.vsd, true);
-  f("diameter", r.diameter, true);
-  f("image_width", r.image_width, true);
+  f("mssd_mm", r.mssd_mm, kAlways);
+  f("mspd_px", r.mspd_px, kAlways);
+  f("vsd", r.vsd, kAlways);
+  f("diameter", r.diameter, kAlways);
+  f("image_width", r.image_width, kAlways);
 }
 template <typename S, typename F>
 void fields(S& r, F& f, JudgementRecord*) {
-  f("correct", r.correct, true);
-  f("translation_mm", r.translation_mm, true);
-  f("rotation_1mpq", r.rotation_1mpq, true);
+  f("correct", r.correct, kAlways);
+  f("translation_mm", r.translation_mm, kAlways);
+  f("rotation_1mpq", r.rotation_1mpq, kAlways);
 }
 template <typename S, typename F>
 void fields(S& r, F& f, TrialRecord*) {
-  f("key", r.key, true);
-  f("scene", r.scene, true);
-  f("scenario", r.scenario, true);
-  f("dataset", r.dataset, true);
-  f("split", r.split, true);
-  f("scene_id", r.scene_id, true);
-  f("im_id", r.im_id, true);
-  f("descriptor", r.descriptor, true);
-  f("refinement", r.refinement, true);
-  f("params", r.params, true);
-  f("added_noise_mm", r.added_noise_mm, true);
-  f("settings", r.settings, true);
-  f("seed", r.seed, true);
-  f("status", r.status, true);
-  f("correct", r.correct, true);
-  f("wall_s", r.wall_s, true);
-  f("message", r.message, false);
-  f("obj_id", r.obj_id, false);
-  f("settings_resolved", r.settings_resolved, false);
-  f("train_s", r.train_s, false);
-  f("train_from_cache", r.train_from_cache, false);
-  f("times", r.times, false);
-  f("hypotheses", r.hypotheses, false);
-  f("init", r.init, false);
-  f("estimate", r.estimate, false);
-  f("score", r.score, false);
-  f("inliers", r.inliers, false);
-  f("gt", r.gt, false);
-  f("visib_fract", r.visib_fract, false);
-  f("errors", r.errors, false);
-  f("bop", r.bop, false);
-  f("judgements", r.judgements, false);
+  f("key", r.key, kAlways);
+  f("scene", r.scene, kAlways);
+  f("scenario", r.scenario, kAlways);
+  f("dataset", r.dataset, kAlways);
+  f("split", r.split, kAlways);
+  f("scene_id", r.scene_id, kAlways);
+  f("im_id", r.im_id, kAlways);
+  f("descriptor", r.descriptor, kAlways);
+  f("refinement", r.refinement, kAlways);
+  f("params", r.params, kAlways);
+  f("added_noise_mm", r.added_noise_mm, kAlways);
+  f("settings", r.settings, kAlways);
+  f("seed", r.seed, kAlways);
+  f("status", r.status, kAlways);
+  f("correct", r.correct, kWhenGt);
+  f("wall_s", r.wall_s, kWhenOk);
+  f("message", r.message, kOptional);
+  f("obj_id", r.obj_id, kWhenOk);
+  f("settings_resolved", r.settings_resolved, kWhenOk);
+  f("train_s", r.train_s, kWhenOk);
+  f("train_from_cache", r.train_from_cache, kWhenOk);
+  f("times", r.times, kWhenOk);
+  f("hypotheses", r.hypotheses, kWhenOk);
+  f("init", r.init, kOptional);
+  f("estimate", r.estimate, kWhenOk);
+  f("score", r.score, kWhenOk);
+  f("inliers", r.inliers, kWhenOk);
+  f("gt", r.gt, kOptional);
+  f("visib_fract", r.visib_fract, kOptional);
+  f("errors", r.errors, kWhenGt);
+  f("bop", r.bop, kWhenGt);
+  f("judgements", r.judgements, kOptional);
 }
 
 template <typename S>
@@ -117,7 +125,7 @@ nlohmann::json write_value(const T& v);
 template <typename S>
 nlohmann::json write_struct(const S& s) {
   nlohmann::json j = nlohmann::json::object();
-  auto f = [&](const char* key, const auto& member, bool) {
+  auto f = [&](const char* key, const auto& member, Req) {
     using M = std::decay_t<decltype(member)>;
     if constexpr (is_optional<M>::value) {
       if (member) j[key] = write_value(*member);
@@ -171,11 +179,27 @@ size_t edit_distance(const std::string& a, const std::string& b) {
   return prev[b.size()];
 }
 
+// Whether a key of requirement `req` must be in the object `j` (a record:
+// when_ok and when_gt look at its status and ground truth).
+bool needed(Req req, const nlohmann::json& j) {
+  if (req == Req::always) return true;
+  if (req == Req::optional) return false;
+  const auto st = j.find("status");
+  const bool ok = st != j.end() && st->is_string() && st->get<std::string>() == "ok";
+  return ok && (req == Req::when_ok || j.contains("gt"));
+}
+
+std::string required_when(Req req) {
+  return req == Req::when_ok ? " (required with status ok)"
+         : req == Req::when_gt ? " (required with status ok and gt)"
+                               : "";
+}
+
 template <typename S>
 void read_struct(const nlohmann::json& j, S& s, const std::string& path, const Where& w) {
   if (!j.is_object()) w.fail(path.empty() ? "(record)" : path, "expected a JSON object");
   std::vector<std::string> known;
-  auto list = [&](const char* key, auto&, bool) { known.push_back(key); };
+  auto list = [&](const char* key, auto&, Req) { known.push_back(key); };
   fields(s, list, static_cast<S*>(nullptr));
   // Unknown keys first: a misspelt key is named as such, not as the
   // required key it should have been.
@@ -186,12 +210,12 @@ void read_struct(const nlohmann::json& j, S& s, const std::string& path, const W
       if (edit_distance(k, it.key()) <= 2) hint = " (did you mean '" + k + "'?)";
     w.fail(path.empty() ? it.key() : path + "." + it.key(), "unknown key" + hint);
   }
-  auto f = [&](const char* key, auto& member, bool required) {
+  auto f = [&](const char* key, auto& member, Req req) {
     using M = std::decay_t<decltype(member)>;
     const std::string p = path.empty() ? key : path + "." + key;
     const auto it = j.find(key);
     if (it == j.end()) {
-      if (required) w.fail(p, "missing required key");
+      if (needed(req, j)) w.fail(p, "missing required key" + required_when(req));
       return;
     }
     if constexpr (is_optional<M>::value) {
@@ -242,14 +266,17 @@ template <typename S>
 nlohmann::json schema_struct() {
   nlohmann::json fs = nlohmann::json::object();
   S s{};
-  auto f = [&](const char* key, auto& member, bool required) {
+  auto f = [&](const char* key, auto& member, Req req) {
     using M = std::decay_t<decltype(member)>;
     nlohmann::json e;
     if constexpr (is_optional<M>::value)
       e = schema_of<typename M::value_type>();
     else
       e = schema_of<M>();
-    e["required"] = required;
+    e["required"] = req == Req::always     ? nlohmann::json(true)
+                    : req == Req::optional ? nlohmann::json(false)
+                    : req == Req::when_ok  ? nlohmann::json("when_ok")
+                                           : nlohmann::json("when_gt");
     fs[key] = e;
   };
   fields(s, f, static_cast<S*>(nullptr));
@@ -306,9 +333,14 @@ TrialRecord record_from_json(const nlohmann::json& j, const std::string& file, i
 
 nlohmann::json record_schema() {
   nlohmann::json s = schema_struct<TrialRecord>();
-  s["notes"] = {"required: present in every record; the others are present when the trial got that far "
-                "(estimate and score with status ok, errors and bop with status ok and ground truth, judgements "
-                "when the experiment declares them)",
+  s["notes"] = {"required: true = in every record; \"when_ok\" = in every record with status ok; \"when_gt\" = "
+                "in every record with status ok and a gt (the judged ones); false = when the trial got that far "
+                "(message, init with registration_only, gt and visib_fract when the image has the object, "
+                "judgements when the experiment declares them)",
+                "a trial whose worker crashed or timed out (status error or timeout) has the always-required "
+                "keys, message and correct = false only",
+                "type object with \"fields\": those keys only; with \"values\": any keys, each value as given; "
+                "with \"free\": true: any keys and values",
                 "poses are {R: 9 numbers row-major, t: 3 numbers in mm}, T_cam_model"};
   return s;
 }

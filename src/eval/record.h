@@ -56,11 +56,14 @@ struct TrialRecord {
   double added_noise_mm = 0;
   nlohmann::json settings = nlohmann::json::object();  // the trial's settings sections, as configured
   uint64_t seed = 0;
-  // The outcome: always present.
+  // The outcome. `status` is always present; the rest when the trial got
+  // that far (record_schema(): "when_ok" = present in every record with
+  // status ok, "when_gt" = in every record with status ok and `gt`). A trial
+  // whose worker crashed or timed out has the trial, status, message and
+  // correct = false only, as before the typed record.
   std::string status;          // ok | no_hypothesis | error | timeout
-  bool correct = false;        // the thesis's judgement (false without a pose or ground truth)
-  double wall_s = 0;           // wall time of the whole trial in its worker (s)
-  // Present when the trial got that far.
+  std::optional<bool> correct;  // the thesis's judgement: with a GT pose (false without an estimate), or a failed worker
+  std::optional<double> wall_s;  // wall time of the whole trial in its worker (s); none when the worker failed
   std::optional<std::string> message;
   std::optional<int> obj_id;
   std::optional<nlohmann::json> settings_resolved;  // every field, after defaults
@@ -81,11 +84,13 @@ struct TrialRecord {
 
 void to_json(nlohmann::json& j, const TrialRecord& r);
 // Strict: InputError(file, "line N: KEY", ...) for an unknown key, a missing
-// required key or a value of the wrong type.
+// required key (always required, or required for the record's status and
+// ground truth) or a value of the wrong type.
 TrialRecord record_from_json(const nlohmann::json& j, const std::string& file, int line);
 
 // The schema (`posebench schema record`): {"fields": {name: {"type",
-// "required", "fields"?}}, "notes": [...]}.
+// "required": true | false | "when_ok" | "when_gt", "fields"? | "values"? |
+// "free"?}}, "notes": [...]}.
 nlohmann::json record_schema();
 
 }  // namespace pb

@@ -130,7 +130,7 @@ double ref_value(const Reference& ref, const std::string& row, const std::string
 std::string fmt(double v, const std::string& measure) {
   if (!std::isfinite(v)) return "-";
   char buf[64];
-  if (measure == "robustness")
+  if (measure.rfind("robustness", 0) == 0)
     std::snprintf(buf, sizeof buf, "%.0f%%", 100 * v);
   else if (measure == "rotation_1mpq" || measure == "rotation_1mpq_std")
     std::snprintf(buf, sizeof buf, "%.4f", v);
@@ -152,6 +152,7 @@ struct Layout {
   std::string ref_id;    // thesis table compared with
   std::vector<std::string> columns, scenes;
   std::map<std::string, std::string> scenario_of;
+  std::vector<std::string> judgements;  // extra judgements the records carry (experiment `judgements:`)
 };
 
 Layout layout_of(const nlohmann::json& exp, const std::vector<TrialRecord>& records, const ReportOptions& opt) {
@@ -191,8 +192,28 @@ Layout layout_of(const nlohmann::json& exp, const std::vector<TrialRecord>& reco
     l.scenes.push_back(s.value("name", ""));
     l.scenario_of[s.value("name", "")] = s.value("scenario", "table");
   }
+  std::set<std::string> judged;
+  for (const auto& r : records)
+    for (const auto& [name, j] : r.judgements) judged.insert(name);
+  l.judgements.assign(judged.begin(), judged.end());
   return l;
 }
+
+// Robustness under an extra judgement (e.g. the carton's faces on faces):
+// the share of trials whose record judges its pose correct that way; a
+// trial without a judged pose counts as not correct.
+double judged_robustness(const std::vector<const TrialRecord*>& recs, const std::string& name) {
+  if (recs.empty()) return kNaN;
+  size_t correct = 0;
+  for (const auto* r : recs) {
+    const auto it = r->judgements.find(name);
+    if (it != r->judgements.end() && it->second.correct) ++correct;
+  }
+  return static_cast<double>(correct) / static_cast<double>(recs.size());
+}
+
+// The measure of the row of an extra judgement.
+std::string judgement_measure(const std::string& name) { return "robustness_" + name; }
 
 const std::vector<std::string>& table_measures() {
   static const std::vector<std::string> m{"robustness", "translation_mm", "rotation_1mpq", "time", "bop_ar",
@@ -206,6 +227,7 @@ void add_scene_rows(const std::string& scene, const std::vector<const TrialRecor
   std::map<std::string, ThesisAggregate> agg;
   std::map<std::string, BopScores> bop;
   std::map<std::string, int> count;
+  std::map<std::string, std::map<std::string, double>> judged;  // measure -> column -> robustness
   for (const auto& col : l.columns) {
     std::vector<ThesisTrial> trials;
     std::vector<const TrialRecord*> recs;
@@ -215,6 +237,7 @@ void add_scene_rows(const std::string& scene, const std::vector<const TrialRecor
         recs.push_back(r);
       }
     if (!recs.empty()) bop[col] = bop_of(recs);
+    for (const auto& name : l.judgements) judged[judgement_measure(name)][col] = judged_robustness(recs, name);
     count[col] = static_cast<int>(trials.size());
     // Correctness was decided by the runner with the experiment's
     // thresholds; recompute here from the stored errors with the same ones.
@@ -223,7 +246,10 @@ void add_scene_rows(const std::string& scene, const std::vector<const TrialRecor
   bool any = false;
   for (const auto& col : l.columns) any |= count[col] > 0;
   if (!any) return;
-  for (const auto& m : table_measures()) {
+  std::vector<std::string> measures = table_measures();  // the judgements' robustness after the main one
+  for (size_t i = 0; i < l.judgements.size(); ++i)
+    measures.insert(measures.begin() + static_cast<long>(1 + i), judgement_measure(l.judgements[i]));
+  for (const auto& m : measures) {
     ReportRow row;
     row.scenario = scene;
     row.measure = m;
@@ -234,7 +260,8 @@ void add_scene_rows(const std::string& scene, const std::vector<const TrialRecor
       cell.trials = count[col];
       const bool has_bop = bop.count(col) > 0;
       const BopScores b = has_bop ? bop[col] : BopScores{};
-      cell.value = m == "robustness"       ? (a.trials ? a.robustness : kNaN)
+      cell.value = judged.count(m)         ? judged[m][col]
+                   : m == "robustness"     ? (a.trials ? a.robustness : kNaN)
                    : m == "translation_mm" ? a.translation_mean_mm
                    : m == "rotation_1mpq"  ? a.rotation_mean
                    : m == "time"           ? a.time_mean_s
@@ -306,13 +333,14 @@ Report build_report(const nlohmann::json& exp, const std::vector<TrialRecord>& r
   return rep;
 }
 
-static const char* measure_label(const std::string& m) {
+static std::string measure_label(const std::string& m) {
   if (m == "robustness") return "robustness";
+  if (m.rfind("robustness_", 0) == 0) return "robustness, judged by " + m.substr(11);
   if (m == "translation_mm") return "translation error (mm)";
   if (m == "rotation_1mpq") return "rotation error (1-|p.q|)";
   if (m == "time") return "time (s)";
   if (m == "bop_ar") return "BOP AR (VSD, MSSD, MSPD)";
-  return m.c_str();
+  return m;
 }
 
 std::string to_markdown(const Report& r) {

@@ -86,13 +86,13 @@ class Pool {
  private:
   Worker spawn() { return spawn_worker(opt_.binary, opt_.context, opt_.log_path); }
 
-  // The input record with a failure outcome.
-  TrialRecord failed(long ti, const std::string& status, const std::string& msg, double wall_s) const {
+  // The input record with a failure outcome (the worker's own record is
+  // lost: no times, no wall_s).
+  TrialRecord failed(long ti, const std::string& status, const std::string& msg) const {
     TrialRecord rec = inputs_[static_cast<size_t>(ti)];
     rec.status = status;
     rec.message = msg;
     rec.correct = false;
-    rec.wall_s = wall_s;
     return rec;
   }
 
@@ -143,9 +143,8 @@ class Pool {
     }
     if (dead) return on_death(w);
     if (w.trial >= 0 && w.started.seconds() > opt_.timeout_s) {
-      const TrialRecord rec = failed(w.trial, "timeout", "exceeded the time limit of " +
-                                                             std::to_string(opt_.timeout_s) + " s",
-                                     w.started.seconds());
+      const TrialRecord rec =
+          failed(w.trial, "timeout", "exceeded the time limit of " + std::to_string(opt_.timeout_s) + " s");
       stop_worker(w, true);
       finish(w, rec);
       respawn(w);
@@ -159,8 +158,7 @@ class Pool {
       rec.key = inputs_[static_cast<size_t>(w.trial)].key;
       return rec;
     } catch (const std::exception& e) {
-      return failed(w.trial, "error", std::string("worker wrote an unreadable record: ") + e.what(),
-                    w.started.seconds());
+      return failed(w.trial, "error", std::string("worker wrote an unreadable record: ") + e.what());
     }
   }
 
@@ -170,12 +168,11 @@ class Pool {
     close(w.out_fd);
     waitpid(w.pid, &status, 0);
     const long ti = w.trial;
-    const double wall = w.started.seconds();
     w.pid = -1;
     if (ti >= 0) {
       const std::string why = WIFSIGNALED(status) ? "worker crashed (signal " + std::to_string(WTERMSIG(status)) + ")"
                                                   : "worker exited (code " + std::to_string(WEXITSTATUS(status)) + ")";
-      finish(w, failed(ti, "error", why + "; see " + opt_.log_path, wall));
+      finish(w, failed(ti, "error", why + "; see " + opt_.log_path));
     }
     w = Worker{};
     respawn(w);

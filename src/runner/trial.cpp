@@ -107,14 +107,15 @@ void evaluate(const Pose& est, const GtObject& gt, const BopDataset& ds, const I
                                                          : ctx.thresholds.table_translation_mm,
                              ctx.thresholds.rotation_1mpq};
   const auto syms = symmetry_transformations(ds.model_info(obj_id));
-  const ThesisErrors e = thesis_errors(est, gt.T_cam_model, syms, {thr});
+  const ThesisJudgement judged = thesis_judge(est, gt.T_cam_model, syms, thr);
+  const ThesisErrors& e = judged.errors;
   rec.errors = ThesisErrorsRecord{e.translation_mm, e.rotation, e.rotation_deg, e.symmetry,
                                   e.translation_mm_plain, e.rotation_plain};
-  rec.correct = thesis_correct(e, thr);
+  rec.correct = judged.correct;
   for (const Judgement& j : ctx.judgements) {
     const auto js = symmetry_transformations(j.symmetries_discrete, j.symmetries_continuous);
-    const ThesisErrors je = thesis_errors(est, gt.T_cam_model, js, {thr});
-    rec.judgements[j.name] = JudgementRecord{thesis_correct(je, thr), je.translation_mm, je.rotation};
+    const ThesisJudgement other = thesis_judge(est, gt.T_cam_model, js, thr);
+    rec.judgements[j.name] = JudgementRecord{other.correct, other.errors.translation_mm, other.errors.rotation};
   }
 
   const std::string rkey = std::to_string(im.K.width) + "x" + std::to_string(im.K.height) + ":" +
@@ -166,11 +167,14 @@ void run(TrialRecord& rec, const TrialContext& ctx) {
     res = recognize(depth, im.K, *model, s);
   }
   record_result(res, rec);
-  if (!gt) return;
+  if (!gt) return;  // nothing to judge against: no `correct` (as the records always had it)
   rec.gt = PoseRecord::from(gt->T_cam_model);
   const size_t gi = static_cast<size_t>(gt - &im.gt[0]);
   if (gi < im.gt_info.size()) rec.visib_fract = im.gt_info[gi].visib_fract;
-  if (res.status == "ok") evaluate(res.T_cam_model, *gt, ds, im, obj_id, *mesh, ctx, rec);
+  if (res.status == "ok")
+    evaluate(res.T_cam_model, *gt, ds, im, obj_id, *mesh, ctx, rec);
+  else
+    rec.correct = false;
 }
 
 }  // namespace

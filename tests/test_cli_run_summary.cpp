@@ -1,0 +1,123 @@
+// posebench run's account of itself (INTERFACES.md section 2): every
+// invocation that runs trials appends one line to OUT/runs.jsonl, and
+// --json-summary FILE writes the same object (also when nothing ran). A
+// small run: the counts add up, a resumed run that finds everything recorded
+// says so and adds no line. The records of an experiment with `judgements:`
+// carry judgements.NAME on every judged pose.
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <nlohmann/json.hpp>
+#include <map>
+#include <regex>
+#include <vector>
+
+#include "cli_test_util.h"
+
+namespace {
+
+// A small, fast scene set: synthetic sensor, 3 table images.
+const char* kSceneConfig = R"(scenario: table
+seed: 77
+images: 3
+sensor: {name: custom, width: 320, height: 320, hfov_deg: 30, vfov_deg: 30}
+noise: {model: gaussian, sigma_mm: 1.0}
+target: ls5
+target_upright_probability: 1.0
+distractors: {pool: [box_small, cylinder], count: [2, 3]}
+occlusion: none
+camera: {distance_mm: [700, 900], elevation_deg: [40, 60]}
+)";
+
+// 3 images x 1 descriptor: 3 trials; a second judgement by the half turn
+// about the LS5's vertical axis.
+std::string experiment_yaml(const std::string& scene_cfg) {
+  return "name: summarytest\nseed: 3\nobject: ls5\nscenes:\n  - name: table_small\n    generate: " + scene_cfg +
+         "\n    scenario: table\ndescriptors: [cvfh]\nrefinements: [icp]\nsettings:\n  views: {views: 4}\n"
+         "judgements:\n  halfturn:\n    symmetries_discrete:\n"
+         "      - [[-1, 0, 0, 0], [0, -1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]\n";
+}
+
+std::vector<nlohmann::json> lines(const std::string& path) {
+  std::vector<nlohmann::json> out;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line))
+    if (!line.empty()) out.push_back(nlohmann::json::parse(line));
+  return out;
+}
+
+size_t counted(const nlohmann::json& s) {
+  size_t n = 0;
+  for (const auto& [status, c] : s.at("status_counts").items()) n += c.get<size_t>();
+  return n;
+}
+
+TEST(CliRunSummary, RunsJsonlAndJsonSummaryCountTheTrials) {
+  pbcli::TempDir tmp;
+  pbcli::write_file(tmp.path + "/scene.yaml", kSceneConfig);
+  pbcli::write_file(tmp.path + "/exp.yaml", experiment_yaml(tmp.path + "/scene.yaml"));
+  setenv("OMP_NUM_THREADS", "1", 1);  // inherited by posebench and its workers
+  const std::string common = "--out r --cache '" + tmp.path + "/cache' --scenes '" + tmp.path + "/scenes' -q";
+
+  const auto a = pbcli::run("run exp.yaml --jobs 2 --json-summary s1.json " + common, tmp.path);
+  ASSERT_EQ(a.code, 0) << a.err;
+  const auto s1 = nlohmann::json::parse(pbcli::slurp(tmp.path + "/s1.json"));
+  EXPECT_EQ(s1.at("total"), 3);
+  EXPECT_EQ(s1.at("already_recorded"), 0);
+  EXPECT_EQ(s1.at("ran"), 3);
+  EXPECT_EQ(counted(s1), 3u);
+  EXPECT_EQ(s1.at("jobs"), 2);
+  EXPECT_EQ(s1.at("omp_threads"), 1);
+  EXPECT_GE(s1.at("host_cores").get<int>(), 1);
+  EXPECT_GT(s1.at("wall_s").get<double>(), 0.0);
+  EXPECT_TRUE(s1.at("load15_end").is_number());
+  EXPECT_TRUE(std::regex_match(s1.at("started").get<std::string>(),
+                               std::regex(R"(\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ)")))
+      << s1.at("started");
+
+  // runs.jsonl: one line, the same object.
+  const auto runs = lines(tmp.path + "/r/runs.jsonl");
+  ASSERT_EQ(runs.size(), 1u);
+  for (const auto& [k, v] : runs[0].items()) EXPECT_EQ(s1.at(k), v) << k;
+  for (const char* k : {"started", "wall_s", "total", "already_recorded", "ran", "status_counts", "jobs",
+                        "omp_threads", "load15_end", "host_cores"})
+    EXPECT_TRUE(runs[0].contains(k)) << k;
+
+  // The records: as many as ran, each status counted; every judged pose is
+  // also judged by the experiment's extra symmetry set.
+  const auto recs = lines(tmp.path + "/r/records.jsonl");
+  ASSERT_EQ(recs.size(), 3u);
+  std::map<std::string, int> statuses;
+  int judged = 0;
+  for (const auto& r : recs) {
+    ++statuses[r.at("status").get<std::string>()];
+    if (r.at("status") == "ok" && r.contains("gt")) {
+      ASSERT_TRUE(r.contains("judgements")) << r.dump();
+      EXPECT_TRUE(r["judgements"]["halfturn"]["correct"].is_boolean());
+      EXPECT_TRUE(r["judgements"]["halfturn"]["translation_mm"].is_number());
+      ++judged;
+    }
+  }
+  EXPECT_GT(judged, 0);
+  for (const auto& [status, n] : statuses) EXPECT_EQ(s1["status_counts"].value(status, 0), n) << status;
+
+  // Resumed with everything recorded: nothing ran, no runs.jsonl line, but
+  // the summary file says so.
+  const auto b = pbcli::run("run exp.yaml --jobs 1 --json-summary s2.json " + common, tmp.path);
+  ASSERT_EQ(b.code, 0) << b.err;
+  const auto s2 = nlohmann::json::parse(pbcli::slurp(tmp.path + "/s2.json"));
+  EXPECT_EQ(s2.at("total"), 3);
+  EXPECT_EQ(s2.at("already_recorded"), 3);
+  EXPECT_EQ(s2.at("ran"), 0);
+  EXPECT_EQ(counted(s2), 0u);
+  EXPECT_EQ(lines(tmp.path + "/r/runs.jsonl").size(), 1u);
+
+  // The records read back strictly (the reporter's reader).
+  const auto rep = pbcli::run("report r --format md", tmp.path);
+  EXPECT_EQ(rep.code, 0) << rep.err;
+  EXPECT_NE(rep.out.find("Records: 3"), std::string::npos) << rep.out;
+  EXPECT_NE(rep.out.find("robustness, judged by halfturn"), std::string::npos) << rep.out;
+}
+
+}  // namespace
