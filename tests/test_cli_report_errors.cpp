@@ -13,8 +13,8 @@ nlohmann::json record(const std::string& key) {
   return {{"key", key},        {"scene", "table_synthetic"}, {"scenario", "table"}, {"dataset", "d"},
           {"split", "test"},   {"scene_id", 1},              {"im_id", 0},          {"descriptor", "fpfh"},
           {"refinement", "icp"}, {"params", nlohmann::json::object()}, {"added_noise_mm", 0.0},
-          {"settings", nlohmann::json::object()}, {"seed", 3}, {"status", "ok"}, {"correct", true},
-          {"wall_s", 0.5}};
+          {"settings", nlohmann::json::object()}, {"seed", 3}, {"status", "timeout"}, {"correct", false},
+          {"message", "exceeded the time limit of 300 s"}};
 }
 
 TEST(CliReport, MisspeltKeyInRecordsIsExit2NamingFileLineAndKey) {
@@ -24,7 +24,7 @@ TEST(CliReport, MisspeltKeyInRecordsIsExit2NamingFileLineAndKey) {
     "refinements": ["icp"], "scenes": [{"name": "table_synthetic", "scenario": "table"}]})");
   nlohmann::json bad = record("b");
   bad.erase("status");
-  bad["statsu"] = "ok";
+  bad["statsu"] = "timeout";
   pbcli::write_file(dir + "/records.jsonl", record("a").dump() + "\n" + bad.dump() + "\n");
   const auto r = pbcli::run("report '" + dir + "' --format md", tmp.path);
   EXPECT_EQ(r.code, 2) << r.out << r.err;
@@ -46,7 +46,9 @@ TEST(CliSchema, RecordSchemaListsRequiredAndOptionalKeys) {
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["fields"]["status"]["required"], true);
-  EXPECT_EQ(j["fields"]["estimate"]["required"], false);
+  EXPECT_EQ(j["fields"]["estimate"]["required"], "when_ok");
+  EXPECT_EQ(j["fields"]["errors"]["required"], "when_gt");
+  EXPECT_EQ(j["fields"]["gt"]["required"], false);
   EXPECT_EQ(j["fields"]["estimate"]["fields"]["R"]["type"], "array");
   EXPECT_EQ(j["fields"]["judgements"]["values"]["fields"]["correct"]["type"], "boolean");
   const auto bad = pbcli::run("schema recrod", tmp.path);

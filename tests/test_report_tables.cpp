@@ -65,6 +65,33 @@ TEST(Report, CellsMatchHandComputedAggregates) {
   EXPECT_NE(csv.find("table_synthetic,robustness,cvfh,0.5,0.43,4"), std::string::npos) << csv;
 }
 
+// An experiment's extra judgement (the carton's faces on faces) gets its own
+// robustness row after the main one, from the records' judgements.NAME.
+TEST(Report, ExtraJudgementRowFromTheRecordsJudgements) {
+  std::vector<pb::TrialRecord> records = {
+      rec("table_synthetic", "cvfh", true, 10.0, 0.01, 0.2),  // correct both ways
+      rec("table_synthetic", "cvfh", true, 10.0, 0.4, 0.2),   // turned: correct on faces only
+      rec("table_synthetic", "cvfh", true, 70.0, 0.4, 0.2),   // wrong both ways
+      rec("table_synthetic", "cvfh", false, 0, 0, 0.5),       // no pose: not judged, not correct
+  };
+  records[0].judgements["faces"] = pb::JudgementRecord{true, 10.0, 0.01};
+  records[1].judgements["faces"] = pb::JudgementRecord{true, 10.0, 0.0};
+  records[2].judgements["faces"] = pb::JudgementRecord{false, 70.0, 0.0};
+  const pb::Report r = pb::build_report(experiment(), records, {});
+  ASSERT_EQ(r.tables.size(), 1u);
+  const auto& t = r.tables[0];
+  ASSERT_EQ(t.rows.size(), 9u);
+  EXPECT_EQ(t.rows[0].measure, "robustness");
+  EXPECT_DOUBLE_EQ(t.rows[0].cells[0].value, 0.25);
+  EXPECT_EQ(t.rows[1].measure, "robustness_faces");
+  EXPECT_DOUBLE_EQ(t.rows[1].cells[0].value, 0.5);
+  EXPECT_EQ(t.rows[1].cells[0].trials, 4);
+  EXPECT_FALSE(t.rows[1].detail);
+  EXPECT_EQ(t.rows[2].measure, "translation_mm");
+  const std::string md = pb::to_markdown(r);
+  EXPECT_NE(md.find("| robustness, judged by faces | 50% |"), std::string::npos) << md;
+}
+
 TEST(Report, BopAverageRecallFromRecordedErrors) {
   // One image, diameter 100 mm, MSSD 12 mm: correct for MSSD thresholds
   // 0.15..0.5 of the diameter (8 of 10); MSPD 7 px at width 640: correct for

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include "core/error.h"
 #include "runner/store.h"
@@ -12,7 +13,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A complete record (every required key) with this key and status.
+// A complete record (every key required for its status) with this key and
+// status.
 pb::TrialRecord record(const std::string& key, const std::string& status) {
   pb::TrialRecord r;
   r.key = key;
@@ -23,7 +25,28 @@ pb::TrialRecord record(const std::string& key, const std::string& status) {
   r.descriptor = "fpfh";
   r.refinement = "icp";
   r.status = status;
+  if (status == "ok") {  // the keys required with status ok
+    r.wall_s = 0.5;
+    r.obj_id = 2;
+    r.settings_resolved = nlohmann::json::object();
+    r.train_s = 0.1;
+    r.train_from_cache = true;
+    r.times = pb::StageTimesRecord{};
+    r.hypotheses = 1;
+    r.estimate = pb::PoseRecord{{1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 0, 700}};
+    r.score = 0.9;
+    r.inliers = 120;
+  }
   return r;
+}
+
+// The trial part of a record as the runner wrote it before the typed record
+// (the same keys today).
+nlohmann::json old_trial(const std::string& key) {
+  return {{"key", key},       {"scene", "table_synthetic"}, {"scenario", "table"},   {"dataset", "scenes/t"},
+          {"split", "test"},  {"scene_id", 1},              {"im_id", 3},            {"descriptor", "cvfh"},
+          {"refinement", "icp"}, {"params", nlohmann::json::object()}, {"added_noise_mm", 0.0},
+          {"settings", {{"descriptor", "cvfh"}, {"refinement", "icp"}}}, {"seed", 12345678901234ull}};
 }
 
 fs::path temp_dir(const std::string& name) {
@@ -164,6 +187,97 @@ TEST(TrialRecord, RoundTripsThroughJson) {
   wrong = j;
   wrong["scene_id"] = "one";
   EXPECT_THROW(pb::record_from_json(wrong, "f", 7), pb::InputError);
+}
+
+// Records written before the typed record read back and write out the same:
+// a worker that crashed or timed out left the trial, status, message and
+// correct = false (no wall_s, no times); an image without the object's
+// ground truth left no `correct`.
+TEST(TrialRecord, RecordsOfBeforeTheTypedRecordReadBackUnchanged) {
+  std::vector<nlohmann::json> old;
+  nlohmann::json crashed = old_trial("a");
+  crashed["status"] = "error";
+  crashed["message"] = "worker crashed (signal 11); see r/workers.log";
+  crashed["correct"] = false;
+  old.push_back(crashed);
+  nlohmann::json timeout = old_trial("b");
+  timeout["status"] = "timeout";
+  timeout["message"] = "exceeded the time limit of 300.000000 s";
+  timeout["correct"] = false;
+  old.push_back(timeout);
+  nlohmann::json no_gt = old_trial("c");
+  no_gt.update({{"status", "no_hypothesis"}, {"obj_id", 2}, {"settings_resolved", {{"seed", 1}}},
+                {"train_s", 0.5}, {"train_from_cache", false}, {"hypotheses", 0}, {"wall_s", 1.5},
+                {"times", {{"preprocess", 0.1}, {"describe", 0.2}, {"match", 0}, {"group", 0},
+                           {"initial_pose", 0}, {"refine", 0}, {"verify", 0}, {"total", 0.3}}}});
+  old.push_back(no_gt);
+  const fs::path d = temp_dir("old");
+  fs::create_directories(d);
+  {
+    std::ofstream out(d / "records.jsonl");
+    for (const auto& j : old) out << j.dump() << "\n";
+  }
+  const auto recs = pb::ResultStore::read_records(d.string());
+  ASSERT_EQ(recs.size(), old.size());
+  for (size_t i = 0; i < old.size(); ++i) EXPECT_EQ(nlohmann::json(recs[i]), old[i]) << old[i].dump();
+  EXPECT_FALSE(recs[0].wall_s.has_value());
+  EXPECT_EQ(recs[0].correct, false);
+  EXPECT_FALSE(recs[2].correct.has_value());
+  fs::remove_all(d);
+}
+
+// What a status requires: an ok record has its estimate (and the rest of a
+// finished trial); an ok record with ground truth has its judgement.
+TEST(TrialRecord, KeysRequiredByTheStatusAreErrorsNamingTheKey) {
+  const nlohmann::json ok = record("k", "ok");
+  EXPECT_NO_THROW(pb::record_from_json(ok, "f", 1));
+  nlohmann::json j = ok;
+  j.erase("estimate");
+  try {
+    pb::record_from_json(j, "records.jsonl", 4);
+    FAIL() << "no error";
+  } catch (const pb::InputError& e) {
+    const std::string w = e.what();
+    EXPECT_EQ(e.file(), "records.jsonl");
+    EXPECT_NE(w.find("line 4"), std::string::npos) << w;
+    EXPECT_NE(w.find("'estimate'"), std::string::npos) << w;
+    EXPECT_NE(w.find("status ok"), std::string::npos) << w;
+  }
+  j["status"] = "no_hypothesis";  // no estimate needed
+  EXPECT_NO_THROW(pb::record_from_json(j, "f", 1));
+
+  nlohmann::json judged = ok;
+  judged["gt"] = judged["estimate"];
+  try {
+    pb::record_from_json(judged, "records.jsonl", 9);
+    FAIL() << "no error";
+  } catch (const pb::InputError& e) {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("line 9"), std::string::npos) << w;
+    EXPECT_TRUE(w.find("'correct'") != std::string::npos || w.find("'errors'") != std::string::npos ||
+                w.find("'bop'") != std::string::npos)
+        << w;
+  }
+  judged["correct"] = true;
+  judged["errors"] = {{"translation_mm", 1}, {"rotation_1mpq", 0.01}, {"rotation_deg", 2}, {"symmetry", 0},
+                      {"translation_mm_plain", 1}, {"rotation_1mpq_plain", 0.01}};
+  judged["bop"] = {{"mssd_mm", 1}, {"mspd_px", 2}, {"vsd", {0.1}}, {"diameter", 150}, {"image_width", 640}};
+  EXPECT_NO_THROW(pb::record_from_json(judged, "f", 1));
+}
+
+// The schema says which keys each status requires, as the reader checks.
+TEST(TrialRecord, SchemaNamesTheRequirementOfEveryKey) {
+  const nlohmann::json s = pb::record_schema();
+  EXPECT_EQ(s["fields"]["key"]["required"], true);
+  EXPECT_EQ(s["fields"]["status"]["required"], true);
+  EXPECT_EQ(s["fields"]["estimate"]["required"], "when_ok");
+  EXPECT_EQ(s["fields"]["wall_s"]["required"], "when_ok");
+  EXPECT_EQ(s["fields"]["errors"]["required"], "when_gt");
+  EXPECT_EQ(s["fields"]["correct"]["required"], "when_gt");
+  EXPECT_EQ(s["fields"]["gt"]["required"], false);
+  EXPECT_EQ(s["fields"]["times"]["fields"]["total"]["required"], true);
+  EXPECT_EQ(s["fields"]["params"]["free"], true);
+  EXPECT_TRUE(s["notes"].is_array());
 }
 
 }  // namespace
