@@ -13,23 +13,11 @@
 #include <thread>
 
 #include "cli_test_util.h"
+#include "test_cli_run_scene.h"
 
 namespace fs = std::filesystem;
 
 namespace {
-
-// A small, fast scene set: synthetic sensor, 3 table images, few distractors.
-const char* kSceneConfig = R"(scenario: table
-seed: 77
-images: 3
-sensor: {name: custom, width: 320, height: 320, hfov_deg: 30, vfov_deg: 30}
-noise: {model: gaussian, sigma_mm: 1.0}
-target: ls5
-target_upright_probability: 1.0
-distractors: {pool: [box_small, cylinder], count: [2, 3]}
-occlusion: none
-camera: {distance_mm: [700, 900], elevation_deg: [40, 60]}
-)";
 
 std::string experiment_yaml(const std::string& scene_cfg) {
   return "name: runtest\nseed: 3\nobject: ls5\nscenes:\n  - name: table_small\n    generate: " + scene_cfg +
@@ -54,7 +42,7 @@ std::map<std::string, nlohmann::json> comparable(const std::string& dir) {
 class RunTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    pbcli::write_file(tmp.path + "/scene.yaml", kSceneConfig);
+    pbcli::write_file(tmp.path + "/scene.yaml", pbcli::kSmallTableScene);
     pbcli::write_file(tmp.path + "/exp.yaml", experiment_yaml(tmp.path + "/scene.yaml"));
   }
   pbcli::TempDir tmp;

@@ -13,21 +13,9 @@
 #include <vector>
 
 #include "cli_test_util.h"
+#include "test_cli_run_scene.h"
 
 namespace {
-
-// A small, fast scene set: synthetic sensor, 3 table images.
-const char* kSceneConfig = R"(scenario: table
-seed: 77
-images: 3
-sensor: {name: custom, width: 320, height: 320, hfov_deg: 30, vfov_deg: 30}
-noise: {model: gaussian, sigma_mm: 1.0}
-target: ls5
-target_upright_probability: 1.0
-distractors: {pool: [box_small, cylinder], count: [2, 3]}
-occlusion: none
-camera: {distance_mm: [700, 900], elevation_deg: [40, 60]}
-)";
 
 // 3 images x 1 descriptor: 3 trials; a second judgement by the half turn
 // about the LS5's vertical axis.
@@ -47,15 +35,19 @@ std::vector<nlohmann::json> lines(const std::string& path) {
   return out;
 }
 
-size_t counted(const nlohmann::json& s) {
-  size_t n = 0;
-  for (const auto& [status, c] : s.at("status_counts").items()) n += c.get<size_t>();
-  return n;
+// The summary's trial counts, its status counts adding up to those run.
+void expect_counts(const nlohmann::json& s, int total, int already, int ran) {
+  EXPECT_EQ(s.at("total"), total) << s.dump();
+  EXPECT_EQ(s.at("already_recorded"), already) << s.dump();
+  EXPECT_EQ(s.at("ran"), ran) << s.dump();
+  int n = 0;
+  for (const auto& [status, c] : s.at("status_counts").items()) n += c.get<int>();
+  EXPECT_EQ(n, ran) << s.dump();
 }
 
 TEST(CliRunSummary, RunsJsonlAndJsonSummaryCountTheTrials) {
   pbcli::TempDir tmp;
-  pbcli::write_file(tmp.path + "/scene.yaml", kSceneConfig);
+  pbcli::write_file(tmp.path + "/scene.yaml", pbcli::kSmallTableScene);
   pbcli::write_file(tmp.path + "/exp.yaml", experiment_yaml(tmp.path + "/scene.yaml"));
   setenv("OMP_NUM_THREADS", "1", 1);  // inherited by posebench and its workers
   const std::string common = "--out r --cache '" + tmp.path + "/cache' --scenes '" + tmp.path + "/scenes' -q";
@@ -63,10 +55,7 @@ TEST(CliRunSummary, RunsJsonlAndJsonSummaryCountTheTrials) {
   const auto a = pbcli::run("run exp.yaml --jobs 2 --json-summary s1.json " + common, tmp.path);
   ASSERT_EQ(a.code, 0) << a.err;
   const auto s1 = nlohmann::json::parse(pbcli::slurp(tmp.path + "/s1.json"));
-  EXPECT_EQ(s1.at("total"), 3);
-  EXPECT_EQ(s1.at("already_recorded"), 0);
-  EXPECT_EQ(s1.at("ran"), 3);
-  EXPECT_EQ(counted(s1), 3u);
+  expect_counts(s1, 3, 0, 3);
   EXPECT_EQ(s1.at("jobs"), 2);
   EXPECT_EQ(s1.at("omp_threads"), 1);
   EXPECT_GE(s1.at("host_cores").get<int>(), 1);
@@ -107,10 +96,7 @@ TEST(CliRunSummary, RunsJsonlAndJsonSummaryCountTheTrials) {
   const auto b = pbcli::run("run exp.yaml --jobs 1 --json-summary s2.json " + common, tmp.path);
   ASSERT_EQ(b.code, 0) << b.err;
   const auto s2 = nlohmann::json::parse(pbcli::slurp(tmp.path + "/s2.json"));
-  EXPECT_EQ(s2.at("total"), 3);
-  EXPECT_EQ(s2.at("already_recorded"), 3);
-  EXPECT_EQ(s2.at("ran"), 0);
-  EXPECT_EQ(counted(s2), 0u);
+  expect_counts(s2, 3, 3, 0);
   EXPECT_EQ(lines(tmp.path + "/r/runs.jsonl").size(), 1u);
 
   // The records read back strictly (the reporter's reader).

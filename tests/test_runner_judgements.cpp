@@ -31,41 +31,35 @@ TEST(Judgements, Table45DeclaresFacesWithTheEightRotationsOfTheBody) {
   EXPECT_EQ(cfg.canonical["judgements"][0]["symmetries_discrete"].size(), 7u);
 }
 
-TEST(Judgements, BadSymmetryIsAnInputErrorNamingTheField) {
+// The InputError load_experiment throws for an experiment whose
+// `judgements:` section is `section` (YAML, from its line 4 on).
+pb::InputError judgements_error(const std::string& name, const std::string& section) {
   const std::string dir = ::testing::TempDir();
-  const std::string path = dir + "/j.yaml";
-  {
-    std::ofstream out(path);
-    out << "object: x\nscenes: [{dataset: " << dir << "}]\ndescriptors: [fpfh]\n"
-        << "judgements:\n  faces:\n    symmetries_discrete:\n      - [[2, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], "
-           "[0, 0, 0, 1]]\n";
-  }
+  const std::string path = dir + "/" + name + ".yaml";
+  std::ofstream(path) << "object: x\nscenes: [{dataset: " << dir << "}]\ndescriptors: [fpfh]\n"
+                      << "judgements:\n" << section;
   try {
     pb::load_experiment(path);
-    FAIL() << "no error";
   } catch (const pb::InputError& e) {
     EXPECT_EQ(e.file(), path);
-    EXPECT_NE(std::string(e.what()).find("judgements.faces.symmetries_discrete"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("not a rotation"), std::string::npos) << e.what();
+    return e;
   }
+  ADD_FAILURE() << "no error for " << section;
+  return pb::InputError(path, "", "");
+}
+
+TEST(Judgements, BadSymmetryIsAnInputErrorNamingTheField) {
+  const std::string w = judgements_error("j1", "  faces:\n    symmetries_discrete:\n"
+                                               "      - [[2, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]\n")
+                            .what();
+  EXPECT_NE(w.find("judgements.faces.symmetries_discrete"), std::string::npos) << w;
+  EXPECT_NE(w.find("not a rotation"), std::string::npos) << w;
 }
 
 TEST(Judgements, MisspeltKeyIsAnInputErrorNamingFileLineAndKey) {
-  const std::string dir = ::testing::TempDir();
-  const std::string path = dir + "/j2.yaml";
-  {
-    std::ofstream out(path);
-    out << "object: x\nscenes: [{dataset: " << dir << "}]\ndescriptors: [fpfh]\n"
-        << "judgements:\n  faces:\n    symmetries_discret: []\n";
-  }
-  try {
-    pb::load_experiment(path);
-    FAIL() << "no error";
-  } catch (const pb::InputError& e) {
-    EXPECT_EQ(e.file(), path);
-    EXPECT_NE(std::string(e.what()).find("symmetries_discret"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("line 6"), std::string::npos) << e.what();
-  }
+  const std::string w = judgements_error("j2", "  faces:\n    symmetries_discret: []\n").what();
+  EXPECT_NE(w.find("symmetries_discret"), std::string::npos) << w;
+  EXPECT_NE(w.find("line 6"), std::string::npos) << w;
 }
 
 }  // namespace
