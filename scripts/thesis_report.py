@@ -24,7 +24,7 @@ import sys
 RECORD_SCHEMA = {
     "key": True, "scene": True, "scenario": True, "dataset": True, "split": True, "scene_id": True,
     "im_id": True, "descriptor": True, "refinement": True, "params": True, "added_noise_mm": True,
-    "settings": True, "seed": True, "status": True, "correct": True, "wall_s": True,
+    "settings": True, "seed": True, "status": True, "correct": False, "wall_s": False,
     "message": False, "obj_id": False, "settings_resolved": False, "train_s": False, "train_from_cache": False,
     "times": False, "hypotheses": False, "init": False, "estimate": False, "score": False, "inliers": False,
     "gt": False, "visib_fract": False, "errors": False, "bop": False, "judgements": False,
@@ -322,7 +322,7 @@ def carton_judgements(e):
         key = (r["scene"], r["descriptor"])
         rows.setdefault(key, [0, 0, 0])
         rows[key][0] += 1
-        rows[key][1] += 1 if r["correct"] else 0
+        rows[key][1] += 1 if r.get("correct") else 0
         if "judgements" in r and "faces" in r["judgements"]:
             rows[key][2] += 1 if r["judgements"]["faces"]["correct"] else 0
         elif r["status"] == "ok" and "errors" in r:

@@ -110,10 +110,10 @@ class StrictRecords(unittest.TestCase):
 
     def test_missing_required_key_is_exit_2(self):
         def drop(raw):
-            rewrite_records(raw, "table_4_5", lambda r: r.pop("wall_s"))
+            rewrite_records(raw, "table_4_5", lambda r: r.pop("seed"))
         run = Run(drop)
         self.assertEqual(run.code, 2)
-        self.assertIn("table_4_5/records.jsonl: line 1: missing required key 'wall_s'", run.err)
+        self.assertIn("table_4_5/records.jsonl: line 1: missing required key 'seed'", run.err)
 
 
 class Schema(unittest.TestCase):
