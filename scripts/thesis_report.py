@@ -64,9 +64,14 @@ class InputError(Exception):
 
 
 class KeyProblem(Exception):
-    def __init__(self, key, what):
-        super().__init__(key, what)
-        self.key, self.what = key, what
+    """A record's key (dotted path) that does not fit the schema: `what 'key'detail`."""
+
+    def __init__(self, key, what, detail=""):
+        super().__init__(key, what, detail)
+        self.key, self.what, self.detail = key, what, detail
+
+    def __str__(self):
+        return "%s '%s'%s" % (self.what, self.key, self.detail)
 
 
 def schema_from_binary(binary):
@@ -97,7 +102,7 @@ def check_value(value, spec, record, path):
     ok = isinstance(value, PY_TYPES[spec["type"]]) and not (isinstance(value, bool) and spec["type"] in
                                                            ("integer", "number"))
     if not ok:
-        raise KeyProblem(path, "wrong type (%s, expected %s)" % (type(value).__name__, spec["type"]))
+        raise KeyProblem(path, "wrong type for key", " (%s, expected %s)" % (type(value).__name__, spec["type"]))
     if "values" in spec:
         for k, v in value.items():
             check_value(v, spec["values"], record, path + "." + k)
@@ -110,7 +115,7 @@ def check_fields(obj, fields, record, path=""):
     for k in obj:  # unknown keys first: a misspelt key is named as such
         if k not in fields:
             close = difflib.get_close_matches(k, list(fields), n=1)
-            raise KeyProblem(prefix + k, "unknown key" + (" (did you mean '%s'?)" % close[0] if close else ""))
+            raise KeyProblem(prefix + k, "unknown key", " (did you mean '%s'?)" % close[0] if close else "")
     for k, spec in fields.items():
         if k in obj:
             check_value(obj[k], spec, record, prefix + k)
@@ -118,26 +123,25 @@ def check_fields(obj, fields, record, path=""):
             raise KeyProblem(prefix + k, "missing required key")
 
 
+def parse_record(line, schema, path, n):
+    """Line n of a records.jsonl as a record that fits the schema."""
+    try:
+        r = json.loads(line)
+    except ValueError as e:
+        raise InputError("%s: line %d: not JSON (%s)" % (path, n, e)) from None
+    if not isinstance(r, dict):
+        raise InputError("%s: line %d: not a JSON object" % (path, n))
+    try:
+        check_fields(r, schema["fields"], r)
+    except KeyProblem as p:
+        raise InputError("%s: line %d: %s" % (path, n, p)) from None
+    return r
+
+
 def load_records(path, schema):
     """Every record of a records.jsonl, each checked against the schema."""
-    records = []
     with open(path) as f:
-        for n, line in enumerate(f, 1):
-            if not line.strip():
-                continue
-            try:
-                r = json.loads(line)
-            except ValueError as e:
-                raise InputError("%s: line %d: not JSON (%s)" % (path, n, e))
-            try:
-                if not isinstance(r, dict):
-                    raise KeyProblem("(record)", "not a JSON object")
-                check_fields(r, schema["fields"], r)
-            except KeyProblem as p:
-                raise InputError("%s: line %d: %s '%s'" % (path, n, p.what, p.key) if p.what.startswith(
-                    ("unknown key", "missing required key")) else "%s: line %d: key '%s': %s" % (path, n, p.key, p.what))
-            records.append(r)
-    return records
+        return [parse_record(line, schema, path, n) for n, line in enumerate(f, 1) if line.strip()]
 
 
 class Runs:
