@@ -82,10 +82,10 @@ def schema_from_binary(binary):
         r = subprocess.run([binary, "schema", "record"], capture_output=True, text=True, timeout=60)
     except (OSError, subprocess.TimeoutExpired):
         return None
-    if r.returncode != 0:
+    try:
+        return {"type": "object", "fields": json.loads(r.stdout)["fields"]} if r.returncode == 0 else None
+    except (ValueError, KeyError, TypeError):
         return None
-    schema = json.loads(r.stdout)
-    return {"type": "object", "fields": schema["fields"]}
 
 
 def is_required(flag, record):
@@ -99,7 +99,7 @@ def is_required(flag, record):
 
 def check_value(value, spec, record, path):
     """Raises KeyProblem(key path, what) where `value` does not fit `spec`."""
-    ok = isinstance(value, PY_TYPES[spec["type"]]) and not (isinstance(value, bool) and spec["type"] in
+    ok = isinstance(value, PY_TYPES.get(spec.get("type"), (object,))) and not (isinstance(value, bool) and spec["type"] in
                                                            ("integer", "number"))
     if not ok:
         raise KeyProblem(path, "wrong type for key", " (%s, expected %s)" % (type(value).__name__, spec["type"]))
@@ -902,9 +902,12 @@ def main(argv=None):
         return 0 if argv else 2
     out_dir, experiments = argv[0], argv[1:]
     binary = os.environ.get("POSEBENCH", "build/posebench")
-    schema = schema_from_binary(binary) or RECORD_SCHEMA
+    schema = schema_from_binary(binary)
+    if schema is None and binary and os.path.exists(binary):
+        print("thesis_report.py: `%s schema record` gave no schema (a binary from before it?); using the copy in "
+              "thesis_report.py" % binary, file=sys.stderr)
     try:
-        res = load_results(out_dir, experiments, schema)
+        res = load_results(out_dir, experiments, schema or RECORD_SCHEMA)
     except InputError as err:
         print("thesis_report.py: %s" % err, file=sys.stderr)
         return 2

@@ -292,6 +292,7 @@ class Schema(unittest.TestCase):
             self.assertIsNone(thesis_report.schema_from_binary(binary))
             run = Run(edit_record("table_4_1", 0, lambda r: r.update(extra="x")), posebench=binary)
         self.assertEqual(run.code, 2)
+        self.assertIn("schema record` gave no schema (a binary from before it?); using the copy", run.err)
         self.assertIn("unknown key 'extra'", run.err)
 
 
