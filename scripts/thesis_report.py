@@ -44,16 +44,20 @@ ERRORS = _struct(("translation_mm", NUMBER, True), ("rotation_1mpq", NUMBER, Tru
 BOP = _struct(("mssd_mm", NUMBER, True), ("mspd_px", NUMBER, True), ("vsd", ARRAY, True), ("diameter", NUMBER, True),
               ("image_width", INTEGER, True))
 JUDGEMENT = _struct(("correct", BOOLEAN, True), ("translation_mm", NUMBER, True), ("rotation_1mpq", NUMBER, True))
+# "required": True = in every record, False = when the trial got that far,
+# "when_ok" = in every record with status ok, "when_gt" = in every record with
+# status ok and a ground truth (`gt`): the judged ones.
+OK, GT = "when_ok", "when_gt"
 RECORD_SCHEMA = _struct(
     ("key", STRING, True), ("scene", STRING, True), ("scenario", STRING, True), ("dataset", STRING, True),
     ("split", STRING, True), ("scene_id", INTEGER, True), ("im_id", INTEGER, True), ("descriptor", STRING, True),
     ("refinement", STRING, True), ("params", FREE, True), ("added_noise_mm", NUMBER, True), ("settings", FREE, True),
-    ("seed", INTEGER, True), ("status", STRING, True), ("correct", BOOLEAN, True), ("wall_s", NUMBER, True),
-    ("message", STRING, False), ("obj_id", INTEGER, False), ("settings_resolved", FREE, False),
-    ("train_s", NUMBER, False), ("train_from_cache", BOOLEAN, False), ("times", TIMES, False),
-    ("hypotheses", INTEGER, False), ("init", POSE, False), ("estimate", POSE, False), ("score", NUMBER, False),
-    ("inliers", INTEGER, False), ("gt", POSE, False), ("visib_fract", NUMBER, False), ("errors", ERRORS, False),
-    ("bop", BOP, False), ("judgements", {"type": "object", "values": JUDGEMENT}, False))
+    ("seed", INTEGER, True), ("status", STRING, True), ("correct", BOOLEAN, GT), ("wall_s", NUMBER, OK),
+    ("message", STRING, False), ("obj_id", INTEGER, OK), ("settings_resolved", FREE, OK), ("train_s", NUMBER, OK),
+    ("train_from_cache", BOOLEAN, OK), ("times", TIMES, OK), ("hypotheses", INTEGER, OK), ("init", POSE, False),
+    ("estimate", POSE, OK), ("score", NUMBER, OK), ("inliers", INTEGER, OK), ("gt", POSE, False),
+    ("visib_fract", NUMBER, False), ("errors", ERRORS, GT), ("bop", BOP, GT),
+    ("judgements", {"type": "object", "values": JUDGEMENT}, False))
 
 PY_TYPES = {"string": (str,), "integer": (int,), "number": (int, float), "boolean": (bool,), "array": (list,),
             "object": (dict,)}
@@ -89,12 +93,13 @@ def schema_from_binary(binary):
 
 
 def is_required(flag, record):
-    """A field's "required": true, false, or "when_ok" / "when_gt" (INTERFACES.md)."""
-    if flag == "when_ok":
-        return record.get("status") == "ok"
-    if flag == "when_gt":
-        return "gt" in record
+    """Whether a key is required in `record`, by its schema's "required"."""
+    if flag in ("when_ok", "when_gt"):
+        return record.get("status") == "ok" and (flag == "when_ok" or "gt" in record)
     return flag is True
+
+
+WHEN = {"when_ok": " (required with status ok)", "when_gt": " (required with status ok and gt)"}
 
 
 def check_value(value, spec, record, path):
@@ -120,7 +125,7 @@ def check_fields(obj, fields, record, path=""):
         if k in obj:
             check_value(obj[k], spec, record, prefix + k)
         elif is_required(spec.get("required"), record):
-            raise KeyProblem(prefix + k, "missing required key")
+            raise KeyProblem(prefix + k, "missing required key", WHEN.get(spec.get("required"), ""))
 
 
 def parse_record(line, schema, path, n):
@@ -467,7 +472,7 @@ def carton_counts(records):
         c = counts.setdefault((r["scene"], r["descriptor"]), [0, 0, 0])
         faces = r.get("judgements", {}).get("faces")
         c[0] += 1
-        c[1] += 1 if r["correct"] else 0
+        c[1] += 1 if r.get("correct") else 0
         c[2] += 1 if faces and faces["correct"] else 0
         if faces is None and "estimate" in r and "gt" in r:
             judged = False
