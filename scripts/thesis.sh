@@ -6,11 +6,13 @@
 #
 # Runs every experiment of configs/thesis/ (table_4_1 ... fig_4_12, and two
 # variants of Tables 4.3 / 4.4 with the one view from 45 degrees above) with
-# `posebench run` into results/thesis/raw/NAME (git-ignored), reports each
-# (markdown, csv, plots), copies the plots to results/thesis/plots/ and
-# writes results/thesis/README.md (scripts/thesis_report.py). Resumable: `posebench run` only runs the
-# trials a results folder is missing, so running this again after an
-# interruption (or after adding an experiment) does only what is missing.
+# `posebench run` into results/thesis/raw/NAME (git-ignored; the run itself
+# logs its wall time and load to NAME/runs.jsonl), reports each (markdown,
+# csv, plots), copies the plots to results/thesis/plots/ and writes
+# results/thesis/README.md with scripts/thesis_report.py. Resumable: `posebench
+# run` only runs the trials a results folder is missing, so running this again
+# after an interruption (or after adding an experiment) does only what is
+# missing. --readme-only: report and rewrite the README from the raw folders.
 #
 # Environment: POSEBENCH (the binary, default build/posebench), JOBS (worker
 # processes, default 2), NICE (niceness of the runs, default 0). Workers run
@@ -28,7 +30,7 @@ while [ $# -gt 0 ]; do
     --jobs) JOBS=$2; shift 2 ;;
     --only) ONLY=$2; shift 2 ;;
     --readme-only) README_ONLY=1; shift ;;
-    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
     *) echo "thesis.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -69,5 +71,6 @@ for e in "${EXPERIMENTS[@]}"; do
   done
 done
 
-# The README: every number from the raw folders (records, reports, runs.jsonl).
+# The README: every number from the raw folders (records checked against
+# `posebench schema record`, reports, runs.jsonl); exit 2 on a bad record.
 POSEBENCH="$PB" JOBS=$JOBS /usr/bin/python3 scripts/thesis_report.py "$OUT" "${EXPERIMENTS[@]}"

@@ -1,7 +1,15 @@
-"""scripts/thesis_report.py: fixture results folders in (two experiments as
-`posebench run` and `posebench report` write them, tests/scripts/fixtures/),
-README rows out; strict records (a misspelt key is exit code 2 naming file,
-line and key); the carton's faces row from the records' judgements."""
+"""scripts/thesis_report.py: fixture results folders in, README rows out.
+
+tests/scripts/fixtures/raw/ holds three small experiments as `posebench run`
+and `posebench report` write them (experiment.json, records.jsonl,
+runs.jsonl; report.md, report.csv, plots.json from the reporter):
+table_4_1 (a Table 4.1-style table), table_4_5 (the milk carton, records
+with judgements.faces) and fig_4_12 (a noise figure, registration only).
+The tests assert exact README rows, the strict record loader (exit code 2
+naming file, line and key), the carton's faces row from the records'
+judgements (and "-" without them), and times and loads from runs.jsonl.
+No network, no binary needed (the schema comparison is skipped without one).
+"""
 import contextlib
 import io
 import json
@@ -11,119 +19,327 @@ import subprocess
 import sys
 import tempfile
 import unittest
+from unittest import mock
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
-FIXTURES = os.path.join(os.path.dirname(__file__), "fixtures")
+FIXTURES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fixtures")
+SCRIPT = os.path.join(ROOT, "scripts", "thesis_report.py")
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 import thesis_report  # noqa: E402
 
+EXPERIMENTS = ("table_4_1", "table_4_5", "fig_4_12")
+
 
 class Run:
-    """Copies the fixtures to a temporary OUT, applies `edit`, writes the README."""
+    """Copies the fixtures to a temporary OUT, applies edit(raw folder), runs
+    main() with the schema copy (POSEBENCH unless given is no binary) and
+    keeps the exit code, stderr and the README's lines."""
 
-    def __init__(self, edit=None, experiments=("table_4_1", "table_4_5")):
-        self.tmp = tempfile.mkdtemp()
-        self.out = os.path.join(self.tmp, "thesis")
-        shutil.copytree(FIXTURES, self.out)
-        if edit:
-            edit(os.path.join(self.out, "raw"))
-        err = io.StringIO()
-        env = dict(os.environ, POSEBENCH="")  # the built-in schema copy
-        old = os.environ.copy()
-        os.environ.clear()
-        os.environ.update(env)
-        try:
-            with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
-                self.code = thesis_report.main([self.out] + list(experiments))
-        finally:
-            os.environ.clear()
-            os.environ.update(old)
-        self.err = err.getvalue()
-        path = os.path.join(self.out, "README.md")
-        self.lines = []
-        if os.path.exists(path):
-            with open(path) as f:
-                self.lines = f.read().splitlines()
-        shutil.rmtree(self.tmp)
+    def __init__(self, edit=None, experiments=EXPERIMENTS, posebench=""):
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "thesis")
+            shutil.copytree(os.path.join(FIXTURES, "raw"), os.path.join(out, "raw"))
+            if edit:
+                edit(os.path.join(out, "raw"))
+            err = io.StringIO()
+            with mock.patch.dict(os.environ, {"POSEBENCH": posebench, "JOBS": "2"}), \
+                    contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+                self.code = thesis_report.main([out] + list(experiments))
+            self.err = err.getvalue()
+            self.lines = read_lines(os.path.join(out, "README.md"))
 
 
-def rewrite_records(raw, name, change):
-    path = os.path.join(raw, name, "records.jsonl")
+def read_lines(path):
+    if not os.path.exists(path):
+        return []
     with open(path) as f:
-        records = [json.loads(line) for line in f]
-    for r in records:
-        change(r)
-    with open(path, "w") as f:
+        return f.read().splitlines()
+
+
+def records_of(raw, name):
+    with open(os.path.join(raw, name, "records.jsonl")) as f:
+        return [json.loads(line) for line in f]
+
+
+def write_records(raw, name, records):
+    with open(os.path.join(raw, name, "records.jsonl"), "w") as f:
         f.write("".join(json.dumps(r) + "\n" for r in records))
 
 
+def edit_record(name, index, change):
+    """An edit of one record (0-based index) of an experiment's records.jsonl."""
+    def edit(raw):
+        records = records_of(raw, name)
+        change(records[index])
+        write_records(raw, name, records)
+    return edit
+
+
 class Readme(unittest.TestCase):
+    longMessage = False
+
     @classmethod
     def setUpClass(cls):
         cls.run_ = Run()
+
+    def assertLine(self, line):
+        self.assertIn(line, self.run_.lines, "README lines:\n" + "\n".join(self.run_.lines))
 
     def test_exit_code_zero(self):
         self.assertEqual(self.run_.code, 0, self.run_.err)
 
     def test_experiments_table_times_and_loads_from_runs_jsonl(self):
         # table_4_1: two invocations, 30.5 s + 12.0 s, loads 1.5 and 2.0.
-        self.assertIn("| Table 4.1 | `configs/thesis/table_4_1.yaml` | 2 | 4 | no_hypothesis 1, ok 3 | 0m42s | "
-                      "1.5/2.0 |", self.run_.lines)
-        self.assertIn("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 4 | no_hypothesis 1, ok 3 | 0m20s | 0.5 |",
-                      self.run_.lines)
-        self.assertIn("| **total** | | | 8 | | **1m02s** | |", self.run_.lines)
+        self.assertLine("| Table 4.1 | `configs/thesis/table_4_1.yaml` | 2 | 4 | no_hypothesis 1, ok 3 | 0m42s | 1.5/2.0 |")
+        self.assertLine("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 4 | no_hypothesis 1, ok 3 | 0m20s | 0.5 |")
+        # fig_4_12: 3725.2 s with an unknown load (null); its second line ran nothing and is left out.
+        self.assertLine("| Figure 4.12 | `configs/thesis/fig_4_12.yaml` | 2 | 8 | ok 8 | 1h02m05s | - |")
+        self.assertLine("| **total** | | | 16 | | **1h03m08s** | |")
 
-    def test_table_rows_come_from_the_report_with_the_thesis_beside(self):
-        # cvfh: 1 of 2 correct (thesis 43%), fpfh: 2 of 2 (thesis 67%), Table 4.1 table synthetic.
-        self.assertIn("| table_synthetic | robustness | 50% (43%) | 100% (67%) |", self.run_.lines)
+    def test_intro_totals_and_load_range(self):
+        text = "\n".join(self.run_.lines)
+        self.assertIn("**Total wall time of the regeneration: 1h03m08s** for 16 trials", text)
+        self.assertIn("2 worker processes, each single-threaded.", text)
+        self.assertIn("ranged from 0.5 to 2.0 on", text)
+
+    def test_table_4_1_rows_come_from_the_report_with_the_thesis_beside(self):
+        # cvfh: 1 of 2 correct (thesis 43%), fpfh: 2 of 2 (thesis 67%).
+        self.assertLine("#### Table 4.1: LS5, multiple model views (12 synthetic, 8 real)")
+        self.assertLine("| scenario | measure | cvfh | fpfh |")
+        self.assertLine("| table_synthetic | robustness | 50% (43%) | 100% (67%) |")
+        self.assertLine("|  | time (s) | 0.25 (0.19) | 0.75 (1.22) |")
 
     def test_carton_faces_row_from_the_records_judgements(self):
         # cvfh: 1 of 2 correct with the half turn, 2 of 2 faces on faces; fpfh: 0 and 0.
-        self.assertIn("| table_astra | half turn only | 50% | 0% |", self.run_.lines)
-        self.assertIn("|  | faces on faces (thesis) | 100% (31%) | 0% (16%) |", self.run_.lines)
+        self.assertLine("| scenario | judgment | cvfh | fpfh |")
+        self.assertLine("| table_astra | half turn only | 50% | 0% |")
+        self.assertLine("|  | faces on faces (thesis) | 100% (31%) | 0% (16%) |")
+        self.assertFalse(any("re-run table_4_5" in line for line in self.run_.lines))
+
+    def test_figure_plot_and_series_table(self):
+        self.assertLine("![Figure 4.12: registration robustness vs added noise](plots/fig_4_12_robustness_vs_noise.png)")
+        self.assertLine("| added noise sigma (mm) | 0 | 2 |")
+        self.assertLine("| icp (warehouse_synthetic) | 50% / 0.3s | 100% / 0.3s |")
+        self.assertLine("| icp_plane (warehouse_synthetic) | 100% / 0.3s | 50% / 0.3s |")
+
+    def test_noise_conclusion_from_the_figure(self):
+        line = [l for l in self.run_.lines if l.startswith("6. ")]
+        self.assertEqual(len(line), 1, self.run_.lines)
+        self.assertTrue(line[0].startswith(
+            "6. **Better with about 2 mm of added noise than with none (thesis section 5.1): partly supported.** Of "
+            "the 2 curves of Figures 4.7, 4.11 and 4.12, 1 are higher at 2 mm than at 0 mm, 1 lower, 0 equal. "
+            "Higher: icp (warehouse_synthetic) 50% -> 100%."), line[0])
+
+    def test_agreement_rows(self):
+        # Table 4.1: ours 50% and 100%, thesis 43% and 67%: means 75% and 55%, |difference| 7 and 33 points.
+        self.assertLine("| Table 4.1 | 2 | 75% | 55% | 20 points |")
+        self.assertLine("| Table 4.5 | 2 | 25% | 24% | 18 points |")
+
+
+class Runs(unittest.TestCase):
+    def write(self, text):
+        d = tempfile.mkdtemp()
+        self.addCleanup(shutil.rmtree, d)
+        path = os.path.join(d, "runs.jsonl")
+        with open(path, "w") as f:
+            f.write(text)
+        return path
+
+    def test_sums_invocations_that_ran_trials(self):
+        runs = thesis_report.load_runs(self.write(
+            '{"wall_s": 10.5, "ran": 3, "load15_end": 1.25}\n\n{"wall_s": 2.0, "ran": 0, "load15_end": 9}\n'
+            '{"wall_s": 4.0, "ran": 2, "load15_end": null}\n'))
+        self.assertEqual((runs.seconds, runs.loads, runs.ran, runs.known), (14.5, [1.25], 5, True))
+
+    def test_no_file_is_unknown(self):
+        runs = thesis_report.load_runs("/nonexistent/runs.jsonl")
+        self.assertEqual((runs.seconds, runs.loads, runs.known), (0.0, [], False))
+
+    def test_a_line_without_wall_s_names_file_and_line(self):
+        path = self.write('{"wall_s": 1, "ran": 1}\n{"ran": 1}\n')
+        with self.assertRaises(thesis_report.InputError) as c:
+            thesis_report.load_runs(path)
+        self.assertIn("%s: line 2: not a run summary" % path, str(c.exception))
+
+    def test_folder_without_runs_jsonl_shows_no_time_and_says_why(self):
+        run = Run(lambda raw: os.remove(os.path.join(raw, "table_4_5", "runs.jsonl")))
+        self.assertEqual(run.code, 0, run.err)
+        self.assertIn("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 4 | no_hypothesis 1, ok 3 | - | - |",
+                      run.lines)
+        self.assertIn("No `runs.jsonl` (runs made before `posebench run` wrote one), so no wall time or load: "
+                      "table_4_5.", run.lines)
 
 
 class Carton(unittest.TestCase):
     def test_records_without_judgements_give_a_dash_and_a_note(self):
-        def drop(raw):
-            rewrite_records(raw, "table_4_5", lambda r: r.pop("judgements", None))
-        run = Run(drop)
+        run = Run(lambda raw: write_records(raw, "table_4_5", [
+            {k: v for k, v in r.items() if k != "judgements"} for r in records_of(raw, "table_4_5")]))
+        self.assertEqual(run.code, 0, run.err)
+        self.assertIn("| table_astra | half turn only | 50% | 0% |", run.lines)
+        self.assertIn("|  | faces on faces (thesis) | - | - |", run.lines)
+        self.assertIn("These records carry no `judgements.faces` (made before that judgement existed): re-run "
+                      "table_4_5 (remove `results/thesis/raw/table_4_5`, then `scripts/thesis.sh --only "
+                      "table_4_5`).", run.lines)
+
+    def test_one_judged_pose_missing_is_enough_for_the_dash(self):
+        run = Run(edit_record("table_4_5", 2, lambda r: r.pop("judgements")))
         self.assertEqual(run.code, 0, run.err)
         self.assertIn("|  | faces on faces (thesis) | - | - |", run.lines)
-        self.assertTrue(any("re-run table_4_5" in line for line in run.lines))
+
+    def test_a_record_without_a_pose_needs_no_judgement(self):
+        # The fixture's no_hypothesis record has no judgements: the row is still judged.
+        counts, judged = thesis_report.carton_counts(
+            [{"scene": "s", "descriptor": "d", "correct": False, "status": "no_hypothesis"},
+             {"scene": "s", "descriptor": "d", "correct": False, "status": "ok", "estimate": {}, "gt": {},
+              "judgements": {"faces": {"correct": True}}}])
+        self.assertEqual((counts, judged), ({("s", "d"): [2, 0, 1]}, True))
 
 
 class StrictRecords(unittest.TestCase):
+    def assertRefused(self, run, message):
+        self.assertEqual(run.code, 2, run.err)
+        self.assertIn(message, run.err)
+        self.assertEqual(run.lines, [], "no README is written")
+
     def test_misspelt_key_is_exit_2_naming_file_line_and_key(self):
-        def misspell(raw):
-            path = os.path.join(raw, "table_4_1", "records.jsonl")
-            with open(path) as f:
-                lines = f.read().splitlines()
-            r = json.loads(lines[1])
+        def misspell(r):
             r["statsu"] = r.pop("status")
-            lines[1] = json.dumps(r)
-            with open(path, "w") as f:
-                f.write("\n".join(lines) + "\n")
-        run = Run(misspell)
-        self.assertEqual(run.code, 2)
-        self.assertIn("table_4_1/records.jsonl: line 2: unknown key 'statsu'", run.err)
+        self.assertRefused(Run(edit_record("table_4_1", 1, misspell)),
+                           "table_4_1/records.jsonl: line 2: unknown key 'statsu' (did you mean 'status'?)")
 
     def test_missing_required_key_is_exit_2(self):
-        def drop(raw):
-            rewrite_records(raw, "table_4_5", lambda r: r.pop("seed"))
-        run = Run(drop)
-        self.assertEqual(run.code, 2)
-        self.assertIn("table_4_5/records.jsonl: line 1: missing required key 'seed'", run.err)
+        self.assertRefused(Run(edit_record("table_4_5", 0, lambda r: r.pop("wall_s"))),
+                           "table_4_5/records.jsonl: line 1: missing required key 'wall_s'")
+
+    def test_misspelt_nested_key_names_its_path(self):
+        def misspell(r):
+            r["times"]["preprocesss"] = r["times"].pop("preprocess")
+        self.assertRefused(Run(edit_record("table_4_1", 2, misspell)),
+                           "table_4_1/records.jsonl: line 3: unknown key 'times.preprocesss' (did you mean "
+                           "'preprocess'?)")
+
+    def test_judgement_without_correct_is_refused(self):
+        self.assertRefused(Run(edit_record("table_4_5", 1, lambda r: r["judgements"]["faces"].pop("correct"))),
+                           "table_4_5/records.jsonl: line 2: missing required key 'judgements.faces.correct'")
+
+    def test_wrong_type_is_refused(self):
+        self.assertRefused(Run(edit_record("fig_4_12", 3, lambda r: r.update(correct="yes"))),
+                           "fig_4_12/records.jsonl: line 4: wrong type for key 'correct' (str, expected boolean)")
+
+    def test_not_json_is_refused(self):
+        def garble(raw):
+            with open(os.path.join(raw, "table_4_1", "records.jsonl"), "a") as f:
+                f.write("{not json\n")
+        self.assertRefused(Run(garble), "table_4_1/records.jsonl: line 5: not JSON")
+
+    def test_conditional_requirements(self):
+        fields = {"status": {"type": "string", "required": True},
+                  "gt": {"type": "object", "required": False, "free": True},
+                  "estimate": {"type": "object", "required": "when_ok", "free": True},
+                  "errors": {"type": "object", "required": "when_gt", "free": True}}
+
+        def problem(record):
+            try:
+                thesis_report.check_fields(record, fields, record)
+            except thesis_report.KeyProblem as p:
+                return str(p)
+            return None
+
+        self.assertIsNone(problem({"status": "no_hypothesis"}))
+        self.assertIsNone(problem({"status": "error", "gt": {}}))
+        self.assertEqual(problem({"status": "ok"}), "missing required key 'estimate' (required with status ok)")
+        self.assertIsNone(problem({"status": "ok", "estimate": {}}))
+        self.assertEqual(problem({"status": "ok", "estimate": {}, "gt": {}}),
+                         "missing required key 'errors' (required with status ok and gt)")
+
+    def test_ok_record_without_times_is_refused(self):
+        self.assertRefused(Run(edit_record("table_4_1", 0, lambda r: r.pop("times"))),
+                           "table_4_1/records.jsonl: line 1: missing required key 'times' (required with status ok)")
+
+    def test_crashed_trial_with_the_always_required_keys_reads(self):
+        keep = ("key", "scene", "scenario", "dataset", "split", "scene_id", "im_id", "descriptor", "refinement",
+                "params", "added_noise_mm", "settings", "seed")
+
+        def crash(r):
+            for k in [k for k in r if k not in keep]:
+                del r[k]
+            r.update(status="timeout", correct=False, message="trial timed out after 300 s")
+        run = Run(edit_record("table_4_1", 1, crash))
+        self.assertEqual(run.code, 0, run.err)
+        self.assertIn("| Table 4.1 | `configs/thesis/table_4_1.yaml` | 2 | 4 | ok 3, timeout 1 | 0m42s | 1.5/2.0 |",
+                      run.lines)
+
+    def test_records_of_the_binary_read_back(self):
+        # Three records as `posebench run` wrote them before the typed record
+        # (fixtures/binary: the ci and demo experiments), so older raw folders still load.
+        records = thesis_report.load_records(os.path.join(FIXTURES, "binary", "records.jsonl"),
+                                             thesis_report.RECORD_SCHEMA)
+        self.assertEqual([r["descriptor"] for r in records], ["cvfh", "esf", "cvfh"])
+
+def fake_binary(directory, stdout, code=0):
+    """An executable that prints `stdout` for `schema record`."""
+    path = os.path.join(directory, "posebench")
+    with open(os.path.join(directory, "schema.json"), "w") as f:
+        f.write(stdout)
+    with open(path, "w") as f:
+        f.write('#!/bin/sh\n[ "$1 $2" = "schema record" ] || exit 9\ncat "%s/schema.json"\nexit %d\n' % (directory, code))
+    os.chmod(path, 0o755)
+    return path
 
 
 class Schema(unittest.TestCase):
     def test_the_copy_matches_the_binarys_schema(self):
-        binary = os.environ.get("POSEBENCH", os.path.join(ROOT, "build", "posebench"))
+        binary = os.environ.get("POSEBENCH") or os.path.join(ROOT, "build", "posebench")
         if not os.access(binary, os.X_OK):
             self.skipTest("no posebench binary at %s (build it, or set POSEBENCH)" % binary)
-        r = subprocess.run([binary, "schema", "record"], capture_output=True, text=True)
+        r = subprocess.run([binary, "schema", "record"], capture_output=True, text=True, timeout=60)
+        if r.returncode != 0:
+            self.fail("`%s schema record` failed (exit %d): %s -- a binary from before the typed record? rebuild "
+                      "it" % (binary, r.returncode, r.stderr.strip()))
+        printed = json.loads(r.stdout)["fields"]
+        copy = thesis_report.RECORD_SCHEMA["fields"]
+        differing = sorted(k for k in set(printed) | set(copy) if printed.get(k) != copy.get(k))
+        self.assertEqual(differing, [], "RECORD_SCHEMA in scripts/thesis_report.py differs from `posebench schema "
+                                        "record` in these keys; update the copy")
+
+    def test_the_binarys_schema_is_used_when_there_is_one(self):
+        with tempfile.TemporaryDirectory() as d:
+            fields = dict(thesis_report.RECORD_SCHEMA["fields"], extra={"type": "string", "required": False})
+            binary = fake_binary(d, json.dumps({"type": "object", "fields": fields, "notes": []}))
+            run = Run(edit_record("table_4_1", 0, lambda r: r.update(extra="x")), posebench=binary)
+        self.assertEqual(run.code, 0, run.err)
+
+    def test_the_copy_is_used_when_the_binary_knows_no_schema(self):
+        with tempfile.TemporaryDirectory() as d:
+            binary = fake_binary(d, "", code=1)  # a binary from before `posebench schema`
+            self.assertIsNone(thesis_report.schema_from_binary(binary))
+            run = Run(edit_record("table_4_1", 0, lambda r: r.update(extra="x")), posebench=binary)
+        self.assertEqual(run.code, 2)
+        self.assertIn("schema record` gave no schema (a binary from before it?); using the copy", run.err)
+        self.assertIn("unknown key 'extra'", run.err)
+
+
+class CommandLine(unittest.TestCase):
+    def test_writes_the_readme_and_prints_its_path(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "thesis")
+            shutil.copytree(os.path.join(FIXTURES, "raw"), os.path.join(out, "raw"))
+            r = subprocess.run([sys.executable, SCRIPT, out] + list(EXPERIMENTS), capture_output=True, text=True,
+                               env=dict(os.environ, POSEBENCH=""), timeout=120)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertEqual(r.stdout.strip(), os.path.join(out, "README.md"))
+            self.assertTrue(read_lines(os.path.join(out, "README.md"))[0].startswith("# The thesis, regenerated"))
+
+    def test_no_arguments_is_exit_2(self):
+        r = subprocess.run([sys.executable, SCRIPT], capture_output=True, text=True, timeout=60)
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("thesis_report.py OUT EXPERIMENT", r.stderr)
+
+    def test_thesis_sh_help(self):
+        r = subprocess.run(["bash", os.path.join(ROOT, "scripts", "thesis.sh"), "--help"], capture_output=True,
+                           text=True, timeout=60)
         self.assertEqual(r.returncode, 0, r.stderr)
-        self.assertEqual(thesis_report.binary_schema(binary), thesis_report.RECORD_SCHEMA)
+        self.assertIn("--readme-only", r.stdout)
 
 
 if __name__ == "__main__":
