@@ -12,7 +12,7 @@ RECORD_SCHEMA below when there is no binary): an unknown key or a missing
 required key is an error naming the file, the line and the key (exit code 2).
 The README's numbers all come from those files: tables from report.csv /
 report.md, wall times and loads from runs.jsonl (one line per `posebench run`
-that ran trials), the milk carton's "faces on faces" row from each record's
+that ran trials; folders of older runs: their run_seconds.txt), the milk carton's "faces on faces" row from each record's
 judgements.faces. Environment: JOBS (worker processes, for the text).
 """
 import csv
@@ -150,18 +150,30 @@ def load_records(path, schema):
 
 
 class Runs:
-    """What runs.jsonl says of the `posebench run` invocations that ran trials."""
+    """What a folder says of its `posebench run` invocations that ran trials:
+    wall seconds, 15-minute loads at their ends, trials ran; `source` is the
+    file read (runs.jsonl, or run_seconds.txt of older runs), None without."""
 
-    def __init__(self, seconds=0.0, loads=(), ran=0, known=False):
-        self.seconds, self.loads, self.ran, self.known = seconds, list(loads), ran, known
+    def __init__(self, seconds=0.0, loads=(), ran=0, source=None):
+        self.seconds, self.loads, self.ran, self.source = seconds, list(loads), ran, source
+
+    @property
+    def known(self):
+        return self.source is not None
+
+    def add(self, wall, ran, load):
+        self.seconds += wall
+        self.ran += ran
+        if load is not None:
+            self.loads.append(load)
 
 
 def load_runs(path):
     """Wall seconds (sum of wall_s), 15-minute loads at the end (load15_end)
-    and trials ran, over the lines of a runs.jsonl with "ran" > 0."""
+    and trials ran (sum of ran), over the lines of a runs.jsonl with "ran" > 0."""
     if not os.path.exists(path):
         return Runs()
-    runs = Runs(known=True)
+    runs = Runs(source="runs.jsonl")
     with open(path) as f:
         for n, line in enumerate(f, 1):
             if not line.strip():
@@ -169,15 +181,37 @@ def load_runs(path):
             try:
                 r = json.loads(line)
                 ran, wall = int(r["ran"]), float(r["wall_s"])
-            except (ValueError, TypeError, KeyError) as e:
+                load = None if r.get("load15_end") is None else float(r["load15_end"])
+            except (ValueError, TypeError, KeyError, AttributeError) as e:
                 raise InputError("%s: line %d: not a run summary (%s: %s)" % (path, n, type(e).__name__, e))
-            if ran <= 0:
-                continue
-            runs.seconds += wall
-            runs.ran += ran
-            if r.get("load15_end") is not None:
-                runs.loads.append(float(r["load15_end"]))
+            if ran > 0:
+                runs.add(wall, ran, load)
     return runs
+
+
+def load_run_seconds(path):
+    """The same from the run_seconds.txt that scripts/thesis.sh kept before
+    runs.jsonl existed: one line per invocation that ran trials,
+    `DATE TIME WALL_SECONDS RAN JOBS LOAD15`."""
+    if not os.path.exists(path):
+        return Runs()
+    runs = Runs(source="run_seconds.txt")
+    with open(path) as f:
+        for n, line in enumerate(f, 1):
+            fields = line.split()
+            if not fields:
+                continue
+            try:
+                runs.add(float(fields[2]), int(fields[3]), float(fields[5]) if len(fields) > 5 else None)
+            except (ValueError, IndexError) as e:
+                raise InputError("%s: line %d: not `DATE TIME WALL_SECONDS RAN JOBS LOAD15` (%s)" % (path, n, e))
+    return runs
+
+
+def load_folder_runs(d):
+    """runs.jsonl of a results folder, else its older run_seconds.txt."""
+    runs = load_runs(os.path.join(d, "runs.jsonl"))
+    return runs if runs.known else load_run_seconds(os.path.join(d, "run_seconds.txt"))
 
 
 # ---- the experiments' folders ---------------------------------------------------
@@ -220,7 +254,7 @@ def load_experiment(raw, name, schema):
     return Experiment(name, read_json(os.path.join(d, "experiment.json"), None),
                       load_records(os.path.join(d, "records.jsonl"), schema),
                       read_text(os.path.join(d, "report.md")), read_csv(os.path.join(d, "report.csv")),
-                      read_json(os.path.join(d, "plots.json"), []), load_runs(os.path.join(d, "runs.jsonl")))
+                      read_json(os.path.join(d, "plots.json"), []), load_folder_runs(d))
 
 
 class Results:
@@ -419,7 +453,7 @@ def section_experiments(res):
              "were measured under different competition for the CPU.\n")
     unknown = [e for e, x in res.x.items() if not x.runs.known]
     if unknown:
-        o.append("No `runs.jsonl` (runs made before `posebench run` wrote one), so no wall time or load: %s.\n" %
+        o.append("No `runs.jsonl` (nor the `run_seconds.txt` of older runs), so no wall time or load: %s.\n" %
                  ", ".join(unknown))
     o.append("The thesis used 30 synthetic images per scenario and 60 (+20 occluded) per real sensor. To fit the "
              "budget of this 2-core machine the tables use %s images per scenario and the noise figures fewer per "

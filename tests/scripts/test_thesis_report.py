@@ -166,8 +166,40 @@ class Runs(unittest.TestCase):
         self.assertEqual(run.code, 0, run.err)
         self.assertIn("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 4 | no_hypothesis 1, ok 3 | - | - |",
                       run.lines)
-        self.assertIn("No `runs.jsonl` (runs made before `posebench run` wrote one), so no wall time or load: "
+        self.assertIn("No `runs.jsonl` (nor the `run_seconds.txt` of older runs), so no wall time or load: "
                       "table_4_5.", run.lines)
+
+    def test_older_folder_falls_back_to_run_seconds_txt(self):
+        # The format scripts/thesis.sh wrote before runs.jsonl: DATE TIME WALL_SECONDS RAN JOBS LOAD15.
+        def older(raw):
+            os.remove(os.path.join(raw, "table_4_5", "runs.jsonl"))
+            with open(os.path.join(raw, "table_4_5", "run_seconds.txt"), "w") as f:
+                f.write("2026-11-22 10:00:00 61.4 3 2 3.7\n2026-11-22 11:00:00 58.9 1 2 1.2\n")
+        run = Run(older)
+        self.assertEqual(run.code, 0, run.err)
+        self.assertIn("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 4 | no_hypothesis 1, ok 3 | 2m00s | 3.7/1.2 |",
+                      run.lines)
+        self.assertFalse(any(line.startswith("No `runs.jsonl`") for line in run.lines))
+
+    def test_runs_jsonl_wins_over_run_seconds_txt(self):
+        def both(raw):
+            with open(os.path.join(raw, "table_4_5", "run_seconds.txt"), "w") as f:
+                f.write("2026-11-22 10:00:00 999.0 3 2 9.9\n")
+        run = Run(both)
+        self.assertIn("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 4 | no_hypothesis 1, ok 3 | 0m20s | 0.5 |",
+                      run.lines)
+
+    def test_run_seconds_txt_sums_seconds_trials_and_loads(self):
+        path = self.write("2026-11-22 10:00:00 3420.8 5 2 3.7\n\n2026-11-22 12:00:00 10.2 2 2 0.5\n")
+        runs = thesis_report.load_run_seconds(path)
+        self.assertEqual((round(runs.seconds, 6), runs.loads, runs.ran, runs.source),
+                         (3431.0, [3.7, 0.5], 7, "run_seconds.txt"))
+
+    def test_a_garbled_run_seconds_line_names_file_and_line(self):
+        path = self.write("2026-11-22 10:00:00 3420.8 5 2 3.7\nhalf a line\n")
+        with self.assertRaises(thesis_report.InputError) as c:
+            thesis_report.load_run_seconds(path)
+        self.assertIn("%s: line 2: not `DATE TIME WALL_SECONDS RAN JOBS LOAD15`" % path, str(c.exception))
 
 
 class Carton(unittest.TestCase):
