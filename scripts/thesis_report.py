@@ -12,8 +12,10 @@ RECORD_SCHEMA below when there is no binary): an unknown key or a missing
 required key is an error naming the file, the line and the key (exit code 2).
 The README's numbers all come from those files: tables from report.csv /
 report.md, wall times and loads from runs.jsonl (one line per `posebench run`
-that ran trials; folders of older runs: their run_seconds.txt), the milk carton's "faces on faces" row from each record's
-judgements.faces. Environment: JOBS (worker processes, for the text).
+that ran trials; folders of older runs: their run_seconds.txt), the milk
+carton's "faces on faces" row from each record's judgements.faces. Without
+any experiment's records the README is left as it is. Environment: JOBS
+(worker processes, for the text).
 """
 import csv
 import datetime
@@ -951,6 +953,10 @@ def main(argv=None):
         print("thesis_report.py: %s" % err, file=sys.stderr)
         return 2
     path = os.path.join(out_dir, "README.md")
+    if not res.x:  # e.g. a fresh clone: keep the committed README rather than empty it
+        print("thesis_report.py: no experiment's records.jsonl in %s; %s left as it is" % (res.raw, path),
+              file=sys.stderr)
+        return 0
     with open(path, "w") as f:
         f.write(readme(res, host_info()))
     print(path)
