@@ -165,11 +165,11 @@ SceneSource parse_scene(const YamlNode& s, const std::string& path, std::set<std
   return src;
 }
 
-// Extra judgements: named symmetry sets each record is also judged with
-// (the thesis's "faces on faces" for the milk carton).
-void parse_judgements(const YamlNode& root, ExperimentConfig& c) {
-  if (!root.has("judgements")) return;
-  const YamlNode js = root["judgements"];
+}  // namespace
+
+std::vector<Judgement> parse_judgements(const YamlNode& js) {
+  std::vector<Judgement> out;
+  if (!js.defined()) return out;
   if (!js.is_map()) js.fail("expected a mapping of name -> {description, symmetries_discrete, symmetries_continuous}");
   for (const auto& name : js.keys()) {
     const YamlNode j = js[name];
@@ -178,8 +178,9 @@ void parse_judgements(const YamlNode& root, ExperimentConfig& c) {
     jd.name = name;
     jd.description = j.get_or<std::string>("description", "");
     read_symmetries(j, jd.symmetries_discrete, jd.symmetries_continuous);
-    c.judgements.push_back(jd);
+    out.push_back(jd);
   }
+  return out;
 }
 
 nlohmann::json judgements_json(const std::vector<Judgement>& js) {
@@ -199,6 +200,8 @@ nlohmann::json judgements_json(const std::vector<Judgement>& js) {
   }
   return out;
 }
+
+namespace {
 
 // The parsed config as JSON: what experiment.json keeps and the hash covers.
 nlohmann::json canonical(const ExperimentConfig& c) {
@@ -249,7 +252,7 @@ ExperimentConfig load_experiment(const std::string& path) {
   if (!scenes.is_sequence() || scenes.size() == 0) scenes.fail("expected a non-empty list of scenes");
   std::set<std::string> names;
   for (size_t i = 0; i < scenes.size(); ++i) c.scenes.push_back(parse_scene(scenes.at(i), path, names));
-  parse_judgements(root, c);
+  c.judgements = parse_judgements(root["judgements"]);
   c.canonical = canonical(c);
   c.hash = hash_hex(c.canonical.dump());
   return c;

@@ -79,6 +79,12 @@ struct ExperimentConfig {
 // Parses and validates; InputError naming file, line and key on any problem.
 ExperimentConfig load_experiment(const std::string& path);
 
+// The `judgements:` section (name -> {description, symmetries_discrete,
+// symmetries_continuous}, BOP-style as in models.yaml).
+std::vector<Judgement> parse_judgements(const YamlNode& section);
+// As JSON for experiment.json: [{name, symmetries_discrete, symmetries_continuous}].
+nlohmann::json judgements_json(const std::vector<Judgement>& judgements);
+
 struct Trial {
   std::string key;        // unique, stable: scene/image/descriptor/refinement/params/noise
   std::string scene_name; // SceneSource::name

@@ -1,7 +1,6 @@
 #include "runner/trial.h"
 
 #include <cmath>
-#include <filesystem>
 #include <map>
 #include <memory>
 
@@ -180,6 +179,13 @@ void run(TrialRecord& rec, const TrialContext& ctx) {
 }  // namespace
 
 nlohmann::json context_json(const ExperimentConfig& cfg, const std::string& cache_dir) {
+  // The judgements as a `judgements:` section, for the workers' parser.
+  nlohmann::json section = nlohmann::json::object();
+  for (nlohmann::json e : judgements_json(cfg.judgements)) {
+    const std::string name = e.at("name");
+    e.erase("name");
+    section[name] = e;
+  }
   nlohmann::json j = {{"object", cfg.object},
                       {"cache_dir", cache_dir},
                       {"table_translation_mm", cfg.thresholds.table_translation_mm},
@@ -188,7 +194,7 @@ nlohmann::json context_json(const ExperimentConfig& cfg, const std::string& cach
                       {"registration_only", cfg.registration_only},
                       {"perturb_deg", cfg.perturb_deg},
                       {"perturb_mm", cfg.perturb_mm},
-                      {"experiment", std::filesystem::absolute(cfg.file).string()}};
+                      {"judgements", section}};
   return j;
 }
 
@@ -202,8 +208,8 @@ TrialContext context_from_json(const nlohmann::json& c) {
   ctx.registration_only = c.at("registration_only");
   ctx.perturb_deg = c.at("perturb_deg");
   ctx.perturb_mm = c.at("perturb_mm");
-  // The judgements come from the experiment file itself (one parser).
-  ctx.judgements = load_experiment(c.at("experiment").get<std::string>()).judgements;
+  // The judgements in their YAML shape (JSON is YAML), read by the same parser.
+  ctx.judgements = parse_judgements(YamlNode::load_string(c.at("judgements").dump(), "runner context"));
   return ctx;
 }
 

@@ -62,15 +62,15 @@ Cells group(const std::vector<Vec3f>& pts, const VoxelGridOptions& opt) {
   std::vector<int> rank(order.size());
   for (size_t r = 0; r < order.size(); ++r) rank[static_cast<size_t>(order[r])] = static_cast<int>(r);
   Cells out;
-  out.cell_of.assign(n, -1);
   out.first.resize(order.size());
   out.count.resize(order.size());
   for (size_t r = 0; r < order.size(); ++r) {
     out.first[r] = c.first[static_cast<size_t>(order[r])];
     out.count[r] = c.count[static_cast<size_t>(order[r])];
   }
-  for (size_t i = 0; i < n; ++i)
-    if (c.cell_of[i] >= 0) out.cell_of[i] = rank[static_cast<size_t>(c.cell_of[i])];
+  out.cell_of = std::move(c.cell_of);
+  for (int& k : out.cell_of)
+    if (k >= 0) k = rank[static_cast<size_t>(k)];
   return out;
 }
 
