@@ -148,7 +148,7 @@ TEST(Settings, JsonRoundTripsThroughTheParsers) {
 TEST(Settings, NamesAreTheIssuesList) {
   EXPECT_EQ(pb::descriptor_names(),
             (std::vector<std::string>{"fpfh", "shot", "cvfh", "esf", "cesf", "ourcvfh", "ppf"}));
-  EXPECT_EQ(pb::refinement_names(), (std::vector<std::string>{"none", "icp", "icp_lm", "icp_plane", "gicp", "ndt"}));
+  EXPECT_EQ(pb::refinement_names(), (std::vector<std::string>{"none", "icp", "icp_lm", "icp_plane", "icp_pcl", "icp_plane_pcl", "gicp", "ndt"}));
 }
 
 }  // namespace

@@ -30,6 +30,8 @@ const std::vector<RefinementEntry>& refinement_registry() {
       {"icp", no, run_icp},
       {"icp_lm", no, run_icp_lm},
       {"icp_plane", [](const RefineSettings&) { return true; }, run_icp_plane},
+      {"icp_pcl", no, run_icp_pcl},
+      {"icp_plane_pcl", [](const RefineSettings&) { return true; }, run_icp_plane_pcl},
       {"gicp", [](const RefineSettings& s) { return s.gicp_covariances_from_normals; }, run_gicp},
       {"ndt", no, run_ndt},
   };

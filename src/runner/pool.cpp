@@ -6,7 +6,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <stdexcept>
+#include <string>
 
 #include "core/timer.h"
 
@@ -23,7 +26,8 @@ struct Worker {
   Timer started;
 };
 
-Worker spawn_worker(const std::string& binary, const std::string& ctx_line, const std::string& log_path) {
+Worker spawn_worker(const std::string& binary, const std::string& ctx_line, const std::string& log_path,
+                    int omp_threads) {
   int to_child[2], from_child[2];
   if (pipe(to_child) != 0 || pipe(from_child) != 0) throw std::runtime_error("pipe failed");
   const pid_t pid = fork();
@@ -35,6 +39,7 @@ Worker spawn_worker(const std::string& binary, const std::string& ctx_line, cons
     if (fd >= 0) dup2(fd, 2);
     close(to_child[1]);
     close(from_child[0]);
+    setenv("OMP_NUM_THREADS", std::to_string(omp_threads).c_str(), 1);
     execl(binary.c_str(), binary.c_str(), "worker", static_cast<char*>(nullptr));
     _exit(127);
   }
@@ -84,7 +89,7 @@ class Pool {
   }
 
  private:
-  Worker spawn() { return spawn_worker(opt_.binary, opt_.context, opt_.log_path); }
+  Worker spawn() { return spawn_worker(opt_.binary, opt_.context, opt_.log_path, opt_.omp_threads); }
 
   // The input record with a failure outcome (the worker's own record is
   // lost: no times, no wall_s).
@@ -197,6 +202,16 @@ class Pool {
 void run_in_workers(const PoolOptions& opt, const std::vector<TrialRecord>& inputs, std::deque<long> pending,
                     const std::function<void(long, const TrialRecord&)>& on_record) {
   Pool(opt, inputs, std::move(pending), on_record).run();
+}
+
+int omp_threads_per_worker(int jobs, int host_cores) {
+  const char* env = std::getenv("OMP_NUM_THREADS");
+  if (env && *env) {
+    char* end = nullptr;
+    const long v = std::strtol(env, &end, 10);
+    if (end && *end == '\0' && v > 0) return static_cast<int>(v);
+  }
+  return std::max(1, host_cores / std::max(1, jobs));
 }
 
 }  // namespace pb

@@ -12,11 +12,18 @@
 
 namespace pb {
 
+// OpenMP threads per worker: OMP_NUM_THREADS when the user set it (a
+// positive integer), else the cores shared out among the workers,
+// max(1, cores / jobs), so that jobs x threads never exceeds the cores and
+// recorded times are not inflated by oversubscription.
+int omp_threads_per_worker(int jobs, int host_cores);
+
 struct PoolOptions {
   std::string binary;    // the posebench executable
   std::string context;   // the first line every worker reads (trial.h context_json)
   std::string log_path;  // workers' stderr
   int jobs = 1;
+  int omp_threads = 1;   // OMP_NUM_THREADS each worker gets (jobs x omp_threads <= cores: no oversubscription)
   double timeout_s = 300;
 };
 

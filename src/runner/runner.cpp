@@ -184,8 +184,7 @@ RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
   sum.total = trials.size();
   sum.jobs = opt.jobs;
   sum.host_cores = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN));
-  const char* omp = std::getenv("OMP_NUM_THREADS");
-  sum.omp_threads = omp && *omp ? std::atoi(omp) : sum.host_cores;
+  sum.omp_threads = omp_threads_per_worker(opt.jobs, sum.host_cores);
 
   std::vector<TrialRecord> inputs;
   std::deque<long> pending;
@@ -203,6 +202,7 @@ RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
     po.context = context_json(cfg, opt.cache_dir).dump();
     po.log_path = (fs::path(out) / "workers.log").string();
     po.jobs = opt.jobs;
+    po.omp_threads = sum.omp_threads;
     po.timeout_s = cfg.timeout_s;
     Progress progress(opt.quiet, pending.size());
     run_in_workers(po, inputs, pending, [&](long, const TrialRecord& rec) {

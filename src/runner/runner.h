@@ -30,7 +30,7 @@ struct RunSummary {
   size_t ok = 0, no_hypothesis = 0, errors = 0, timeouts = 0;  // of those run now
   double seconds = 0;      // wall time of the invocation, scene generation included
   int jobs = 1;            // worker processes
-  int omp_threads = 0;     // OMP_NUM_THREADS of the workers (unset: the core count)
+  int omp_threads = 0;     // OMP_NUM_THREADS of each worker (omp_threads_per_worker: the user's, else cores / jobs)
   double load15_end = 0;   // the machine's 15-minute load average at the end (NaN if unknown)
   int host_cores = 0;
 };

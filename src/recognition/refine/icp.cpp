@@ -1,21 +1,41 @@
-// ICP point-to-point (pcl::IterativeClosestPoint, SVD per iteration), on an
-// optional random subset of the source points (thesis: "random subset of
-// source points"), drawn from pb::Rng. Frame and units: internal.h.
-#include <pcl/registration/icp.h>
-
+// The project's own ICP, point-to-point (icp) and point-to-plane
+// (icp_plane): the same algorithm and stopping rules as PCL's
+// IterativeClosestPoint / IterativeClosestPointWithNormals (icp_pcl.cpp, kept
+// for comparison), with the search structures built once per call instead of
+// once per call and iteration:
+//   correspondences  every source point's nearest target point within
+//                    max_correspondence_mm; reciprocal (optional): the target
+//                    point's nearest source point must be that point. The
+//                    target tree is built once; the reciprocal search maps
+//                    the target point back by the inverse of the current
+//                    transform into a source tree built once (distances are
+//                    invariant under the rigid transform), where PCL rebuilds
+//                    a tree over the moved source on every iteration.
+//   step             point-to-point: the least-squares rotation and
+//                    translation (SVD of the cross-covariance, Arun / Umeyama
+//                    without scale); point-to-plane: linear least squares on
+//                    the distances to the targets' tangent planes, small-angle
+//                    rotation R = Rz Ry Rx (as PCL's
+//                    TransformationEstimationPointToPlaneLLS).
+//   stop             PCL's DefaultConvergenceCriteria: the iteration cap;
+//                    the step's rotation cosine >= cos(rotation_epsilon) and
+//                    squared translation <= transformation_epsilon; the mean
+//                    squared correspondence distance changing by less than
+//                    fitness_epsilon (relative) or 1e-12 (absolute); fewer
+//                    than 3 correspondences ends it unconverged.
+// Frame and units: internal.h (metres, local frame).
+#include <Eigen/Dense>
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "core/random.h"
-#include "recognition/pcl_adapter.h"
-#include "recognition/refine/pcl_registration.h"
+#include "recognition/kdtree.h"
+#include "recognition/refine/internal.h"
 
 namespace pb::refine_detail {
 
-namespace {
-
-// The first k of a seeded Fisher-Yates shuffle of the indices, in index order
-// (all indices when k is 0 or not below n).
 std::vector<size_t> sample_indices(size_t n, int k, uint64_t seed) {
   std::vector<size_t> idx(n);
   std::iota(idx.begin(), idx.end(), size_t(0));
@@ -31,13 +51,136 @@ std::vector<size_t> sample_indices(size_t n, int k, uint64_t seed) {
   return idx;
 }
 
+namespace {
+
+struct Pair {
+  int src, tgt;
+  float sq_dist;
+};
+
+using Mat4 = Eigen::Matrix4d;
+
+// Correspondences of the source points moved by T (see the file comment).
+void correspond(const std::vector<Vec3f>& src, const KdTree3& src_tree, const std::vector<Vec3f>& tgt,
+                const KdTree3& tgt_tree, const Mat4& T, const RefineSettings& s, std::vector<Pair>& out) {
+  out.clear();
+  const double max_m = s.max_correspondence_mm * 1e-3;
+  const float max2 = std::nextafter(static_cast<float>(max_m * max_m), std::numeric_limits<float>::infinity());
+  const Eigen::Matrix3f R = T.block<3, 3>(0, 0).cast<float>();
+  const Eigen::Vector3f t = T.block<3, 1>(0, 3).cast<float>();
+  const Eigen::Matrix3f Ri = R.transpose();
+  for (size_t i = 0; i < src.size(); ++i) {
+    const Vec3f q = R * src[i] + t;
+    float d2 = 0;
+    const int j = tgt_tree.nearest(q, &d2, max2);
+    if (j < 0) continue;
+    if (s.reciprocal_correspondences) {
+      const Vec3f back = Ri * (tgt[static_cast<size_t>(j)] - t);
+      if (src_tree.nearest(back, nullptr, max2) != static_cast<int>(i)) continue;
+    }
+    out.push_back({static_cast<int>(i), j, d2});
+  }
+}
+
+// Point-to-point step: the rigid transform taking the moved source points
+// onto their targets in the least-squares sense.
+Mat4 step_point(const std::vector<Vec3f>& src, const std::vector<Vec3f>& tgt, const Mat4& T,
+                const std::vector<Pair>& c) {
+  Vec3 ms = Vec3::Zero(), mt = Vec3::Zero();
+  std::vector<Vec3> a(c.size()), b(c.size());
+  for (size_t k = 0; k < c.size(); ++k) {
+    a[k] = T.block<3, 3>(0, 0) * src[static_cast<size_t>(c[k].src)].cast<double>() + T.block<3, 1>(0, 3);
+    b[k] = tgt[static_cast<size_t>(c[k].tgt)].cast<double>();
+    ms += a[k];
+    mt += b[k];
+  }
+  ms /= static_cast<double>(c.size());
+  mt /= static_cast<double>(c.size());
+  Mat3 H = Mat3::Zero();
+  for (size_t k = 0; k < c.size(); ++k) H += (a[k] - ms) * (b[k] - mt).transpose();
+  Eigen::JacobiSVD<Mat3> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Mat3 V = svd.matrixV();
+  Mat3 R = V * svd.matrixU().transpose();
+  if (R.determinant() < 0) {
+    V.col(2) *= -1;
+    R = V * svd.matrixU().transpose();
+  }
+  Mat4 D = Mat4::Identity();
+  D.block<3, 3>(0, 0) = R;
+  D.block<3, 1>(0, 3) = mt - R * ms;
+  return D;
+}
+
+// Point-to-plane step: minimizes sum ((R a + t - b) . n_b)^2 linearized in
+// the rotation angles (alpha, beta, gamma about x, y, z).
+Mat4 step_plane(const std::vector<Vec3f>& src, const std::vector<Vec3f>& tgt, const std::vector<Vec3f>& tgt_n,
+                const Mat4& T, const std::vector<Pair>& c) {
+  Eigen::Matrix<double, 6, 6> AtA = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> Atb = Eigen::Matrix<double, 6, 1>::Zero();
+  for (const Pair& p : c) {
+    const Vec3 a = T.block<3, 3>(0, 0) * src[static_cast<size_t>(p.src)].cast<double>() + T.block<3, 1>(0, 3);
+    const Vec3 b = tgt[static_cast<size_t>(p.tgt)].cast<double>();
+    const Vec3 n = tgt_n[static_cast<size_t>(p.tgt)].cast<double>();
+    Eigen::Matrix<double, 6, 1> row;
+    row << a.cross(n), n;
+    AtA += row * row.transpose();
+    Atb += row * n.dot(b - a);
+  }
+  const Eigen::Matrix<double, 6, 1> x = AtA.ldlt().solve(Atb);
+  Mat4 D = Mat4::Identity();
+  D.block<3, 3>(0, 0) = (Eigen::AngleAxisd(x[2], Vec3::UnitZ()) * Eigen::AngleAxisd(x[1], Vec3::UnitY()) *
+                         Eigen::AngleAxisd(x[0], Vec3::UnitX()))
+                            .toRotationMatrix();
+  D.block<3, 1>(0, 3) = x.tail<3>();
+  return D;
+}
+
+enum class Metric { kPoint, kPlane };
+
+Outcome icp(const Problem& p, const RefineSettings& s, uint64_t seed, Metric metric) {
+  Outcome o;
+  std::vector<Vec3f> src;
+  for (size_t i : sample_indices(p.src.size(), metric == Metric::kPoint ? s.icp_sample_points : 0, seed))
+    src.push_back(p.src[i]);
+  if (src.size() < 3 || p.tgt.size() < 3) return o;
+  const KdTree3 tgt_tree(p.tgt);
+  const KdTree3 src_tree = s.reciprocal_correspondences ? KdTree3(src) : KdTree3();
+  const double rot_cos = std::cos(s.rotation_epsilon_deg * M_PI / 180.0);
+  Mat4 T = Mat4::Identity();
+  double prev_mse = std::numeric_limits<double>::max();
+  std::vector<Pair> c;
+  while (true) {
+    correspond(src, src_tree, p.tgt, tgt_tree, T, s, c);
+    if (c.size() < 3) break;  // unconverged, the transform so far stands
+    const Mat4 D = metric == Metric::kPoint ? step_point(src, p.tgt, T, c) : step_plane(src, p.tgt, p.tgt_normals, T, c);
+    if (!D.allFinite()) break;
+    T = D * T;
+    ++o.iterations;
+    if (o.iterations >= s.max_iterations) break;  // the cap: not converged
+    const double cos_angle = 0.5 * (D.block<3, 3>(0, 0).trace() - 1.0);
+    if (cos_angle >= rot_cos && D.block<3, 1>(0, 3).squaredNorm() <= s.transformation_epsilon) {
+      o.converged = true;
+      break;
+    }
+    double mse = 0;
+    for (const Pair& q : c) mse += q.sq_dist;
+    mse /= static_cast<double>(c.size());
+    if (std::abs(mse - prev_mse) < 1e-12 || std::abs(mse - prev_mse) / prev_mse < s.fitness_epsilon) {
+      o.converged = true;
+      break;
+    }
+    prev_mse = mse;
+  }
+  o.delta = T.cast<float>();
+  return o;
+}
+
 }  // namespace
 
-Outcome run_icp(const Problem& p, const RefineSettings& s, uint64_t seed) {
-  Counted<pcl::IterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ>> icp;
-  const auto src = pcl_adapter::xyz(p.src, sample_indices(p.src.size(), s.icp_sample_points, seed));
-  return align<StopReport::kCriteria>(icp, src, pcl_adapter::xyz(p.tgt), s,
-               [&](auto& r) { configure_icp_family(r, s); }, no_after_inputs());
+Outcome run_icp(const Problem& p, const RefineSettings& s, uint64_t seed) { return icp(p, s, seed, Metric::kPoint); }
+
+Outcome run_icp_plane(const Problem& p, const RefineSettings& s, uint64_t seed) {
+  return icp(p, s, seed, Metric::kPlane);
 }
 
 }  // namespace pb::refine_detail

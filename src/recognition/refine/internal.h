@@ -38,11 +38,17 @@ struct Outcome {
 
 // The methods the registry lists (registry.cpp); each is its PCL object and
 // a configure function around the one driver in pcl_registration.h.
-Outcome run_icp(const Problem& p, const RefineSettings& s, uint64_t seed);
+Outcome run_icp(const Problem& p, const RefineSettings& s, uint64_t seed);        // own (icp.cpp)
+Outcome run_icp_plane(const Problem& p, const RefineSettings& s, uint64_t seed);  // own (icp.cpp)
+Outcome run_icp_pcl(const Problem& p, const RefineSettings& s, uint64_t seed);    // stock PCL (icp_pcl.cpp)
+Outcome run_icp_plane_pcl(const Problem& p, const RefineSettings& s, uint64_t seed);
 Outcome run_icp_lm(const Problem& p, const RefineSettings& s, uint64_t seed);
-Outcome run_icp_plane(const Problem& p, const RefineSettings& s, uint64_t seed);
 Outcome run_gicp(const Problem& p, const RefineSettings& s, uint64_t seed);
 Outcome run_ndt(const Problem& p, const RefineSettings& s, uint64_t seed);
+
+// The first k of a seeded Fisher-Yates shuffle of 0..n-1, in index order (all
+// of them when k is 0 or not below n): ICP's random subset of source points.
+std::vector<size_t> sample_indices(size_t n, int k, uint64_t seed);
 
 // Unit normals by PCA over the k nearest neighbours (sign arbitrary: the
 // point-to-plane and plane-to-plane metrics do not depend on it).

@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "core/error.h"
+#include "recognition/kdtree.h"
 #include "recognition/pcl_adapter.h"
 #include "recognition/refine/internal.h"
 #include "recognition/refine/refine.h"
@@ -130,20 +131,15 @@ RefineResult refine_pose(const std::string& method, const PointSet& model, const
   // Fitness: mean squared distance (mm^2) of the model points to their
   // nearest cropped scene point, over pairs within max_correspondence_mm.
   {
-    auto tgt = pcl_adapter::xyz(p.tgt);
-    pcl::KdTreeFLANN<pcl::PointXYZ> tree;
-    tree.setInputCloud(tgt);
-    pcl::Indices idx(1);
-    std::vector<float> d2(1);
+    const KdTree3 tree(p.tgt);
     double sum = 0;
     size_t n = 0;
     const double lim = max_corr * max_corr;
     for (const auto& x : model.points) {
-      const Eigen::Vector3d q = (res.T_cam_model * x.cast<double>() - c) * 1e-3;
-      pcl::PointXYZ pt;
-      pt.getVector3fMap() = q.cast<float>();
-      if (tree.nearestKSearch(pt, 1, idx, d2) < 1) continue;
-      const double dmm2 = static_cast<double>(d2[0]) * 1e6;
+      const Vec3f q = ((res.T_cam_model * x.cast<double>() - c) * 1e-3).cast<float>();
+      float d2 = 0;
+      if (tree.nearest(q, &d2) < 0) continue;
+      const double dmm2 = static_cast<double>(d2) * 1e6;
       if (dmm2 <= lim) {
         sum += dmm2;
         ++n;

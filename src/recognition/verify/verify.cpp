@@ -1,56 +1,34 @@
 // Verification (thesis 3.1): inliers are model points whose nearest scene
-// point lies within a threshold. PointIndex wraps pcl::KdTreeFLANN.
-#include "recognition/pcl_adapter.h"
+// point lies within a threshold. PointIndex is the project's kd-tree (kdtree.h).
 #include "recognition/verify/verify.h"
-
-#include <pcl/kdtree/kdtree_flann.h>
-#include <pcl/point_cloud.h>
-#include <pcl/point_types.h>
 
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
+#include "recognition/kdtree.h"
+
 namespace pb {
 
 struct PointIndex::Impl {
-  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud{new pcl::PointCloud<pcl::PointXYZ>};
-  pcl::KdTreeFLANN<pcl::PointXYZ> tree{true};  // sorted radius results
+  KdTree3 tree;
 };
 
 PointIndex::PointIndex(const std::vector<Vec3f>& points) : impl_(new Impl) {
   for (const auto& p : points)
     if (!p.allFinite()) throw std::invalid_argument("PointIndex: non-finite point");  // callers pass finite clouds
-  impl_->cloud = pcl_adapter::xyz(points);
-  if (!impl_->cloud->empty()) impl_->tree.setInputCloud(impl_->cloud);
+  impl_->tree = KdTree3(points);
 }
 
 PointIndex::~PointIndex() = default;
 
-size_t PointIndex::size() const { return impl_->cloud->size(); }
+size_t PointIndex::size() const { return impl_->tree.size(); }
 
-int PointIndex::nearest(const Vec3f& q, float* sq_dist) const {
-  if (impl_->cloud->empty() || !q.allFinite()) {
-    if (sq_dist) *sq_dist = std::numeric_limits<float>::infinity();
-    return -1;
-  }
-  pcl::Indices idx(1);
-  std::vector<float> d(1);
-  if (impl_->tree.nearestKSearch(pcl::PointXYZ(q.x(), q.y(), q.z()), 1, idx, d) < 1) {
-    if (sq_dist) *sq_dist = std::numeric_limits<float>::infinity();
-    return -1;
-  }
-  if (sq_dist) *sq_dist = d[0];
-  return idx[0];
-}
+int PointIndex::nearest(const Vec3f& q, float* sq_dist) const { return impl_->tree.nearest(q, sq_dist); }
 
 std::vector<int> PointIndex::radius(const Vec3f& q, float r) const {
   std::vector<int> out;
-  if (impl_->cloud->empty() || !q.allFinite() || !(r > 0)) return out;
-  pcl::Indices idx;
-  std::vector<float> d;
-  impl_->tree.radiusSearch(pcl::PointXYZ(q.x(), q.y(), q.z()), r, idx, d);
-  out.assign(idx.begin(), idx.end());
+  impl_->tree.radius(q, r, out);
   return out;
 }
 

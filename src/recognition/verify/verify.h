@@ -33,7 +33,7 @@ struct VerifySettings {
   }
 };
 
-// A kd-tree over 3D points (PCL inside), for nearest neighbour queries.
+// A kd-tree over 3D points (kdtree.h), for nearest neighbour queries.
 class PointIndex {
  public:
   explicit PointIndex(const std::vector<Vec3f>& points);

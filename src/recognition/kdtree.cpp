@@ -1,0 +1,105 @@
+#include "recognition/kdtree.h"
+
+#include <algorithm>
+#include <numeric>
+
+namespace pb {
+
+KdTree3::KdTree3(const std::vector<Vec3f>& points, int leaf_size) {
+  order_.resize(points.size());
+  std::iota(order_.begin(), order_.end(), 0);
+  points_ = points;
+  if (points.empty()) return;
+  nodes_.reserve(2 * points.size() / static_cast<size_t>(std::max(1, leaf_size)) + 2);
+  build(0, static_cast<int>(points.size()), std::max(1, leaf_size));
+  std::vector<Vec3f> sorted(points.size());
+  for (size_t i = 0; i < order_.size(); ++i) sorted[i] = points[static_cast<size_t>(order_[i])];
+  points_.swap(sorted);
+}
+
+// Splits at the median of the widest extent (points_ still in input order,
+// addressed through order_).
+int KdTree3::build(int begin, int end, int leaf_size) {
+  const int id = static_cast<int>(nodes_.size());
+  nodes_.emplace_back();
+  nodes_[static_cast<size_t>(id)].begin = begin;
+  nodes_[static_cast<size_t>(id)].end = end;
+  if (end - begin <= leaf_size) return id;
+  Vec3f lo = points_[static_cast<size_t>(order_[static_cast<size_t>(begin)])], hi = lo;
+  for (int i = begin + 1; i < end; ++i) {
+    const Vec3f& p = points_[static_cast<size_t>(order_[static_cast<size_t>(i)])];
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  int dim = 0;
+  (hi - lo).maxCoeff(&dim);
+  if (!(hi[dim] > lo[dim])) return id;  // all points equal: one leaf
+  const int mid = begin + (end - begin) / 2;
+  std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end, [&](int a, int b) {
+    const float x = points_[static_cast<size_t>(a)][dim], y = points_[static_cast<size_t>(b)][dim];
+    return x < y || (x == y && a < b);
+  });
+  const float split = points_[static_cast<size_t>(order_[static_cast<size_t>(mid)])][dim];
+  const int left = build(begin, mid, leaf_size);
+  const int right = build(mid, end, leaf_size);
+  Node& n = nodes_[static_cast<size_t>(id)];
+  n.dim = dim;
+  n.split = split;
+  n.left = left;
+  n.right = right;
+  return id;
+}
+
+void KdTree3::nearest_in(int node, const Vec3f& q, int& best, float& best_d) const {
+  const Node& n = nodes_[static_cast<size_t>(node)];
+  if (n.dim < 0) {
+    for (int i = n.begin; i < n.end; ++i) {
+      const float d = (points_[static_cast<size_t>(i)] - q).squaredNorm();
+      const int idx = order_[static_cast<size_t>(i)];
+      if (d < best_d || (d == best_d && best >= 0 && idx < best)) {
+        best_d = d;
+        best = idx;
+      }
+    }
+    return;
+  }
+  const float diff = q[n.dim] - n.split;
+  const int near = diff < 0 ? n.left : n.right, far = diff < 0 ? n.right : n.left;
+  nearest_in(near, q, best, best_d);
+  if (diff * diff <= best_d) nearest_in(far, q, best, best_d);
+}
+
+int KdTree3::nearest(const Vec3f& q, float* sq_dist, float max_sq_dist) const {
+  int best = -1;
+  float best_d = max_sq_dist;
+  if (!nodes_.empty() && q.allFinite()) nearest_in(0, q, best, best_d);
+  if (sq_dist) *sq_dist = best >= 0 ? best_d : std::numeric_limits<float>::infinity();
+  return best;
+}
+
+void KdTree3::radius_in(int node, const Vec3f& q, float r2, std::vector<std::pair<float, int>>& out) const {
+  const Node& n = nodes_[static_cast<size_t>(node)];
+  if (n.dim < 0) {
+    for (int i = n.begin; i < n.end; ++i) {
+      const float d = (points_[static_cast<size_t>(i)] - q).squaredNorm();
+      if (d <= r2) out.emplace_back(d, order_[static_cast<size_t>(i)]);
+    }
+    return;
+  }
+  const float diff = q[n.dim] - n.split;
+  const int near = diff < 0 ? n.left : n.right, far = diff < 0 ? n.right : n.left;
+  radius_in(near, q, r2, out);
+  if (diff * diff <= r2) radius_in(far, q, r2, out);
+}
+
+void KdTree3::radius(const Vec3f& q, float r, std::vector<int>& out) const {
+  out.clear();
+  if (nodes_.empty() || !q.allFinite() || !(r > 0)) return;
+  std::vector<std::pair<float, int>> found;
+  radius_in(0, q, r * r, found);
+  std::sort(found.begin(), found.end());
+  out.reserve(found.size());
+  for (const auto& f : found) out.push_back(f.second);
+}
+
+}  // namespace pb

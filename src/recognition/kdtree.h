@@ -1,0 +1,45 @@
+// A static kd-tree over 3D points, PCL-free: built once per cloud, exact
+// nearest-neighbour and radius queries, const and thread-safe, deterministic
+// (equal distances resolve to the lower point index). Used wherever the
+// pipeline searches a cloud many times: refinement (one tree per scene crop
+// and per model cloud, not one per ICP iteration), verification, normals.
+#pragma once
+
+#include <limits>
+#include <vector>
+
+#include "core/types.h"
+
+namespace pb {
+
+class KdTree3 {
+ public:
+  KdTree3() = default;
+  explicit KdTree3(const std::vector<Vec3f>& points, int leaf_size = 8);
+
+  // The nearest point with squared distance below max_sq_dist (index, or -1
+  // when none); its squared distance in *sq_dist.
+  int nearest(const Vec3f& q, float* sq_dist = nullptr,
+              float max_sq_dist = std::numeric_limits<float>::infinity()) const;
+  // Every point within r (squared distance <= r^2), sorted by distance, then
+  // index.
+  void radius(const Vec3f& q, float r, std::vector<int>& out) const;
+  size_t size() const { return points_.size(); }
+
+ private:
+  struct Node {
+    int begin = 0, end = 0;   // range of order_ / points_ (a leaf when dim < 0)
+    int dim = -1;
+    float split = 0;
+    int left = -1, right = -1;
+  };
+  int build(int begin, int end, int leaf_size);
+  void nearest_in(int node, const Vec3f& q, int& best, float& best_d) const;
+  void radius_in(int node, const Vec3f& q, float r2, std::vector<std::pair<float, int>>& out) const;
+
+  std::vector<Vec3f> points_;  // in tree order (cache friendly)
+  std::vector<int> order_;     // tree position -> input index
+  std::vector<Node> nodes_;
+};
+
+}  // namespace pb

@@ -1,0 +1,78 @@
+// The kd-tree against brute force: nearest (with the distance bound and the
+// lower-index rule for ties) and radius queries on random and degenerate
+// clouds.
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "core/random.h"
+#include "recognition/kdtree.h"
+
+namespace {
+
+using pb::Vec3f;
+
+std::vector<Vec3f> random_cloud(size_t n, uint64_t seed, float scale) {
+  pb::Rng rng(seed);
+  std::vector<Vec3f> v;
+  for (size_t i = 0; i < n; ++i)
+    v.emplace_back(static_cast<float>(rng.uniform(-scale, scale)), static_cast<float>(rng.uniform(-scale, scale)),
+                   static_cast<float>(rng.uniform(-scale, scale)));
+  return v;
+}
+
+int brute_nearest(const std::vector<Vec3f>& pts, const Vec3f& q, float max2, float* d2) {
+  int best = -1;
+  float bd = max2;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const float d = (pts[i] - q).squaredNorm();
+    if (d < bd) {
+      bd = d;
+      best = static_cast<int>(i);
+    }
+  }
+  *d2 = bd;
+  return best;
+}
+
+TEST(KdTree3, NearestAndRadiusEqualBruteForce) {
+  for (size_t n : {1u, 2u, 7u, 100u, 3000u}) {
+    const auto pts = random_cloud(n, 5 + n, 100.f);
+    const pb::KdTree3 tree(pts);
+    ASSERT_EQ(tree.size(), n);
+    const auto queries = random_cloud(300, 99, 130.f);
+    for (const Vec3f& q : queries) {
+      float d_tree = 0, d_brute = 0;
+      EXPECT_EQ(tree.nearest(q, &d_tree), brute_nearest(pts, q, std::numeric_limits<float>::infinity(), &d_brute));
+      EXPECT_EQ(d_tree, d_brute);
+      const float max2 = 20.f * 20.f;  // bounded: -1 when nothing is closer
+      EXPECT_EQ(tree.nearest(q, &d_tree, max2), brute_nearest(pts, q, max2, &d_brute));
+      std::vector<int> got, want;
+      tree.radius(q, 25.f, got);
+      std::vector<std::pair<float, int>> all;
+      for (size_t i = 0; i < pts.size(); ++i)
+        if ((pts[i] - q).squaredNorm() <= 25.f * 25.f) all.emplace_back((pts[i] - q).squaredNorm(), static_cast<int>(i));
+      std::sort(all.begin(), all.end());
+      for (const auto& a : all) want.push_back(a.second);
+      EXPECT_EQ(got, want);
+    }
+  }
+}
+
+TEST(KdTree3, DuplicatesResolveToTheLowestIndexAndEmptyTreesFindNothing) {
+  std::vector<Vec3f> pts(50, Vec3f(1, 2, 3));
+  pts.push_back(Vec3f(10, 0, 0));
+  const pb::KdTree3 tree(pts);
+  float d2 = -1;
+  EXPECT_EQ(tree.nearest(Vec3f(1, 2, 3.5f), &d2), 0);
+  EXPECT_FLOAT_EQ(d2, 0.25f);
+  EXPECT_EQ(tree.nearest(Vec3f(9, 0, 0)), 50);
+  const pb::KdTree3 empty(std::vector<Vec3f>{});
+  EXPECT_EQ(empty.nearest(Vec3f(0, 0, 0), &d2), -1);
+  EXPECT_EQ(tree.nearest(Vec3f(NAN, 0, 0)), -1);
+  std::vector<int> out{7};
+  empty.radius(Vec3f(0, 0, 0), 5, out);
+  EXPECT_TRUE(out.empty());
+}
+
+}  // namespace
