@@ -5,7 +5,6 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <unordered_map>
 
 namespace pb {
 
@@ -30,14 +29,71 @@ struct Cells {
   size_t size() const { return first.size(); }
 };
 
+// Open addressing over the cell keys (linear probing, power-of-two
+// capacity, grown at half load): no allocation per cell.
+class KeyTable {
+ public:
+  explicit KeyTable(size_t expected) {
+    size_t cap = 64;
+    while (cap < 2 * expected) cap *= 2;
+    keys_.resize(cap);
+    slots_.assign(cap, -1);
+  }
+  // The slot of k, inserting `fresh` when k is new (then *inserted = true).
+  int find_or_insert(const Key& k, int fresh, bool* inserted) {
+    if (2 * (size_ + 1) > slots_.size()) grow();
+    size_t i = home(k);
+    while (slots_[i] >= 0) {
+      if (keys_[i] == k) {
+        *inserted = false;
+        return slots_[i];
+      }
+      i = (i + 1) & (slots_.size() - 1);
+    }
+    keys_[i] = k;
+    slots_[i] = fresh;
+    ++size_;
+    *inserted = true;
+    return fresh;
+  }
+
+ private:
+  size_t home(const Key& k) const {  // the hash with its high bits folded in (the mask keeps the low ones)
+    uint64_t h = KeyHash()(k);
+    h ^= h >> 33;
+    h *= 0xff51afd7ed558ccdull;
+    h ^= h >> 33;
+    return static_cast<size_t>(h) & (slots_.size() - 1);
+  }
+  void grow() {
+    std::vector<Key> keys;
+    std::vector<int> slots;
+    keys.swap(keys_);
+    slots.swap(slots_);
+    keys_.resize(2 * keys.size());
+    slots_.assign(2 * slots.size(), -1);
+    for (size_t j = 0; j < slots.size(); ++j) {
+      if (slots[j] < 0) continue;
+      size_t i = home(keys[j]);
+      while (slots_[i] >= 0) i = (i + 1) & (slots_.size() - 1);
+      keys_[i] = keys[j];
+      slots_[i] = slots[j];
+    }
+  }
+  std::vector<Key> keys_;
+  std::vector<int> slots_;
+  size_t size_ = 0;
+};
+
 Cells group(const std::vector<Vec3f>& pts, const VoxelGridOptions& opt) {
   const size_t n = pts.size();
   const double inv = 1.0 / opt.leaf_mm;
   Cells c;
   c.cell_of.assign(n, -1);
-  std::unordered_map<Key, int, KeyHash> slot;
-  slot.reserve(n / 8 + 16);
+  KeyTable slot(n / 8 + 16);
   std::vector<Key> keys;
+  Key last{};
+  int last_slot = -1;  // consecutive points (neighbouring pixels) mostly share a cell
   for (size_t i = 0; i < n; ++i) {
     const Vec3f& p = pts[i];
     if (!p.allFinite()) continue;
@@ -46,14 +102,20 @@ Cells group(const std::vector<Vec3f>& pts, const VoxelGridOptions& opt) {
       a[d] = static_cast<int64_t>(opt.cell_index == VoxelGridOptions::CellIndex::kDivide ? std::floor(p[d] / opt.leaf_mm)
                                                                                        : std::floor(p[d] * inv));
     const Key k = opt.order == VoxelGridOptions::Order::kZYX ? Key{a[2], a[1], a[0]} : Key{a[0], a[1], a[2]};
-    auto [it, fresh] = slot.emplace(k, static_cast<int>(keys.size()));
-    if (fresh) {
-      keys.push_back(k);
-      c.first.push_back(static_cast<int>(i));
-      c.count.push_back(0);
+    int s = last_slot;
+    if (s < 0 || k != last) {
+      bool fresh = false;
+      s = slot.find_or_insert(k, static_cast<int>(keys.size()), &fresh);
+      if (fresh) {
+        keys.push_back(k);
+        c.first.push_back(static_cast<int>(i));
+        c.count.push_back(0);
+      }
+      last = k;
+      last_slot = s;
     }
-    ++c.count[static_cast<size_t>(it->second)];
-    c.cell_of[i] = it->second;
+    ++c.count[static_cast<size_t>(s)];
+    c.cell_of[i] = s;
   }
   // Renumber the cells in key order.
   std::vector<int> order(keys.size());
