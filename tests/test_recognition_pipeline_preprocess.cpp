@@ -67,6 +67,96 @@ TEST(Ransac, FindsThePlaneDeterministically) {
   EXPECT_EQ(pb::detail::ransac_plane(line, 5.0, 50, 1), std::vector<char>(4, 0));
 }
 
+// Scored on a 500-point subset, RANSAC still selects the plane among all
+// points (the subset only picks the winner), deterministically per seed.
+TEST(Ransac, SubsetScoringSelectsThePlaneAmongAllPoints) {
+  pb::Rng rng(5);
+  std::vector<Vec3f> pts;
+  for (int i = 0; i < 20000; ++i) {
+    const double x = rng.uniform(-400, 400), y = rng.uniform(-400, 400);
+    pts.emplace_back(x, y, 0.1 * y + 800 + rng.normal(0, 1));
+  }
+  for (int i = 0; i < 3000; ++i) pts.emplace_back(rng.uniform(-60, 60), rng.uniform(-60, 60), rng.uniform(600, 760));
+  const auto flags = pb::detail::ransac_plane(pts, 5.0, 100, 9, nullptr, 500);
+  int on = 0, outliers_on = 0;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    if (i < 20000) on += flags[i];
+    else outliers_on += flags[i];
+  }
+  EXPECT_GE(on, 19900);
+  EXPECT_EQ(outliers_on, 0);
+  EXPECT_EQ(flags, pb::detail::ransac_plane(pts, 5.0, 100, 9, nullptr, 500));
+}
+
+// A floor and a wall (the warehouse): max_planes 1 removes the larger one,
+// max_planes 2 both; the object stays.
+TEST(Preprocess, MaxPlanesRemovesFloorAndWall) {
+  pb::OrganizedCloud cloud;
+  cloud.width = 200;
+  cloud.height = 1;
+  pb::Rng rng(4);
+  for (int i = 0; i < 6000; ++i) cloud.points.emplace_back(rng.uniform(-1500, 1500), 800, rng.uniform(2000, 5000));   // floor y = 800
+  for (int i = 0; i < 4000; ++i) cloud.points.emplace_back(rng.uniform(-1500, 1500), rng.uniform(-800, 800), 5000);  // wall z = 5000
+  for (int i = 0; i < 800; ++i) {  // an object: a ball of 200 mm radius
+    const pb::Vec3 d = pb::Vec3(rng.normal(), rng.normal(), rng.normal()).normalized() * 200;
+    cloud.points.push_back((pb::Vec3(0, 400, 3500) + d).cast<float>());
+  }
+  cloud.width = static_cast<int>(cloud.points.size());
+  pb::PreprocessSettings s;
+  s.max_range_mm = 9000;
+  s.voxel_mm = 20;
+  s.normal_radius_mm = 80;
+  s.plane_threshold_mm = 20;
+  s.min_plane_fraction = 0.1;
+  auto count_near = [](const PointSet& ps, auto pred) {
+    int n = 0;
+    for (const auto& p : ps.points) n += pred(p);
+    return n;
+  };
+  auto on_floor = [](const Vec3f& p) { return std::abs(p.y() - 800) < 5; };
+  auto on_wall = [](const Vec3f& p) { return std::abs(p.z() - 5000) < 5; };
+  auto on_ball = [](const Vec3f& p) { return (p - Vec3f(0, 400, 3500)).norm() < 230; };
+  s.max_planes = 1;
+  const PointSet one = pb::preprocess_scene(cloud, s, 3);
+  EXPECT_EQ(count_near(one, on_floor), 0);
+  EXPECT_GT(count_near(one, on_wall), 1000);
+  s.max_planes = 2;
+  const PointSet two = pb::preprocess_scene(cloud, s, 3);
+  EXPECT_EQ(count_near(two, on_floor), 0);
+  EXPECT_EQ(count_near(two, on_wall), 0);
+  EXPECT_GT(count_near(two, on_ball), 400);
+}
+
+// Normals by PCA in a radius: exact on a plane (zero curvature) and on a
+// sphere (radial, curvature about r^2 / (8 R^2) of the neighbourhood),
+// toward the viewpoint; points without 3 neighbours are dropped.
+TEST(Normals, PlaneAndSphereNormalsAreExactAndFaceTheViewpoint) {
+  PointSet plane;
+  for (int x = -20; x <= 20; ++x)
+    for (int y = -20; y <= 20; ++y) plane.points.emplace_back(5.f * x, 5.f * y, 600.f + 0.5f * x);
+  plane.points.emplace_back(0.f, 0.f, 0.f);  // isolated: no neighbours within the radius
+  pb::detail::estimate_normals(plane, 12.0);
+  ASSERT_EQ(plane.size(), 41u * 41u);
+  const Vec3f n_true = Vec3f(0.5f, 0, -5.f).normalized();  // facing the origin (negative z)
+  for (size_t i = 0; i < plane.size(); ++i) {
+    EXPECT_GT(plane.normals[i].dot(n_true), 0.99999f) << i;
+    EXPECT_LT(plane.curvature[i], 1e-6f) << i;
+  }
+  PointSet sphere;
+  pb::Rng rng(2);
+  const Vec3f c(0, 0, 1000);
+  for (int i = 0; i < 20000; ++i) {
+    const pb::Vec3 d = pb::Vec3(rng.normal(), rng.normal(), rng.normal()).normalized();
+    if (d.z() < -0.3) sphere.points.push_back(c + (d * 100).cast<float>());  // a cap facing the camera
+  }
+  pb::detail::estimate_normals(sphere, 15.0);
+  for (size_t i = 0; i < sphere.size(); ++i) {
+    const Vec3f radial = (sphere.points[i] - c).normalized();
+    if (radial.z() > -0.5f) continue;  // away from the cap's rim (one-sided neighbourhoods)
+    EXPECT_GT(sphere.normals[i].dot(radial), 0.995f) << i;  // outward = toward the camera here
+  }
+}
+
 class TableScenePreprocess : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {

@@ -102,4 +102,23 @@ void KdTree3::radius(const Vec3f& q, float r, std::vector<int>& out) const {
   for (const auto& f : found) out.push_back(f.second);
 }
 
+void KdTree3::radius_idx(int node, const Vec3f& q, float r2, std::vector<int>& out) const {
+  const Node& n = nodes_[static_cast<size_t>(node)];
+  if (n.dim < 0) {
+    for (int i = n.begin; i < n.end; ++i)
+      if ((points_[static_cast<size_t>(i)] - q).squaredNorm() <= r2) out.push_back(order_[static_cast<size_t>(i)]);
+    return;
+  }
+  const float diff = q[n.dim] - n.split;
+  const int near = diff < 0 ? n.left : n.right, far = diff < 0 ? n.right : n.left;
+  radius_idx(near, q, r2, out);
+  if (diff * diff <= r2) radius_idx(far, q, r2, out);
+}
+
+void KdTree3::radius_unsorted(const Vec3f& q, float r, std::vector<int>& out) const {
+  out.clear();
+  if (nodes_.empty() || !q.allFinite() || !(r > 0)) return;
+  radius_idx(0, q, r * r, out);
+}
+
 }  // namespace pb

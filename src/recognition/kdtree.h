@@ -24,6 +24,8 @@ class KdTree3 {
   // Every point within r (squared distance <= r^2), sorted by distance, then
   // index.
   void radius(const Vec3f& q, float r, std::vector<int>& out) const;
+  // The same set in tree order (no sort: for sums over the neighbourhood).
+  void radius_unsorted(const Vec3f& q, float r, std::vector<int>& out) const;
   size_t size() const { return points_.size(); }
 
  private:
@@ -36,6 +38,7 @@ class KdTree3 {
   int build(int begin, int end, int leaf_size);
   void nearest_in(int node, const Vec3f& q, int& best, float& best_d) const;
   void radius_in(int node, const Vec3f& q, float r2, std::vector<std::pair<float, int>>& out) const;
+  void radius_idx(int node, const Vec3f& q, float r2, std::vector<int>& out) const;
 
   std::vector<Vec3f> points_;  // in tree order (cache friendly)
   std::vector<int> order_;     // tree position -> input index

@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "core/error.h"
+#include "recognition/pcl_console.h"
 #include "recognition/settings.h"
 
 namespace pb {
@@ -81,6 +82,9 @@ std::string check_name(const YamlNode& node, const std::vector<std::string>& all
   return v;
 }
 
-std::unique_ptr<Method> make_method(const RecognitionSettings& s) { return descriptor_entry(s.descriptor).make(s); }
+std::unique_ptr<Method> make_method(const RecognitionSettings& s) {
+  silence_pcl_console();
+  return descriptor_entry(s.descriptor).make(s);
+}
 
 }  // namespace pb

@@ -13,11 +13,14 @@ namespace pb::detail {
 // Seeded RANSAC plane fit (as pcl::SACSegmentation with SACMODEL_PLANE and
 // optimized coefficients): `iterations` random triples, the plane with most
 // points within `threshold_mm` wins (first found on ties), then a least
-// squares refit on its inliers and a final inlier selection. Returns the
-// inlier flags; `plane` (n, d with n.p + d = 0) when not null. Fewer than 3
-// points or no valid sample: all false.
+// squares refit on its inliers and a final inlier selection. With
+// sample_points > 0 (and fewer than the cloud has), the triples are drawn
+// from and scored on a seeded random subset of that many points; the
+// winner's inliers are then selected among all points. Returns the inlier
+// flags; `plane` (n, d with n.p + d = 0) when not null. Fewer than 3 points
+// or no valid sample: all false.
 std::vector<char> ransac_plane(const std::vector<Vec3f>& points, double threshold_mm, int iterations,
-                               uint64_t seed, Eigen::Vector4d* plane = nullptr);
+                               uint64_t seed, Eigen::Vector4d* plane = nullptr, int sample_points = 0);
 
 // Normals by PCA of the neighbours within `radius_mm` (pcl::NormalEstimationOMP
 // on a kd-tree, one thread per omp_get_max_threads()), flipped toward the

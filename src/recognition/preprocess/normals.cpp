@@ -1,70 +1,76 @@
-// Normals of the preprocessed cloud through pcl::NormalEstimationOMP (PCA of
-// the neighbours in a radius, flipped toward the viewpoint at the origin).
-// OpenMP computes each point independently, so the result does not depend on
-// the thread count.
-#include <pcl/features/normal_3d_omp.h>
-#include <pcl/point_cloud.h>
-#include <pcl/point_types.h>
-#include <pcl/search/kdtree.h>
-
+// Normals of the preprocessed cloud: PCA of the neighbours within a radius
+// (the point itself included; as pcl::NormalEstimation), the eigenvector of
+// the smallest eigenvalue of their covariance, flipped toward the viewpoint
+// at the origin; curvature = the surface variation l0 / (l0 + l1 + l2).
+// Neighbours come from the project's kd-tree (kdtree.h), built once; the
+// covariance is accumulated in double about the neighbourhood's first point
+// (stable for clouds far from the origin). Each point is independent, so
+// OpenMP threads do not change the result.
+#include <Eigen/Eigenvalues>
 #include <cmath>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
-#include "recognition/pcl_adapter.h"
+#include "recognition/kdtree.h"
 #include "recognition/preprocess/internal.h"
 
-#include <pcl/console/print.h>
+namespace pb::detail {
 
 namespace {
-// PCL's messages (OUR-CVFH's "both axes are equally easy/difficult to
-// disambiguate", CVFH's "no clusters were found", the RANSAC inside Hough
-// grouping's "no samples could be selected") would flood stderr and the
-// runner's worker log. Every PCL result is checked by its caller instead.
-struct QuietPcl {
-  QuietPcl() { pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS); }
-} quiet_pcl;
-}  // namespace
 
-namespace pb::detail {
+// Normal and curvature of one neighbourhood; false when fewer than 3 points
+// or degenerate.
+bool pca_normal(const std::vector<Vec3f>& pts, const std::vector<int>& nb, Vec3f& normal, float& curvature) {
+  if (nb.size() < 3) return false;
+  const Vec3 o = pts[static_cast<size_t>(nb[0])].cast<double>();
+  Vec3 sum = Vec3::Zero();
+  Mat3 sq = Mat3::Zero();
+  for (int j : nb) {
+    const Vec3 d = pts[static_cast<size_t>(j)].cast<double>() - o;
+    sum += d;
+    sq += d * d.transpose();
+  }
+  const double n = static_cast<double>(nb.size());
+  const Vec3 mean = sum / n;
+  const Mat3 cov = sq / n - mean * mean.transpose();
+  Eigen::SelfAdjointEigenSolver<Mat3> es;
+  es.computeDirect(cov);
+  const Vec3 ev = es.eigenvalues();
+  const Vec3 v = es.eigenvectors().col(0);
+  if (!v.allFinite() || !(v.norm() > 0)) return false;
+  normal = v.normalized().cast<float>();
+  const double total = ev.sum();
+  curvature = total != 0 ? static_cast<float>(std::abs(ev[0] / total)) : 0.f;
+  return true;
+}
+
+}  // namespace
 
 void estimate_normals(PointSet& ps, double radius_mm) {
   ps.normals.clear();
   ps.curvature.clear();
   if (ps.points.empty()) return;
-  const auto cloud = pcl_adapter::xyz(ps.points);
-  pcl::NormalEstimationOMP<pcl::PointXYZ, pcl::Normal> ne;
-#ifdef _OPENMP
-  ne.setNumberOfThreads(static_cast<unsigned>(omp_get_max_threads()));
-#else
-  ne.setNumberOfThreads(1);
-#endif
-  ne.setInputCloud(cloud);
-  ne.setSearchMethod(pcl::search::KdTree<pcl::PointXYZ>::Ptr(new pcl::search::KdTree<pcl::PointXYZ>));
-  ne.setRadiusSearch(radius_mm);
-  ne.setViewPoint(0.f, 0.f, 0.f);
-  pcl::PointCloud<pcl::Normal> normals;
-  ne.compute(normals);
-
+  const KdTree3 tree(ps.points);
+  const long n = static_cast<long>(ps.points.size());
   std::vector<char> keep(ps.points.size(), 0);
-  ps.normals.resize(ps.points.size(), Vec3f::Zero());
-  ps.curvature.resize(ps.points.size(), 0.f);
-  size_t kept = 0;
-  for (size_t i = 0; i < ps.points.size(); ++i) {
-    const pcl::Normal& n = normals[i];
-    if (!std::isfinite(n.normal_x) || !std::isfinite(n.normal_y) || !std::isfinite(n.normal_z) ||
-        !std::isfinite(n.curvature))
-      continue;
-    Vec3f v(n.normal_x, n.normal_y, n.normal_z);
-    const float l = v.norm();
-    if (!(l > 0.f)) continue;
-    ps.normals[i] = v / l;
-    ps.curvature[i] = n.curvature;
-    keep[i] = 1;
-    ++kept;
+  ps.normals.assign(ps.points.size(), Vec3f::Zero());
+  ps.curvature.assign(ps.points.size(), 0.f);
+#pragma omp parallel
+  {
+    std::vector<int> nb;
+#pragma omp for schedule(static)
+    for (long i = 0; i < n; ++i) {
+      const size_t k = static_cast<size_t>(i);
+      tree.radius_unsorted(ps.points[k], static_cast<float>(radius_mm), nb);
+      Vec3f nrm;
+      float curv = 0;
+      if (!pca_normal(ps.points, nb, nrm, curv)) continue;
+      if (nrm.dot(-ps.points[k]) < 0) nrm = -nrm;  // toward the viewpoint (origin)
+      ps.normals[k] = nrm;
+      ps.curvature[k] = curv;
+      keep[k] = 1;
+    }
   }
+  size_t kept = 0;
+  for (char c : keep) kept += c;
   if (kept != ps.points.size()) ps = select(ps, keep);
 }
 

@@ -87,15 +87,23 @@ size_t within(const std::vector<Vec3f>& pts, const Eigen::Vector4d& plane, doubl
 
 }  // namespace
 
-std::vector<char> ransac_plane(const std::vector<Vec3f>& pts, double thr, int iterations, uint64_t seed,
-                               Eigen::Vector4d* plane_out) {
-  const size_t n = pts.size();
+std::vector<char> ransac_plane(const std::vector<Vec3f>& all, double thr, int iterations, uint64_t seed,
+                               Eigen::Vector4d* plane_out, int sample_points) {
+  const size_t n = all.size();
   std::vector<char> flags(n, 0);
   if (n < 3) return flags;
   Rng rng(seed);
+  // The points the candidates are drawn from and scored on.
+  std::vector<Vec3f> subset;
+  if (sample_points > 0 && static_cast<size_t>(sample_points) < n) {
+    subset.reserve(static_cast<size_t>(sample_points));
+    const int max_i = static_cast<int>(n) - 1;
+    for (int k = 0; k < sample_points; ++k) subset.push_back(all[static_cast<size_t>(rng.uniform_int(0, max_i))]);
+  }
+  const std::vector<Vec3f>& pts = subset.empty() ? all : subset;
   Eigen::Vector4d best = Eigen::Vector4d::Zero();
   size_t best_count = 0;
-  const int max_n = static_cast<int>(n) - 1;
+  const int max_n = static_cast<int>(pts.size()) - 1;
   for (int it = 0; it < iterations; ++it) {
     const int a = rng.uniform_int(0, max_n), b = rng.uniform_int(0, max_n), c = rng.uniform_int(0, max_n);
     if (a == b || b == c || a == c) continue;  // a degenerate sample costs its iteration, as in PCL
@@ -113,13 +121,13 @@ std::vector<char> ransac_plane(const std::vector<Vec3f>& pts, double thr, int it
     }
   }
   if (best_count < 3) return flags;
-  within(pts, best, thr, &flags);
+  const size_t support = within(all, best, thr, &flags);
   Eigen::Vector4d refined;
-  if (fit_plane(pts, flags, refined)) {
+  if (fit_plane(all, flags, refined)) {
     // Keep the refit only if it does not lose support (PCL keeps the refit
     // unconditionally; a refit tilted by a large object can lose the plane).
     std::vector<char> f2(n, 0);
-    if (within(pts, refined, thr, &f2) >= best_count) {
+    if (within(all, refined, thr, &f2) >= support) {
       best = refined;
       flags.swap(f2);
     }
@@ -151,11 +159,14 @@ PointSet range_cut(const OrganizedCloud& cloud, double min_z, double max_z) {
 PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings& s, uint64_t seed) {
   PointSet ps = range_cut(cloud, s.min_range_mm, s.max_range_mm);
   ps = voxel_downsample(ps, {s.voxel_mm});
-  if (s.remove_plane && ps.size() >= 3) {
-    const std::vector<char> on_plane =
-        detail::ransac_plane(ps.points, s.plane_threshold_mm, s.plane_iterations, seed);
-    const size_t cnt = static_cast<size_t>(std::count(on_plane.begin(), on_plane.end(), 1));
-    if (cnt > 0 && static_cast<double>(cnt) >= s.min_plane_fraction * static_cast<double>(ps.size())) {
+  if (s.remove_plane) {
+    const double min_count = s.min_plane_fraction * static_cast<double>(ps.size());
+    for (int k = 0; k < s.max_planes && ps.size() >= 3; ++k) {
+      const std::vector<char> on_plane = detail::ransac_plane(ps.points, s.plane_threshold_mm, s.plane_iterations,
+                                                              k == 0 ? seed : derive_seed(seed, {static_cast<uint64_t>(k)}), nullptr,
+                                                              s.plane_sample_points);
+      const size_t cnt = static_cast<size_t>(std::count(on_plane.begin(), on_plane.end(), 1));
+      if (cnt == 0 || static_cast<double>(cnt) < min_count) break;
       std::vector<char> keep(on_plane.size());
       for (size_t i = 0; i < keep.size(); ++i) keep[i] = !on_plane[i];
       ps = detail::select(ps, keep);

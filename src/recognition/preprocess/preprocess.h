@@ -16,7 +16,13 @@ struct PreprocessSettings {
   bool remove_plane = true;         // remove the dominant plane (floor / table)
   double plane_threshold_mm = 10.0; // RANSAC inlier distance for the plane
   int plane_iterations = 200;       // RANSAC iterations
-  double min_plane_fraction = 0.2;  // remove the plane only if it holds this fraction
+  double min_plane_fraction = 0.2;  // remove a plane only if it holds this fraction (of the points
+                                    // before any plane was removed)
+  int max_planes = 1;               // dominant planes removed one after the other (thesis: 1, the
+                                    // table; the warehouse's floor and wall: 2)
+  int plane_sample_points = 5000;   // RANSAC scores its candidate planes on a seeded random subset
+                                    // of this many points (0 = all); the winner's inliers are then
+                                    // selected among all points and refitted
   double normal_radius_mm = 20.0;   // PCA neighbourhood radius for normals
 
   template <class S, class F>
@@ -28,6 +34,8 @@ struct PreprocessSettings {
     f("plane_threshold_mm", s.plane_threshold_mm, fields::positive());
     f("plane_iterations", s.plane_iterations, fields::at_least(1));
     f("min_plane_fraction", s.min_plane_fraction, fields::in_range(0, 1));
+    f("max_planes", s.max_planes, fields::at_least(0));
+    f("plane_sample_points", s.plane_sample_points, fields::at_least(0));
     f("normal_radius_mm", s.normal_radius_mm, fields::positive());
   }
   void validate(const YamlNode& node) const;  // max_range_mm > min_range_mm

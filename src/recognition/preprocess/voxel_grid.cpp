@@ -29,6 +29,14 @@ struct Cells {
   size_t size() const { return first.size(); }
 };
 
+// floor(x) as an integer, for finite x in range: the same value as
+// std::floor without a libm call (baseline x86-64 has no rounding
+// instruction).
+inline int64_t floor_to_int(double x) {
+  const int64_t i = static_cast<int64_t>(x);  // truncates toward zero
+  return static_cast<double>(i) > x ? i - 1 : i;
+}
+
 // Open addressing over the cell keys (linear probing, power-of-two
 // capacity, grown at half load): no allocation per cell.
 class KeyTable {
@@ -40,9 +48,38 @@ class KeyTable {
     slots_.assign(cap, -1);
   }
   // The slot of k, inserting `fresh` when k is new (then *inserted = true).
+  // A small direct-mapped cache in front (the cells of the last image rows
+  // fit in it) saves most probes of the large table.
   int find_or_insert(const Key& k, int fresh, bool* inserted) {
+    const uint64_t h = mix(k);
+    Recent& r = recent_[h & (kRecent - 1)];
+    if (r.slot >= 0 && r.key == k) {
+      *inserted = false;
+      return r.slot;
+    }
+    const int s = probe(k, h, fresh, inserted);
+    r.key = k;
+    r.slot = s;
+    return s;
+  }
+
+ private:
+  static constexpr size_t kRecent = 2048;
+  struct Recent {
+    Key key{};
+    int slot = -1;
+  };
+  static uint64_t mix(const Key& k) {  // the hash with its high bits folded in (masks keep the low ones)
+    uint64_t h = KeyHash()(k);
+    h ^= h >> 33;
+    h *= 0xff51afd7ed558ccdull;
+    h ^= h >> 33;
+    return h;
+  }
+  size_t home(const Key& k) const { return static_cast<size_t>(mix(k)) & (slots_.size() - 1); }
+  int probe(const Key& k, uint64_t h, int fresh, bool* inserted) {
     if (2 * (size_ + 1) > slots_.size()) grow();
-    size_t i = home(k);
+    size_t i = static_cast<size_t>(h) & (slots_.size() - 1);
     while (slots_[i] >= 0) {
       if (keys_[i] == k) {
         *inserted = false;
@@ -57,14 +94,6 @@ class KeyTable {
     return fresh;
   }
 
- private:
-  size_t home(const Key& k) const {  // the hash with its high bits folded in (the mask keeps the low ones)
-    uint64_t h = KeyHash()(k);
-    h ^= h >> 33;
-    h *= 0xff51afd7ed558ccdull;
-    h ^= h >> 33;
-    return static_cast<size_t>(h) & (slots_.size() - 1);
-  }
   void grow() {
     std::vector<Key> keys;
     std::vector<int> slots;
@@ -83,6 +112,7 @@ class KeyTable {
   std::vector<Key> keys_;
   std::vector<int> slots_;
   size_t size_ = 0;
+  std::vector<Recent> recent_ = std::vector<Recent>(kRecent);
 };
 
 Cells group(const std::vector<Vec3f>& pts, const VoxelGridOptions& opt) {
@@ -99,8 +129,7 @@ Cells group(const std::vector<Vec3f>& pts, const VoxelGridOptions& opt) {
     if (!p.allFinite()) continue;
     int64_t a[3];
     for (int d = 0; d < 3; ++d)
-      a[d] = static_cast<int64_t>(opt.cell_index == VoxelGridOptions::CellIndex::kDivide ? std::floor(p[d] / opt.leaf_mm)
-                                                                                       : std::floor(p[d] * inv));
+      a[d] = floor_to_int(opt.cell_index == VoxelGridOptions::CellIndex::kDivide ? p[d] / opt.leaf_mm : p[d] * inv);
     const Key k = opt.order == VoxelGridOptions::Order::kZYX ? Key{a[2], a[1], a[0]} : Key{a[0], a[1], a[2]};
     int s = last_slot;
     if (s < 0 || k != last) {
@@ -117,10 +146,29 @@ Cells group(const std::vector<Vec3f>& pts, const VoxelGridOptions& opt) {
     ++c.count[static_cast<size_t>(s)];
     c.cell_of[i] = s;
   }
-  // Renumber the cells in key order.
+  // Renumber the cells in key order: keys packed into one integer (21 bits
+  // per axis, offset by the minimum: the same order) when they fit, else
+  // compared as triples.
   std::vector<int> order(keys.size());
-  for (size_t k = 0; k < order.size(); ++k) order[k] = static_cast<int>(k);
-  std::sort(order.begin(), order.end(), [&](int x, int y) { return keys[x] < keys[y]; });
+  Key lo = keys.empty() ? Key{} : keys[0], hi = lo;
+  for (const Key& k : keys)
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = std::min(lo[d], k[d]);
+      hi[d] = std::max(hi[d], k[d]);
+    }
+  constexpr int64_t kSpan = int64_t(1) << 21;
+  if (hi[0] - lo[0] < kSpan && hi[1] - lo[1] < kSpan && hi[2] - lo[2] < kSpan) {
+    std::vector<std::pair<uint64_t, int>> packed(keys.size());
+    for (size_t k = 0; k < keys.size(); ++k)
+      packed[k] = {(static_cast<uint64_t>(keys[k][0] - lo[0]) << 42) | (static_cast<uint64_t>(keys[k][1] - lo[1]) << 21) |
+                       static_cast<uint64_t>(keys[k][2] - lo[2]),
+                   static_cast<int>(k)};
+    std::sort(packed.begin(), packed.end());
+    for (size_t k = 0; k < order.size(); ++k) order[k] = packed[k].second;
+  } else {
+    for (size_t k = 0; k < order.size(); ++k) order[k] = static_cast<int>(k);
+    std::sort(order.begin(), order.end(), [&](int x, int y) { return keys[x] < keys[y]; });
+  }
   std::vector<int> rank(order.size());
   for (size_t r = 0; r < order.size(); ++r) rank[static_cast<size_t>(order[r])] = static_cast<int>(r);
   Cells out;
