@@ -14,13 +14,47 @@
 
 namespace pb::ppf {
 
-// One model pair in the feature table.
+// One model pair in the feature table, with its alpha_m inline (voting
+// reads the table sequentially, never the n x n feature matrix).
 struct PairEntry {
   uint64_t key;
   uint32_t ref, other;  // model reference point, second point
+  float alpha_m = 0;
   bool operator<(const PairEntry& o) const {
     return std::tie(key, ref, other) < std::tie(o.key, o.ref, o.other);
   }
+};
+
+// The table's key index: for each distinct key its range [begin, end) of
+// the sorted table, in an open-addressing hash (one probe sequence per
+// scene pair instead of a binary search over the whole table).
+class KeyIndex {
+ public:
+  void build(const std::vector<PairEntry>& table);
+  // The range of `key` (begin == end when absent).
+  std::pair<uint32_t, uint32_t> find(uint64_t key) const {
+    if (keys_.empty()) return {0, 0};
+    size_t i = home(key);
+    while (true) {
+      const Slot& s = keys_[i];
+      if (s.end == 0) return {0, 0};
+      if (s.key == key) return {s.begin, s.end};
+      i = (i + 1) & (keys_.size() - 1);
+    }
+  }
+
+ private:
+  struct Slot {
+    uint64_t key = 0;
+    uint32_t begin = 0, end = 0;  // end == 0: empty slot
+  };
+  size_t home(uint64_t key) const {
+    key ^= key >> 29;
+    key *= 0xbf58476d1ce4e5b9ull;
+    key ^= key >> 32;
+    return static_cast<size_t>(key) & (keys_.size() - 1);
+  }
+  std::vector<Slot> keys_;
 };
 
 // The discretized feature (PCL's floor(f / step), in float) packed into 64
@@ -48,6 +82,7 @@ struct Model {
   std::vector<Vec3f> points, normals;
   std::vector<PairFeature> features;
   std::vector<PairEntry> table;  // empty: nothing to match
+  KeyIndex index;                 // over table
   float angle_step = 0, distance_step = 0, diameter = 0;
 };
 

@@ -15,9 +15,13 @@
 // coincident points) are left out, so they never vote.
 //
 // Matching follows the paper with PCL's conventions (the same feature,
-// alpha and pose formulas as pcl::PPFRegistration): each scene reference
-// point (a seeded random subset, scene_reference_fraction of the scene) is
-// paired with every scene point within the model's diameter; each model pair
+// alpha and pose formulas as pcl::PPFRegistration): the scene is
+// voxel-downsampled to the model's sampling (scene_sampling_steps distance
+// steps, as Drost et al. sample scene and model alike); each scene reference
+// point (a seeded random subset, scene_reference_fraction of those points)
+// is paired with every such scene point within the model's diameter, found
+// on the project's kd-tree; the model pairs of the same feature key come
+// from a hash index over the sorted table, alpha_m stored with each pair; each model pair
 // in the same feature bin votes for (model reference point, alpha) in an
 // accumulator; the best cell gives one pose per reference point. The poses
 // are clustered greedily, most votes first (a pose joins the first cluster
@@ -123,14 +127,19 @@ class PpfMethod : public Method {
     std::vector<Hypothesis> out;
     if (m_.table.empty() || !scene.has_normals() || scene.size() < 2) return out;
 
-    // Describe: the seeded subset of reference points.
+    // Describe: the scene at the model's sampling, the seeded subset of
+    // reference points.
     Timer timer;
-    const std::vector<int> refs = ppf::reference_points(scene.size(), s_.scene_reference_fraction, seed);
+    const double leaf = s_.scene_sampling_steps * m_.distance_step;
+    const PointSet sampled = leaf > 0 ? voxel_downsample(scene, {leaf}) : PointSet();
+    const PointSet& paired = leaf > 0 ? sampled : scene;
+    if (paired.size() < 2 || !paired.has_normals()) return out;
+    const std::vector<int> refs = ppf::reference_points(paired.size(), s_.scene_reference_fraction, seed);
     times.describe += timer.seconds();
 
     // Match: vote per reference point.
     timer.reset();
-    std::vector<ppf::PoseVote> poses = ppf::vote(m_, scene, refs);
+    std::vector<ppf::PoseVote> poses = ppf::vote(m_, paired, refs);
     times.match += timer.seconds();
 
     // Group: greedy pose clustering, most votes first.
@@ -183,9 +192,10 @@ class PpfMethod : public Method {
             !std::isfinite(f.f4) || !std::isfinite(f.alpha_m))
           continue;
         m_.table.push_back({ppf::feature_key(f.f1, f.f2, f.f3, f.f4, m_.angle_step, m_.distance_step),
-                          static_cast<uint32_t>(i), static_cast<uint32_t>(j)});
+                            static_cast<uint32_t>(i), static_cast<uint32_t>(j), f.alpha_m});
       }
     std::sort(m_.table.begin(), m_.table.end());
+    m_.index.build(m_.table);
   }
 
   PpfSettings s_;

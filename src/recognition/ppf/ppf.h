@@ -10,6 +10,10 @@ struct PpfSettings {
   double angle_step_deg = 12.0;           // discretization of the pair feature angles
   double distance_step_fraction = 0.05;   // distance step as a fraction of the diameter
   double scene_reference_fraction = 0.2;  // fraction of scene points used as references
+  double scene_sampling_steps = 1.0;      // the scene is paired at the model's sampling (Drost et
+                                          // al.): voxel-downsampled to this many distance steps
+                                          // (distance_step_fraction x diameter) before references
+                                          // and pairs are drawn; 0 = the preprocessed scene as is
   double position_cluster_mm = 30.0;      // pose clustering: translation threshold
   double rotation_cluster_deg = 30.0;     // pose clustering: rotation threshold
   int max_hypotheses = 5;                 // clustered poses passed on
@@ -21,6 +25,7 @@ struct PpfSettings {
     f("angle_step_deg", s.angle_step_deg, fields::positive(90));
     f("distance_step_fraction", s.distance_step_fraction, fields::positive(1));
     f("scene_reference_fraction", s.scene_reference_fraction, fields::positive(1));
+    f("scene_sampling_steps", s.scene_sampling_steps, fields::nonnegative());
     f("position_cluster_mm", s.position_cluster_mm, fields::positive());
     f("rotation_cluster_deg", s.rotation_cluster_deg, fields::positive());
     f("max_hypotheses", s.max_hypotheses, fields::at_least(1));

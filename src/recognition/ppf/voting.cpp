@@ -1,14 +1,12 @@
 // PPF voting and pose clustering (see method.cpp for the algorithm).
 #include <pcl/features/pfh_tools.h>
-#include <pcl/kdtree/kdtree_flann.h>
-#include <pcl/point_types.h>
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 
 #include "core/random.h"
-#include "recognition/pcl_adapter.h"
+#include "recognition/kdtree.h"
 #include "recognition/ppf/internal.h"
 
 namespace pb::ppf {
@@ -49,47 +47,71 @@ std::vector<int> reference_points(size_t n, double fraction, uint64_t seed) {
   return refs;
 }
 
+void KeyIndex::build(const std::vector<PairEntry>& table) {
+  keys_.clear();
+  size_t distinct = 0;
+  for (size_t i = 0; i < table.size(); ++i) distinct += i == 0 || table[i].key != table[i - 1].key;
+  if (distinct == 0) return;
+  size_t cap = 16;
+  while (cap < 2 * distinct) cap *= 2;
+  keys_.assign(cap, Slot{});
+  for (size_t b = 0; b < table.size();) {
+    size_t e = b;
+    while (e < table.size() && table[e].key == table[b].key) ++e;
+    size_t i = home(table[b].key);
+    while (keys_[i].end != 0) i = (i + 1) & (cap - 1);
+    keys_[i] = Slot{table[b].key, static_cast<uint32_t>(b), static_cast<uint32_t>(e)};
+    b = e;
+  }
+}
+
 std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vector<int>& refs) {
-  const auto cloud = pcl_adapter::point_normals(scene.points, scene.normals);
-  pcl::KdTreeFLANN<pcl::PointNormal> tree;
-  tree.setInputCloud(cloud);
+  const KdTree3 tree(scene.points);
   const size_t n_model = m.points.size();
   const int n_alpha = std::max(1, static_cast<int>(std::floor(2 * M_PI / m.angle_step)));
   std::vector<uint32_t> acc(n_model * static_cast<size_t>(n_alpha), 0);
+  std::vector<uint32_t> touched;  // accumulator cells voted for by the current reference point
   std::vector<PoseVote> poses;
-  pcl::Indices nn;
-  std::vector<float> d2;
+  std::vector<int> nn;
+  auto v4 = [](const Vec3f& v) { return Eigen::Vector4f(v.x(), v.y(), v.z(), 0.f); };
   for (int r : refs) {
     const Vec3f sr = scene.points[r], nr = scene.normals[r];
     if (!sr.allFinite() || !nr.allFinite()) continue;
     const Eigen::Affine3f T_sg = to_reference_frame(sr, nr);
-    tree.radiusSearch((*cloud)[r], m.diameter, nn, d2);
-    std::fill(acc.begin(), acc.end(), 0u);
+    tree.radius_unsorted(sr, m.diameter, nn);  // votes add up: the neighbour order does not matter
+    for (uint32_t c : touched) acc[c] = 0;
+    touched.clear();
+    const Eigen::Vector4f pr = v4(sr), npr = v4(nr);
     for (int i : nn) {
       if (i == r) continue;
       float f1, f2, f3, f4;
-      if (!pcl::computePairFeatures((*cloud)[r].getVector4fMap(), (*cloud)[r].getNormalVector4fMap(),
-                                    (*cloud)[i].getVector4fMap(), (*cloud)[i].getNormalVector4fMap(), f1, f2,
-                                    f3, f4))
+      if (!pcl::computePairFeatures(pr, npr, v4(scene.points[static_cast<size_t>(i)]),
+                                    v4(scene.normals[static_cast<size_t>(i)]), f1, f2, f3, f4))
         continue;
       if (!std::isfinite(f1) || !std::isfinite(f2) || !std::isfinite(f3) || !std::isfinite(f4)) continue;
-      const PairEntry probe{feature_key(f1, f2, f3, f4, m.angle_step, m.distance_step), 0, 0};
-      auto it = std::lower_bound(m.table.begin(), m.table.end(), probe);
-      if (it == m.table.end() || it->key != probe.key) continue;
-      const float alpha_s = pcl_alpha(T_sg, scene.points[i]);
-      for (; it != m.table.end() && it->key == probe.key; ++it) {
-        float alpha = m.features[static_cast<size_t>(it->ref) * n_model + it->other].alpha_m - alpha_s;
+      const auto [begin, end] = m.index.find(feature_key(f1, f2, f3, f4, m.angle_step, m.distance_step));
+      if (begin == end) continue;
+      const float alpha_s = pcl_alpha(T_sg, scene.points[static_cast<size_t>(i)]);
+      for (uint32_t e = begin; e < end; ++e) {
+        const PairEntry& it = m.table[e];
+        float alpha = it.alpha_m - alpha_s;
         if (!std::isfinite(alpha)) continue;
         if (alpha < -M_PI) alpha += static_cast<float>(2 * M_PI);
         else if (alpha > M_PI) alpha -= static_cast<float>(2 * M_PI);
         int bin = static_cast<int>(std::floor((alpha + M_PI) / m.angle_step));
         bin = std::max(0, std::min(n_alpha - 1, bin));
-        ++acc[it->ref * static_cast<size_t>(n_alpha) + static_cast<size_t>(bin)];
+        const uint32_t cell = it.ref * static_cast<uint32_t>(n_alpha) + static_cast<uint32_t>(bin);
+        if (acc[cell]++ == 0) touched.push_back(cell);
       }
     }
-    const auto best = std::max_element(acc.begin(), acc.end());  // first maximum: deterministic
-    if (*best == 0) continue;
-    const size_t cell = static_cast<size_t>(best - acc.begin());
+    if (touched.empty()) continue;
+    // The first maximum in cell order (deterministic, as max_element over
+    // the whole accumulator).
+    uint32_t best_cell = touched[0];
+    for (uint32_t c : touched)
+      if (acc[c] > acc[best_cell] || (acc[c] == acc[best_cell] && c < best_cell)) best_cell = c;
+    const uint32_t* best = &acc[best_cell];
+    const size_t cell = best_cell;
     const size_t mr = cell / static_cast<size_t>(n_alpha);
     const int bin = static_cast<int>(cell % static_cast<size_t>(n_alpha));
     const float alpha = static_cast<float>((bin + 0.5) * m.angle_step - M_PI);
