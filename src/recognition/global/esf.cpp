@@ -16,16 +16,9 @@ constexpr int kB = kEsfBinsPerHistogram;
 
 enum Cls { kOn = 0, kOff = 1, kMixed = 2 };
 
-// Round-to-nearest of num / den for den > 0 (halves rounded up), exact in
-// integers for negative numerators too.
-inline int round_div(int num, int den) {
-  const int n2 = 2 * num + den, d2 = 2 * den;
-  return n2 >= 0 ? n2 / d2 : -((-n2 + d2 - 1) / d2);
-}
-
 class OccupancyGrid {
  public:
-  OccupancyGrid() : cells_(static_cast<size_t>(kG) * kG * kG, 0) {}
+  OccupancyGrid() : bits_((static_cast<size_t>(kG) * kG * kG + 63) / 64, 0) {}
   static int cell(float c) { return std::clamp(static_cast<int>(std::floor(c)) + kHalf, 0, kG - 1); }
   static Eigen::Vector3i cell(const Vec3f& p) { return {cell(p.x()), cell(p.y()), cell(p.z())}; }
   // Marks the voxel of p and its 26 neighbours.
@@ -35,14 +28,18 @@ class OccupancyGrid {
         for (int dz = -1; dz <= 1; ++dz) {
           const int x = v.x() + dx, y = v.y() + dy, z = v.z() + dz;
           if (x < 0 || y < 0 || z < 0 || x >= kG || y >= kG || z >= kG) continue;
-          cells_[index(x, y, z)] = 1;
+          const size_t i = index(x, y, z);
+          bits_[i >> 6] |= uint64_t(1) << (i & 63);
         }
   }
-  bool occupied(int x, int y, int z) const { return cells_[index(x, y, z)] != 0; }
+  bool occupied(int x, int y, int z) const {
+    const size_t i = index(x, y, z);
+    return (bits_[i >> 6] >> (i & 63)) & 1;
+  }
 
  private:
   static size_t index(int x, int y, int z) { return (static_cast<size_t>(x) * kG + y) * kG + z; }
-  std::vector<uint8_t> cells_;
+  std::vector<uint64_t> bits_;  // one bit per voxel: the whole grid stays in the L1 cache
 };
 
 struct Line {
@@ -54,16 +51,45 @@ struct Line {
 
 // Traces the line from voxel a toward voxel b: max(|d|) voxels (at least
 // one), a included, b excluded, the minor axes rounded to nearest.
+// One coordinate of the traced line: a + (d i / n rounded to nearest, halves
+// up) for i = 0, 1, ..., that is a + floor((2 d i + n) / (2 n)), exact in
+// integers for negative d too, updated incrementally (no division per step).
+struct Stepper {
+  int value, rem, step, den;  // value = a + floor(num / den), 0 <= rem < den
+  Stepper(int a, int d, int n) : den(2 * n) {
+    const int num = n;  // i = 0: (2 d 0 + n)
+    value = a + num / den;  // num >= 0
+    rem = num % den;
+    step = 2 * d;
+  }
+  void next() {
+    rem += step;
+    while (rem >= den) {
+      rem -= den;
+      ++value;
+    }
+    while (rem < 0) {
+      rem += den;
+      --value;
+    }
+  }
+};
+
 Line trace(const OccupancyGrid& g, const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
   const Eigen::Vector3i d = b - a;
   const int n = std::max({std::abs(d.x()), std::abs(d.y()), std::abs(d.z())});
   Line L;
   L.count = std::max(n, 1);
-  for (int i = 0; i < L.count; ++i) {
-    const int x = n ? a.x() + round_div(d.x() * i, n) : a.x();
-    const int y = n ? a.y() + round_div(d.y() * i, n) : a.y();
-    const int z = n ? a.z() + round_div(d.z() * i, n) : a.z();
-    L.occupied += g.occupied(x, y, z) ? 1 : 0;
+  if (n == 0) {
+    L.occupied = g.occupied(a.x(), a.y(), a.z()) ? 1 : 0;
+  } else {
+    Stepper x(a.x(), d.x(), n), y(a.y(), d.y(), n), z(a.z(), d.z(), n);
+    for (int i = 0; i < L.count; ++i) {
+      L.occupied += g.occupied(x.value, y.value, z.value) ? 1 : 0;
+      x.next();
+      y.next();
+      z.next();
+    }
   }
   if (L.occupied >= L.count - 1) {
     L.cls = kOn;
