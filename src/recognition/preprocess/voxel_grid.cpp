@@ -13,13 +13,21 @@ namespace {
 using Key = std::array<int64_t, 3>;  // cell index, in sort priority order
 
 // The spatial hash of Teschner et al. 2003 (hash-table buckets only, never
-// persisted: the output order comes from sorting the keys).
-struct KeyHash {
-  size_t operator()(const Key& k) const {
-    return static_cast<size_t>((static_cast<uint64_t>(k[0]) * 73856093u) ^ (static_cast<uint64_t>(k[1]) * 19349663u) ^
-                               (static_cast<uint64_t>(k[2]) * 83492791u));
-  }
-};
+// persisted: the output order comes from sorting the keys), and a 64-bit
+// finalizer that folds the high bits in (the table masks keep the low ones).
+inline uint64_t key_hash(const Key& k) {
+  return (static_cast<uint64_t>(k[0]) * 73856093u) ^ (static_cast<uint64_t>(k[1]) * 19349663u) ^
+         (static_cast<uint64_t>(k[2]) * 83492791u);
+}
+inline uint64_t key_hash(uint64_t k) { return k; }
+template <class K>
+inline uint64_t mix(const K& k) {
+  uint64_t h = key_hash(k);
+  h ^= h >> 33;
+  h *= 0xff51afd7ed558ccdull;
+  h ^= h >> 33;
+  return h;
+}
 
 // Points grouped by cell: cell_of[i] (or -1), cells in output order, the
 // first point of each cell and its count.
@@ -38,7 +46,10 @@ inline int64_t floor_to_int(double x) {
 }
 
 // Open addressing over the cell keys (linear probing, power-of-two
-// capacity, grown at half load): no allocation per cell.
+// capacity, grown at half load): no allocation per cell. A small
+// direct-mapped cache in front (the cells of the last image rows fit in it)
+// saves most probes of the large table.
+template <class K>
 class KeyTable {
  public:
   explicit KeyTable(size_t expected) {
@@ -48,54 +59,36 @@ class KeyTable {
     slots_.assign(cap, -1);
   }
   // The slot of k, inserting `fresh` when k is new (then *inserted = true).
-  // A small direct-mapped cache in front (the cells of the last image rows
-  // fit in it) saves most probes of the large table.
-  int find_or_insert(const Key& k, int fresh, bool* inserted) {
+  int find_or_insert(const K& k, int fresh, bool* inserted) {
     const uint64_t h = mix(k);
     Recent& r = recent_[h & (kRecent - 1)];
     if (r.slot >= 0 && r.key == k) {
       *inserted = false;
       return r.slot;
     }
-    const int s = probe(k, h, fresh, inserted);
+    if (2 * (size_ + 1) > slots_.size()) grow();
+    size_t i = static_cast<size_t>(h) & (slots_.size() - 1);
+    *inserted = false;
+    while (slots_[i] >= 0 && !(keys_[i] == k)) i = (i + 1) & (slots_.size() - 1);
+    if (slots_[i] < 0) {
+      keys_[i] = k;
+      slots_[i] = fresh;
+      ++size_;
+      *inserted = true;
+    }
     r.key = k;
-    r.slot = s;
-    return s;
+    r.slot = slots_[i];
+    return slots_[i];
   }
 
  private:
   static constexpr size_t kRecent = 2048;
   struct Recent {
-    Key key{};
+    K key{};
     int slot = -1;
   };
-  static uint64_t mix(const Key& k) {  // the hash with its high bits folded in (masks keep the low ones)
-    uint64_t h = KeyHash()(k);
-    h ^= h >> 33;
-    h *= 0xff51afd7ed558ccdull;
-    h ^= h >> 33;
-    return h;
-  }
-  size_t home(const Key& k) const { return static_cast<size_t>(mix(k)) & (slots_.size() - 1); }
-  int probe(const Key& k, uint64_t h, int fresh, bool* inserted) {
-    if (2 * (size_ + 1) > slots_.size()) grow();
-    size_t i = static_cast<size_t>(h) & (slots_.size() - 1);
-    while (slots_[i] >= 0) {
-      if (keys_[i] == k) {
-        *inserted = false;
-        return slots_[i];
-      }
-      i = (i + 1) & (slots_.size() - 1);
-    }
-    keys_[i] = k;
-    slots_[i] = fresh;
-    ++size_;
-    *inserted = true;
-    return fresh;
-  }
-
   void grow() {
-    std::vector<Key> keys;
+    std::vector<K> keys;
     std::vector<int> slots;
     keys.swap(keys_);
     slots.swap(slots_);
@@ -103,36 +96,32 @@ class KeyTable {
     slots_.assign(2 * slots.size(), -1);
     for (size_t j = 0; j < slots.size(); ++j) {
       if (slots[j] < 0) continue;
-      size_t i = home(keys[j]);
+      size_t i = static_cast<size_t>(mix(keys[j])) & (slots_.size() - 1);
       while (slots_[i] >= 0) i = (i + 1) & (slots_.size() - 1);
       keys_[i] = keys[j];
       slots_[i] = slots[j];
     }
   }
-  std::vector<Key> keys_;
+  std::vector<K> keys_;
   std::vector<int> slots_;
   size_t size_ = 0;
   std::vector<Recent> recent_ = std::vector<Recent>(kRecent);
 };
 
-Cells group(const std::vector<Vec3f>& pts, const VoxelGridOptions& opt) {
-  const size_t n = pts.size();
-  const double inv = 1.0 / opt.leaf_mm;
+// The cell keys of the points in first-appearance order, grouped: key_of(i)
+// gives point i's key, `skip(i)` says it has none.
+template <class K, class KeyOf, class Skip>
+Cells group_by(size_t n, KeyOf key_of, Skip skip, std::vector<K>& keys) {
   Cells c;
   c.cell_of.assign(n, -1);
-  KeyTable slot(n / 8 + 16);
-  std::vector<Key> keys;
-  Key last{};
+  KeyTable<K> slot(n / 8 + 16);
+  K last{};
   int last_slot = -1;  // consecutive points (neighbouring pixels) mostly share a cell
   for (size_t i = 0; i < n; ++i) {
-    const Vec3f& p = pts[i];
-    if (!p.allFinite()) continue;
-    int64_t a[3];
-    for (int d = 0; d < 3; ++d)
-      a[d] = floor_to_int(opt.cell_index == VoxelGridOptions::CellIndex::kDivide ? p[d] / opt.leaf_mm : p[d] * inv);
-    const Key k = opt.order == VoxelGridOptions::Order::kZYX ? Key{a[2], a[1], a[0]} : Key{a[0], a[1], a[2]};
+    if (skip(i)) continue;
+    const K k = key_of(i);
     int s = last_slot;
-    if (s < 0 || k != last) {
+    if (s < 0 || !(k == last)) {
       bool fresh = false;
       s = slot.find_or_insert(k, static_cast<int>(keys.size()), &fresh);
       if (fresh) {
@@ -146,29 +135,11 @@ Cells group(const std::vector<Vec3f>& pts, const VoxelGridOptions& opt) {
     ++c.count[static_cast<size_t>(s)];
     c.cell_of[i] = s;
   }
-  // Renumber the cells in key order: keys packed into one integer (21 bits
-  // per axis, offset by the minimum: the same order) when they fit, else
-  // compared as triples.
-  std::vector<int> order(keys.size());
-  Key lo = keys.empty() ? Key{} : keys[0], hi = lo;
-  for (const Key& k : keys)
-    for (int d = 0; d < 3; ++d) {
-      lo[d] = std::min(lo[d], k[d]);
-      hi[d] = std::max(hi[d], k[d]);
-    }
-  constexpr int64_t kSpan = int64_t(1) << 21;
-  if (hi[0] - lo[0] < kSpan && hi[1] - lo[1] < kSpan && hi[2] - lo[2] < kSpan) {
-    std::vector<std::pair<uint64_t, int>> packed(keys.size());
-    for (size_t k = 0; k < keys.size(); ++k)
-      packed[k] = {(static_cast<uint64_t>(keys[k][0] - lo[0]) << 42) | (static_cast<uint64_t>(keys[k][1] - lo[1]) << 21) |
-                       static_cast<uint64_t>(keys[k][2] - lo[2]),
-                   static_cast<int>(k)};
-    std::sort(packed.begin(), packed.end());
-    for (size_t k = 0; k < order.size(); ++k) order[k] = packed[k].second;
-  } else {
-    for (size_t k = 0; k < order.size(); ++k) order[k] = static_cast<int>(k);
-    std::sort(order.begin(), order.end(), [&](int x, int y) { return keys[x] < keys[y]; });
-  }
+  return c;
+}
+
+// Renumbers the cells of c in the order `order` (cell ids, output order).
+Cells renumber(Cells c, const std::vector<int>& order) {
   std::vector<int> rank(order.size());
   for (size_t r = 0; r < order.size(); ++r) rank[static_cast<size_t>(order[r])] = static_cast<int>(r);
   Cells out;
@@ -182,6 +153,59 @@ Cells group(const std::vector<Vec3f>& pts, const VoxelGridOptions& opt) {
   for (int& k : out.cell_of)
     if (k >= 0) k = rank[static_cast<size_t>(k)];
   return out;
+}
+
+// Groups the points by cell, cells in key order (PCL's: z, then y, then x
+// for kZYX). When every axis spans fewer than 2^21 cells (always, for images
+// at sensor range and millimetre-scale leaves) the key is one integer, 21
+// bits per axis above the minimum cell, in priority order: hashing,
+// comparing and sorting it is cheap, and its order is the triple's.
+// Otherwise the triple itself is the key.
+Cells group(const std::vector<Vec3f>& pts, const VoxelGridOptions& opt) {
+  const size_t n = pts.size();
+  const double inv = 1.0 / opt.leaf_mm;
+  const bool divide = opt.cell_index == VoxelGridOptions::CellIndex::kDivide;
+  auto cell = [&](float v) { return floor_to_int(divide ? v / opt.leaf_mm : v * inv); };
+  const int ax[3] = {opt.order == VoxelGridOptions::Order::kZYX ? 2 : 0, 1,
+                     opt.order == VoxelGridOptions::Order::kZYX ? 0 : 2};  // priority order of the axes
+  auto skip = [&](size_t i) { return !pts[i].allFinite(); };
+  Eigen::AlignedBox3f box;
+  for (size_t i = 0; i < n; ++i)
+    if (!skip(i)) box.extend(pts[i]);
+  if (box.isEmpty()) return Cells{std::vector<int>(n, -1), {}, {}};
+  int64_t lo[3], span = 0;
+  for (int d = 0; d < 3; ++d) {
+    lo[d] = cell(box.min()[ax[d]]);  // the cell index is monotonic in the coordinate
+    span = std::max(span, cell(box.max()[ax[d]]) - lo[d]);
+  }
+  std::vector<int> order;
+  auto sorted_order = [&order](auto& keyed) {
+    std::sort(keyed.begin(), keyed.end());
+    order.resize(keyed.size());
+    for (size_t k = 0; k < keyed.size(); ++k) order[k] = keyed[k].second;
+  };
+  if (span < (int64_t(1) << 21)) {
+    std::vector<uint64_t> keys;
+    Cells c = group_by<uint64_t>(
+        n,
+        [&](size_t i) {
+          const Vec3f& p = pts[i];
+          return (static_cast<uint64_t>(cell(p[ax[0]]) - lo[0]) << 42) |
+                 (static_cast<uint64_t>(cell(p[ax[1]]) - lo[1]) << 21) | static_cast<uint64_t>(cell(p[ax[2]]) - lo[2]);
+        },
+        skip, keys);
+    std::vector<std::pair<uint64_t, int>> keyed(keys.size());
+    for (size_t k = 0; k < keys.size(); ++k) keyed[k] = {keys[k], static_cast<int>(k)};
+    sorted_order(keyed);
+    return renumber(std::move(c), order);
+  }
+  std::vector<Key> keys;
+  Cells c = group_by<Key>(
+      n, [&](size_t i) { return Key{cell(pts[i][ax[0]]), cell(pts[i][ax[1]]), cell(pts[i][ax[2]])}; }, skip, keys);
+  std::vector<std::pair<Key, int>> keyed(keys.size());
+  for (size_t k = 0; k < keys.size(); ++k) keyed[k] = {keys[k], static_cast<int>(k)};
+  sorted_order(keyed);
+  return renumber(std::move(c), order);
 }
 
 // Centroids accumulated in input order (double).
