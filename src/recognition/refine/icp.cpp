@@ -23,6 +23,7 @@
 //                    squared correspondence distance changing by less than
 //                    fitness_epsilon (relative) or 1e-12 (absolute); fewer
 //                    than 3 correspondences ends it unconverged.
+// Both use icp_sample_points (a seeded random subset of the source points).
 // Frame and units: internal.h (metres, local frame).
 #include <Eigen/Dense>
 #include <algorithm>
@@ -140,8 +141,7 @@ enum class Metric { kPoint, kPlane };
 Outcome icp(const Problem& p, const RefineSettings& s, uint64_t seed, Metric metric) {
   Outcome o;
   std::vector<Vec3f> src;
-  for (size_t i : sample_indices(p.src.size(), metric == Metric::kPoint ? s.icp_sample_points : 0, seed))
-    src.push_back(p.src[i]);
+  for (size_t i : sample_indices(p.src.size(), s.icp_sample_points, seed)) src.push_back(p.src[i]);
   if (src.size() < 3 || p.tgt.size() < 3) return o;
   const KdTree3 tgt_tree(p.tgt);
   const KdTree3 src_tree = s.reciprocal_correspondences ? KdTree3(src) : KdTree3();

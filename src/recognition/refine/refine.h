@@ -26,7 +26,8 @@ struct RefineSettings {
   bool reciprocal_correspondences = true;  // ICP, ICP-LM, ICP-plane: keep only mutual nearest
                                            // neighbours (PCL's reciprocal correspondences); makes
                                            // them robust to surface seen in one cloud only
-  int icp_sample_points = 0;               // ICP point-to-point: random subset of source points (0 = all)
+  int icp_sample_points = 0;               // icp, icp_plane (and icp_pcl): seeded random subset of
+                                           // this many source points (0 = all)
   double ndt_resolution_mm = 30.0;         // NDT grid cell, at least this (a planar cell needs about
                                            // 6 scene points: >= 2.5 x the scene voxel; 30 mm for the
                                            // table's 10 mm voxel)
