@@ -25,8 +25,9 @@ struct LocalSettings {
   bool hough_interpolation = false;     // spread each vote over the 8 nearest bins (PCL option;
                                         // off: one vote per correspondence, as the thesis)
   int max_hypotheses = 10;              // at most this many clusters go on to refinement
-  int threads = 0;                      // OpenMP threads for FPFH / SHOT / matching (0 = all
-                                        // cores); results are identical for any value
+  int threads = 0;                      // OpenMP threads for FPFH / SHOT / matching (0 = OpenMP's
+                                        // count: OMP_NUM_THREADS, all cores when unset); results are
+                                        // identical for any value
 
   template <class S, class F>
   static void fields(S& s, F& f) {

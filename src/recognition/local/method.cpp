@@ -27,7 +27,7 @@ using namespace local;
 
 int omp_threads(int threads) {
 #ifdef _OPENMP
-  return threads > 0 ? threads : omp_get_num_procs();
+  return threads > 0 ? threads : omp_get_max_threads();  // OMP_NUM_THREADS, as run gives its workers
 #else
   return 1;
 #endif

@@ -5,6 +5,10 @@
 // keypoint.
 #pragma once
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include <pcl/search/kdtree.h>
 
 #include <limits>
@@ -36,7 +40,14 @@ std::vector<float> describe_keypoints(Estimator& est, const PointSet& cloud, con
                                       double radius_mm, int threads, int dim, Values values, bool zero_is_invalid) {
   std::vector<float> out(keypoints.size() * dim, std::numeric_limits<float>::quiet_NaN());
   if (keypoints.empty() || !cloud.has_normals()) return out;
-  est.setNumberOfThreads(threads < 0 ? 0u : static_cast<unsigned>(threads));
+  // 0 = OpenMP's thread count (OMP_NUM_THREADS; PCL's own 0 would take
+  // every core and oversubscribe `run --jobs N`).
+#ifdef _OPENMP
+  if (threads <= 0) threads = omp_get_max_threads();
+#else
+  threads = 1;
+#endif
+  est.setNumberOfThreads(static_cast<unsigned>(threads));
   pcl::PointCloud<Signature> desc;
   if (!estimate_at_keypoints(est, cloud, keypoints, radius_mm, desc)) return out;
   for (size_t i = 0; i < desc.size(); ++i) {

@@ -22,8 +22,9 @@ namespace pb::detail {
 std::vector<char> ransac_plane(const std::vector<Vec3f>& points, double threshold_mm, int iterations,
                                uint64_t seed, Eigen::Vector4d* plane = nullptr, int sample_points = 0);
 
-// Normals by PCA of the neighbours within `radius_mm` (pcl::NormalEstimationOMP
-// on a kd-tree, one thread per omp_get_max_threads()), flipped toward the
+// Normals by PCA of the neighbours within `radius_mm` (the point included, as
+// pcl::NormalEstimation; the project's kd-tree, OpenMP threads per
+// omp_get_max_threads(), the same result for any count), flipped toward the
 // viewpoint (origin), and the surface variation as curvature. Points whose
 // normal cannot be estimated (fewer than 3 neighbours) are dropped, with
 // their pixel.
