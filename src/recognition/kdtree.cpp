@@ -77,48 +77,38 @@ int KdTree3::nearest(const Vec3f& q, float* sq_dist, float max_sq_dist) const {
   return best;
 }
 
-void KdTree3::radius_in(int node, const Vec3f& q, float r2, std::vector<std::pair<float, int>>& out) const {
+template <class F>
+void KdTree3::visit_radius(int node, const Vec3f& q, float r2, F& f) const {
   const Node& n = nodes_[static_cast<size_t>(node)];
   if (n.dim < 0) {
     for (int i = n.begin; i < n.end; ++i) {
       const float d = (points_[static_cast<size_t>(i)] - q).squaredNorm();
-      if (d <= r2) out.emplace_back(d, order_[static_cast<size_t>(i)]);
+      if (d <= r2) f(d, order_[static_cast<size_t>(i)]);
     }
     return;
   }
   const float diff = q[n.dim] - n.split;
   const int near = diff < 0 ? n.left : n.right, far = diff < 0 ? n.right : n.left;
-  radius_in(near, q, r2, out);
-  if (diff * diff <= r2) radius_in(far, q, r2, out);
+  visit_radius(near, q, r2, f);
+  if (diff * diff <= r2) visit_radius(far, q, r2, f);
 }
 
 void KdTree3::radius(const Vec3f& q, float r, std::vector<int>& out) const {
   out.clear();
   if (nodes_.empty() || !q.allFinite() || !(r > 0)) return;
   std::vector<std::pair<float, int>> found;
-  radius_in(0, q, r * r, found);
+  auto add = [&found](float d, int i) { found.emplace_back(d, i); };
+  visit_radius(0, q, r * r, add);
   std::sort(found.begin(), found.end());
   out.reserve(found.size());
   for (const auto& f : found) out.push_back(f.second);
 }
 
-void KdTree3::radius_idx(int node, const Vec3f& q, float r2, std::vector<int>& out) const {
-  const Node& n = nodes_[static_cast<size_t>(node)];
-  if (n.dim < 0) {
-    for (int i = n.begin; i < n.end; ++i)
-      if ((points_[static_cast<size_t>(i)] - q).squaredNorm() <= r2) out.push_back(order_[static_cast<size_t>(i)]);
-    return;
-  }
-  const float diff = q[n.dim] - n.split;
-  const int near = diff < 0 ? n.left : n.right, far = diff < 0 ? n.right : n.left;
-  radius_idx(near, q, r2, out);
-  if (diff * diff <= r2) radius_idx(far, q, r2, out);
-}
-
 void KdTree3::radius_unsorted(const Vec3f& q, float r, std::vector<int>& out) const {
   out.clear();
   if (nodes_.empty() || !q.allFinite() || !(r > 0)) return;
-  radius_idx(0, q, r * r, out);
+  auto add = [&out](float, int i) { out.push_back(i); };
+  visit_radius(0, q, r * r, add);
 }
 
 }  // namespace pb

@@ -37,8 +37,9 @@ class KdTree3 {
   };
   int build(int begin, int end, int leaf_size);
   void nearest_in(int node, const Vec3f& q, int& best, float& best_d) const;
-  void radius_in(int node, const Vec3f& q, float r2, std::vector<std::pair<float, int>>& out) const;
-  void radius_idx(int node, const Vec3f& q, float r2, std::vector<int>& out) const;
+  // Calls f(squared distance, input index) for every point within sqrt(r2).
+  template <class F>
+  void visit_radius(int node, const Vec3f& q, float r2, F& f) const;
 
   std::vector<Vec3f> points_;  // in tree order (cache friendly)
   std::vector<int> order_;     // tree position -> input index
