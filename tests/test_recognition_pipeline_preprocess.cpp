@@ -86,6 +86,13 @@ TEST(Ransac, SubsetScoringSelectsThePlaneAmongAllPoints) {
   EXPECT_GE(on, 19900);
   EXPECT_EQ(outliers_on, 0);
   EXPECT_EQ(flags, pb::detail::ransac_plane(pts, 5.0, 100, 9, nullptr, 500));
+  // The adaptive stop (probability 0.99: with 87% of the points on the
+  // plane a handful of samples suffice) finds the same plane.
+  const auto early = pb::detail::ransac_plane(pts, 5.0, 100, 9, nullptr, 500, 0.99);
+  int differ = 0;
+  for (size_t i = 0; i < pts.size(); ++i) differ += early[i] != flags[i];
+  EXPECT_LE(differ, 100);  // boundary points of the 5 mm band (of 23000)
+  for (size_t i = 20000; i < pts.size(); ++i) EXPECT_FALSE(early[i]) << i;
 }
 
 // A floor and a wall (the warehouse): max_planes 1 removes the larger one,

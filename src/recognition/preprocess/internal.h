@@ -16,11 +16,15 @@ namespace pb::detail {
 // squares refit on its inliers and a final inlier selection. With
 // sample_points > 0 (and fewer than the cloud has), the triples are drawn
 // from and scored on a seeded random subset of that many points; the
-// winner's inliers are then selected among all points. Returns the inlier
-// flags; `plane` (n, d with n.p + d = 0) when not null. Fewer than 3 points
-// or no valid sample: all false.
+// winner's inliers are then selected among all points. With probability
+// below 1 it stops early, as PCL's RandomSampleConsensus: once the
+// iterations done make it that likely that a sample of three inliers of the
+// best plane so far was drawn. Returns the inlier flags; `plane` (n, d with
+// n.p + d = 0) when not null. Fewer than 3 points or no valid sample: all
+// false.
 std::vector<char> ransac_plane(const std::vector<Vec3f>& points, double threshold_mm, int iterations,
-                               uint64_t seed, Eigen::Vector4d* plane = nullptr, int sample_points = 0);
+                               uint64_t seed, Eigen::Vector4d* plane = nullptr, int sample_points = 0,
+                               double probability = 1.0);
 
 // Normals by PCA of the neighbours within `radius_mm` (the point included, as
 // pcl::NormalEstimation; the project's kd-tree, OpenMP threads per

@@ -88,7 +88,7 @@ size_t within(const std::vector<Vec3f>& pts, const Eigen::Vector4d& plane, doubl
 }  // namespace
 
 std::vector<char> ransac_plane(const std::vector<Vec3f>& all, double thr, int iterations, uint64_t seed,
-                               Eigen::Vector4d* plane_out, int sample_points) {
+                               Eigen::Vector4d* plane_out, int sample_points, double probability) {
   const size_t n = all.size();
   std::vector<char> flags(n, 0);
   if (n < 3) return flags;
@@ -118,6 +118,16 @@ std::vector<char> ransac_plane(const std::vector<Vec3f>& all, double thr, int it
     if (cnt > best_count) {
       best_count = cnt;
       best = plane;
+      // Adaptive stop (as PCL's RandomSampleConsensus): enough iterations
+      // that a sample of three inliers of the best plane so far was drawn
+      // with `probability`.
+      if (probability < 1) {
+        const double w = static_cast<double>(cnt) / static_cast<double>(pts.size());
+        const double p_good = w * w * w;
+        if (p_good >= 1) break;
+        const double needed = std::log(1 - probability) / std::log(1 - p_good);
+        iterations = static_cast<int>(std::min<double>(iterations, std::ceil(needed)));
+      }
     }
   }
   if (best_count < 3) return flags;
@@ -144,6 +154,8 @@ PointSet range_cut(const OrganizedCloud& cloud, double min_z, double max_z) {
   PointSet ps;
   ps.source_width = cloud.width;
   ps.source_height = cloud.height;
+  ps.points.reserve(cloud.points.size());
+  ps.pixel.reserve(cloud.points.size());
   for (size_t i = 0; i < cloud.points.size(); ++i) {
     const Vec3f& p = cloud.points[i];
     if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) continue;
@@ -164,7 +176,7 @@ PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings&
     for (int k = 0; k < s.max_planes && ps.size() >= 3; ++k) {
       const std::vector<char> on_plane = detail::ransac_plane(ps.points, s.plane_threshold_mm, s.plane_iterations,
                                                               k == 0 ? seed : derive_seed(seed, {static_cast<uint64_t>(k)}), nullptr,
-                                                              s.plane_sample_points);
+                                                              s.plane_sample_points, s.plane_probability);
       const size_t cnt = static_cast<size_t>(std::count(on_plane.begin(), on_plane.end(), 1));
       if (cnt == 0 || static_cast<double>(cnt) < min_count) break;
       std::vector<char> keep(on_plane.size());

@@ -15,7 +15,12 @@ struct PreprocessSettings {
   double voxel_mm = 10.0;           // downsampling voxel (Table 4.2: 20 warehouse, 10 table)
   bool remove_plane = true;         // remove the dominant plane (floor / table)
   double plane_threshold_mm = 10.0; // RANSAC inlier distance for the plane
-  int plane_iterations = 200;       // RANSAC iterations
+  int plane_iterations = 200;       // RANSAC iterations, at most
+  double plane_probability = 1.0;   // < 1: RANSAC stops once a sample of three inliers of the best
+                                    // plane so far was drawn with this probability (PCL's
+                                    // RandomSampleConsensus, 0.99 there); 1 = always
+                                    // plane_iterations. Measured at 0.99: table frames 3 ms faster,
+                                    // Table 4.1 153 of 300 correct instead of 156 (results/bench)
   double min_plane_fraction = 0.2;  // remove a plane only if it holds this fraction (of the points
                                     // before any plane was removed)
   int max_planes = 1;               // dominant planes removed one after the other (thesis: 1, the
@@ -33,6 +38,7 @@ struct PreprocessSettings {
     f("remove_plane", s.remove_plane);
     f("plane_threshold_mm", s.plane_threshold_mm, fields::positive());
     f("plane_iterations", s.plane_iterations, fields::at_least(1));
+    f("plane_probability", s.plane_probability, fields::in_range(0, 1));
     f("min_plane_fraction", s.min_plane_fraction, fields::in_range(0, 1));
     f("max_planes", s.max_planes, fields::at_least(0));
     f("plane_sample_points", s.plane_sample_points, fields::at_least(0));
