@@ -13,7 +13,11 @@ KdTree3::KdTree3(const std::vector<Vec3f>& points, int leaf_size) {
   nodes_.reserve(2 * points.size() / static_cast<size_t>(std::max(1, leaf_size)) + 2);
   build(0, static_cast<int>(points.size()), std::max(1, leaf_size));
   std::vector<Vec3f> sorted(points.size());
-  for (size_t i = 0; i < order_.size(); ++i) sorted[i] = points[static_cast<size_t>(order_[i])];
+  position_.resize(points.size());
+  for (size_t i = 0; i < order_.size(); ++i) {
+    sorted[i] = points[static_cast<size_t>(order_[i])];
+    position_[static_cast<size_t>(order_[i])] = static_cast<int>(i);
+  }
   points_.swap(sorted);
 }
 
@@ -69,9 +73,17 @@ void KdTree3::nearest_in(int node, const Vec3f& q, int& best, float& best_d) con
   if (diff * diff <= best_d) nearest_in(far, q, best, best_d);
 }
 
-int KdTree3::nearest(const Vec3f& q, float* sq_dist, float max_sq_dist) const {
+int KdTree3::nearest(const Vec3f& q, float* sq_dist, float max_sq_dist, int hint) const {
   int best = -1;
   float best_d = max_sq_dist;
+  if (hint >= 0 && static_cast<size_t>(hint) < position_.size()) {
+    // Equal distances still reach the lower index: the pruning keeps ties.
+    const float d = (points_[static_cast<size_t>(position_[static_cast<size_t>(hint)])] - q).squaredNorm();
+    if (d < best_d) {
+      best_d = d;
+      best = hint;
+    }
+  }
   if (!nodes_.empty() && q.allFinite()) nearest_in(0, q, best, best_d);
   if (sq_dist) *sq_dist = best >= 0 ? best_d : std::numeric_limits<float>::infinity();
   return best;

@@ -18,9 +18,11 @@ class KdTree3 {
   explicit KdTree3(const std::vector<Vec3f>& points, int leaf_size = 8);
 
   // The nearest point with squared distance below max_sq_dist (index, or -1
-  // when none); its squared distance in *sq_dist.
+  // when none); its squared distance in *sq_dist. `hint` (an input index, or
+  // -1), a point likely near q (ICP: the previous iteration's match), only
+  // tightens the search bound from the start: the answer is the same.
   int nearest(const Vec3f& q, float* sq_dist = nullptr,
-              float max_sq_dist = std::numeric_limits<float>::infinity()) const;
+              float max_sq_dist = std::numeric_limits<float>::infinity(), int hint = -1) const;
   // Every point within r (squared distance <= r^2), sorted by distance, then
   // index.
   void radius(const Vec3f& q, float r, std::vector<int>& out) const;
@@ -43,6 +45,7 @@ class KdTree3 {
 
   std::vector<Vec3f> points_;  // in tree order (cache friendly)
   std::vector<int> order_;     // tree position -> input index
+  std::vector<int> position_;  // input index -> tree position
   std::vector<Node> nodes_;
 };
 

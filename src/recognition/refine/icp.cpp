@@ -62,8 +62,11 @@ struct Pair {
 using Mat4 = Eigen::Matrix4d;
 
 // Correspondences of the source points moved by T (see the file comment).
+// `last[i]`: source point i's match of the previous iteration (or -1), the
+// target search's starting bound (the same answer, found sooner).
 void correspond(const std::vector<Vec3f>& src, const KdTree3& src_tree, const std::vector<Vec3f>& tgt,
-                const KdTree3& tgt_tree, const Mat4& T, const RefineSettings& s, std::vector<Pair>& out) {
+                const KdTree3& tgt_tree, const Mat4& T, const RefineSettings& s, std::vector<int>& last,
+                std::vector<Pair>& out) {
   out.clear();
   const double max_m = s.max_correspondence_mm * 1e-3;
   const float max2 = std::nextafter(static_cast<float>(max_m * max_m), std::numeric_limits<float>::infinity());
@@ -73,11 +76,12 @@ void correspond(const std::vector<Vec3f>& src, const KdTree3& src_tree, const st
   for (size_t i = 0; i < src.size(); ++i) {
     const Vec3f q = R * src[i] + t;
     float d2 = 0;
-    const int j = tgt_tree.nearest(q, &d2, max2);
+    const int j = tgt_tree.nearest(q, &d2, max2, last[i]);
+    last[i] = j;
     if (j < 0) continue;
     if (s.reciprocal_correspondences) {
       const Vec3f back = Ri * (tgt[static_cast<size_t>(j)] - t);
-      if (src_tree.nearest(back, nullptr, max2) != static_cast<int>(i)) continue;
+      if (src_tree.nearest(back, nullptr, max2, static_cast<int>(i)) != static_cast<int>(i)) continue;
     }
     out.push_back({static_cast<int>(i), j, d2});
   }
@@ -149,8 +153,9 @@ Outcome icp(const Problem& p, const RefineSettings& s, uint64_t seed, Metric met
   Mat4 T = Mat4::Identity();
   double prev_mse = std::numeric_limits<double>::max();
   std::vector<Pair> c;
+  std::vector<int> last(src.size(), -1);
   while (true) {
-    correspond(src, src_tree, p.tgt, tgt_tree, T, s, c);
+    correspond(src, src_tree, p.tgt, tgt_tree, T, s, last, c);
     if (c.size() < 3) break;  // unconverged, the transform so far stands
     const Mat4 D = metric == Metric::kPoint ? step_point(src, p.tgt, T, c) : step_plane(src, p.tgt, p.tgt_normals, T, c);
     if (!D.allFinite()) break;
