@@ -37,14 +37,20 @@ TEST(Voxel, CentroidsPclOrderAndNearestPixel) {
   EXPECT_EQ(pb::voxel_downsample(in, {10.0}).size(), 2u);
 }
 
+// n points of the plane z = ax x + ay y + z0 over |x|, |y| < half, with
+// 1 mm Gaussian noise along z.
+void add_noisy_plane(pb::Rng& rng, int n, double half, double ax, double ay, double z0, std::vector<Vec3f>& pts) {
+  for (int i = 0; i < n; ++i) {
+    const double x = rng.uniform(-half, half), y = rng.uniform(-half, half);
+    pts.emplace_back(x, y, ax * x + ay * y + z0 + rng.normal(0, 1));
+  }
+}
+
 TEST(Ransac, FindsThePlaneDeterministically) {
   pb::Rng rng(3);
   std::vector<Vec3f> pts;
   // A tilted plane z = 0.2 x + 500 with 1 mm noise, 2000 points, plus 500 outliers above it.
-  for (int i = 0; i < 2000; ++i) {
-    const double x = rng.uniform(-300, 300), y = rng.uniform(-300, 300);
-    pts.emplace_back(x, y, 0.2 * x + 500 + rng.normal(0, 1));
-  }
+  add_noisy_plane(rng, 2000, 300, 0.2, 0, 500, pts);
   for (int i = 0; i < 500; ++i) {
     const double x = rng.uniform(-50, 50), y = rng.uniform(-50, 50);
     pts.emplace_back(x, y, 0.2 * x + 500 - rng.uniform(20, 120));
@@ -72,10 +78,7 @@ TEST(Ransac, FindsThePlaneDeterministically) {
 TEST(Ransac, SubsetScoringSelectsThePlaneAmongAllPoints) {
   pb::Rng rng(5);
   std::vector<Vec3f> pts;
-  for (int i = 0; i < 20000; ++i) {
-    const double x = rng.uniform(-400, 400), y = rng.uniform(-400, 400);
-    pts.emplace_back(x, y, 0.1 * y + 800 + rng.normal(0, 1));
-  }
+  add_noisy_plane(rng, 20000, 400, 0, 0.1, 800, pts);
   for (int i = 0; i < 3000; ++i) pts.emplace_back(rng.uniform(-60, 60), rng.uniform(-60, 60), rng.uniform(600, 760));
   const auto flags = pb::detail::ransac_plane(pts, 5.0, 100, 9, nullptr, 500);
   int on = 0, outliers_on = 0;

@@ -9,7 +9,6 @@
 // budget each scenario is held to. It is a run underneath: resumable, and
 // a second call only re-summarizes.
 #include <sys/utsname.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -26,13 +25,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string self_path() {
-  char buf[4096];
-  const ssize_t n = readlink("/proc/self/exe", buf, sizeof buf - 1);
-  if (n <= 0) return "posebench";
-  buf[n] = '\0';
-  return buf;
-}
 
 std::string default_config() {
 #ifdef POSEBENCH_SOURCE_DIR
@@ -79,7 +71,7 @@ static pb::cli::Command bench_cmd(
 
       setenv("OMP_NUM_THREADS", std::to_string(threads).c_str(), 1);  // the worker inherits it
       opt.jobs = 1;
-      opt.binary = self_path();
+      opt.binary = pb::cli::self_path();
       const pb::ExperimentConfig cfg = pb::load_experiment(config);
       const pb::RunSummary s = pb::run_experiment(cfg, opt);
       const std::string out = opt.out_dir.empty() ? "results/" + cfg.name : opt.out_dir;

@@ -1,19 +1,9 @@
 // posebench run EXPERIMENT.yaml [--out results/NAME] [--jobs N]
-#include <unistd.h>
-
 #include <iostream>
 
 #include "cli/command.h"
 #include "io/png.h"
 #include "runner/runner.h"
-
-static std::string self_path() {
-  char buf[4096];
-  const ssize_t n = readlink("/proc/self/exe", buf, sizeof buf - 1);
-  if (n <= 0) return "posebench";
-  buf[n] = '\0';
-  return buf;
-}
 
 static pb::cli::Command run_cmd("run", "run an experiment (YAML): trials in parallel, resumable", [](int argc, char** argv) {
   CLI::App app{"Runs every trial of an experiment config and streams one JSON record per trial to "
@@ -32,7 +22,7 @@ static pb::cli::Command run_cmd("run", "run an experiment (YAML): trials in para
                  "write what this invocation did as JSON (trials, already recorded, ran, statuses, wall time, "
                  "jobs, load) to FILE; OUT/runs.jsonl keeps one such line per invocation that ran trials");
   PB_CLI_PARSE(app, argc, argv);
-  opt.binary = self_path();
+  opt.binary = pb::cli::self_path();
   const pb::ExperimentConfig cfg = pb::load_experiment(config);
   const pb::RunSummary s = pb::run_experiment(cfg, opt);
   const std::string out = opt.out_dir.empty() ? "results/" + cfg.name : opt.out_dir;

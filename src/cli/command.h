@@ -14,6 +14,10 @@ namespace pb::cli {
 
 using CommandFn = std::function<int(int argc, char** argv)>;  // argv[0] = "posebench NAME"
 
+// The running posebench executable (/proc/self/exe; "posebench" if unknown):
+// what `run` starts its workers and the generator with.
+std::string self_path();
+
 struct Command {
   Command(std::string name, std::string summary, CommandFn fn);
 };

@@ -1,5 +1,7 @@
 // posebench: one binary, one subcommand per job (generate, render-views,
 // export-pcd, recognize, run, report, ...).
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -15,6 +17,14 @@ namespace pb::cli {
 std::vector<CommandEntry>& commands() {
   static std::vector<CommandEntry> c;
   return c;
+}
+
+std::string self_path() {
+  char buf[4096];
+  const ssize_t n = readlink("/proc/self/exe", buf, sizeof buf - 1);
+  if (n <= 0) return "posebench";
+  buf[n] = '\0';
+  return buf;
 }
 
 Command::Command(std::string name, std::string summary, CommandFn fn) {

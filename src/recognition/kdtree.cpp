@@ -8,30 +8,28 @@ namespace pb {
 KdTree3::KdTree3(const std::vector<Vec3f>& points, int leaf_size) {
   order_.resize(points.size());
   std::iota(order_.begin(), order_.end(), 0);
-  points_ = points;
   if (points.empty()) return;
   nodes_.reserve(2 * points.size() / static_cast<size_t>(std::max(1, leaf_size)) + 2);
-  build(0, static_cast<int>(points.size()), std::max(1, leaf_size));
-  std::vector<Vec3f> sorted(points.size());
+  build(points, 0, static_cast<int>(points.size()), std::max(1, leaf_size));
+  points_.resize(points.size());
   position_.resize(points.size());
   for (size_t i = 0; i < order_.size(); ++i) {
-    sorted[i] = points[static_cast<size_t>(order_[i])];
+    points_[i] = points[static_cast<size_t>(order_[i])];
     position_[static_cast<size_t>(order_[i])] = static_cast<int>(i);
   }
-  points_.swap(sorted);
 }
 
-// Splits at the median of the widest extent (points_ still in input order,
-// addressed through order_).
-int KdTree3::build(int begin, int end, int leaf_size) {
+// Splits at the median of the widest extent (the input points, addressed
+// through order_).
+int KdTree3::build(const std::vector<Vec3f>& pts, int begin, int end, int leaf_size) {
   const int id = static_cast<int>(nodes_.size());
   nodes_.emplace_back();
   nodes_[static_cast<size_t>(id)].begin = begin;
   nodes_[static_cast<size_t>(id)].end = end;
   if (end - begin <= leaf_size) return id;
-  Vec3f lo = points_[static_cast<size_t>(order_[static_cast<size_t>(begin)])], hi = lo;
+  Vec3f lo = pts[static_cast<size_t>(order_[static_cast<size_t>(begin)])], hi = lo;
   for (int i = begin + 1; i < end; ++i) {
-    const Vec3f& p = points_[static_cast<size_t>(order_[static_cast<size_t>(i)])];
+    const Vec3f& p = pts[static_cast<size_t>(order_[static_cast<size_t>(i)])];
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
@@ -40,12 +38,12 @@ int KdTree3::build(int begin, int end, int leaf_size) {
   if (!(hi[dim] > lo[dim])) return id;  // all points equal: one leaf
   const int mid = begin + (end - begin) / 2;
   std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end, [&](int a, int b) {
-    const float x = points_[static_cast<size_t>(a)][dim], y = points_[static_cast<size_t>(b)][dim];
+    const float x = pts[static_cast<size_t>(a)][dim], y = pts[static_cast<size_t>(b)][dim];
     return x < y || (x == y && a < b);
   });
-  const float split = points_[static_cast<size_t>(order_[static_cast<size_t>(mid)])][dim];
-  const int left = build(begin, mid, leaf_size);
-  const int right = build(mid, end, leaf_size);
+  const float split = pts[static_cast<size_t>(order_[static_cast<size_t>(mid)])][dim];
+  const int left = build(pts, begin, mid, leaf_size);
+  const int right = build(pts, mid, end, leaf_size);
   Node& n = nodes_[static_cast<size_t>(id)];
   n.dim = dim;
   n.split = split;

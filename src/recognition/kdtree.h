@@ -37,7 +37,7 @@ class KdTree3 {
     float split = 0;
     int left = -1, right = -1;
   };
-  int build(int begin, int end, int leaf_size);
+  int build(const std::vector<Vec3f>& pts, int begin, int end, int leaf_size);
   void nearest_in(int node, const Vec3f& q, int& best, float& best_d) const;
   // Calls f(squared distance, input index) for every point within sqrt(r2).
   template <class F>

@@ -10,6 +10,7 @@ namespace {
 
 struct Samples {
   BenchRow row;
+  int correct_k = 0, correct_n = 0;  // records with a thesis judgement, and of those correct
   std::vector<double> pre, hyp, ref, ver, tot, nh;
 };
 
@@ -27,7 +28,6 @@ nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlo
 BenchTable bench_table(const std::vector<TrialRecord>& records, const std::map<std::string, double>& budgets_s) {
   std::vector<Samples> groups;
   std::map<std::string, size_t> index;
-  std::map<std::string, int> correct_k, correct_n;
   for (const TrialRecord& r : records) {
     const std::string key = r.scene + "\n" + r.descriptor + "\n" + r.refinement;
     auto it = index.find(key);
@@ -46,8 +46,8 @@ BenchTable bench_table(const std::vector<TrialRecord>& records, const std::map<s
     ++g.row.trials;
     if (r.status == "ok") ++g.row.ok;
     if (r.correct) {
-      ++correct_n[key];
-      if (*r.correct) ++correct_k[key];
+      ++g.correct_n;
+      if (*r.correct) ++g.correct_k;
     }
     if (r.times) {
       const StageTimesRecord& t = *r.times;
@@ -60,12 +60,9 @@ BenchTable bench_table(const std::vector<TrialRecord>& records, const std::map<s
     if (r.hypotheses) g.nh.push_back(*r.hypotheses);
   }
   BenchTable t;
-  for (auto& [key, i] : index) {
-    Samples& g = groups[i];
-    g.row.correct = wilson(correct_k[key], correct_n[key]);
-  }
   for (Samples& g : groups) {
     BenchRow& r = g.row;
+    r.correct = wilson(g.correct_k, g.correct_n);
     r.preprocess_s = median(g.pre);
     r.hypothesize_s = median(g.hyp);
     r.refine_s = median(g.ref);

@@ -49,19 +49,12 @@ struct Line {
   float ratio = 0;   // occupied / count (used for MIXED)
 };
 
-// Traces the line from voxel a toward voxel b: max(|d|) voxels (at least
-// one), a included, b excluded, the minor axes rounded to nearest.
 // One coordinate of the traced line: a + (d i / n rounded to nearest, halves
 // up) for i = 0, 1, ..., that is a + floor((2 d i + n) / (2 n)), exact in
 // integers for negative d too, updated incrementally (no division per step).
 struct Stepper {
-  int value, rem, step, den;  // value = a + floor(num / den), 0 <= rem < den
-  Stepper(int a, int d, int n) : den(2 * n) {
-    const int num = n;  // i = 0: (2 d 0 + n)
-    value = a + num / den;  // num >= 0
-    rem = num % den;
-    step = 2 * d;
-  }
+  int value, rem, step, den;  // value = a + floor((2 d i + n) / den), 0 <= rem < den
+  Stepper(int a, int d, int n) : value(a), rem(n), step(2 * d), den(2 * n) {}  // i = 0: n / 2n = 0 rem n
   void next() {
     rem += step;
     while (rem >= den) {
@@ -75,6 +68,8 @@ struct Stepper {
   }
 };
 
+// Traces the line from voxel a toward voxel b: max(|d|) voxels (at least
+// one), a included, b excluded, the minor axes rounded to nearest.
 Line trace(const OccupancyGrid& g, const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
   const Eigen::Vector3i d = b - a;
   const int n = std::max({std::abs(d.x()), std::abs(d.y()), std::abs(d.z())});

@@ -110,17 +110,15 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
     uint32_t best_cell = touched[0];
     for (uint32_t c : touched)
       if (acc[c] > acc[best_cell] || (acc[c] == acc[best_cell] && c < best_cell)) best_cell = c;
-    const uint32_t* best = &acc[best_cell];
-    const size_t cell = best_cell;
-    const size_t mr = cell / static_cast<size_t>(n_alpha);
-    const int bin = static_cast<int>(cell % static_cast<size_t>(n_alpha));
+    const size_t mr = best_cell / static_cast<size_t>(n_alpha);
+    const int bin = static_cast<int>(best_cell % static_cast<size_t>(n_alpha));
     const float alpha = static_cast<float>((bin + 0.5) * m.angle_step - M_PI);
     const Eigen::Affine3f T_mg = to_reference_frame(m.points[mr], m.normals[mr]);
     const Eigen::Affine3f T = T_sg.inverse() * Eigen::AngleAxisf(alpha, Vec3f::UnitX()) * T_mg;
     PoseVote pv;
     pv.pose.R = T.linear().cast<double>();
     pv.pose.t = T.translation().cast<double>();
-    pv.votes = *best;
+    pv.votes = acc[best_cell];
     poses.push_back(pv);
   }
   return poses;

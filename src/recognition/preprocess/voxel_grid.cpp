@@ -46,9 +46,7 @@ inline int64_t floor_to_int(double x) {
 }
 
 // Open addressing over the cell keys (linear probing, power-of-two
-// capacity, grown at half load): no allocation per cell. A small
-// direct-mapped cache in front (the cells of the last image rows fit in it)
-// saves most probes of the large table.
+// capacity, grown at half load): no allocation per cell.
 template <class K>
 class KeyTable {
  public:
@@ -61,11 +59,6 @@ class KeyTable {
   // The slot of k, inserting `fresh` when k is new (then *inserted = true).
   int find_or_insert(const K& k, int fresh, bool* inserted) {
     const uint64_t h = mix(k);
-    Recent& r = recent_[h & (kRecent - 1)];
-    if (r.slot >= 0 && r.key == k) {
-      *inserted = false;
-      return r.slot;
-    }
     if (2 * (size_ + 1) > slots_.size()) grow();
     size_t i = static_cast<size_t>(h) & (slots_.size() - 1);
     *inserted = false;
@@ -76,17 +69,10 @@ class KeyTable {
       ++size_;
       *inserted = true;
     }
-    r.key = k;
-    r.slot = slots_[i];
     return slots_[i];
   }
 
  private:
-  static constexpr size_t kRecent = 2048;
-  struct Recent {
-    K key{};
-    int slot = -1;
-  };
   void grow() {
     std::vector<K> keys;
     std::vector<int> slots;
@@ -105,7 +91,6 @@ class KeyTable {
   std::vector<K> keys_;
   std::vector<int> slots_;
   size_t size_ = 0;
-  std::vector<Recent> recent_ = std::vector<Recent>(kRecent);
 };
 
 // The cell keys of the points in first-appearance order, grouped: key_of(i)
