@@ -32,13 +32,11 @@ class OccupancyGrid {
           bits_[i >> 6] |= uint64_t(1) << (i & 63);
         }
   }
-  bool occupied(int x, int y, int z) const {
-    const size_t i = index(x, y, z);
-    return (bits_[i >> 6] >> (i & 63)) & 1;
-  }
+  int occupied(int i) const { return static_cast<int>((bits_[static_cast<size_t>(i) >> 6] >> (i & 63)) & 1); }
+  static int index(int x, int y, int z) { return (x * kG + y) * kG + z; }
+  static int stride(int axis) { return axis == 0 ? kG * kG : (axis == 1 ? kG : 1); }
 
  private:
-  static size_t index(int x, int y, int z) { return (static_cast<size_t>(x) * kG + y) * kG + z; }
   std::vector<uint64_t> bits_;  // one bit per voxel: the whole grid stays in the L1 cache
 };
 
@@ -49,42 +47,46 @@ struct Line {
   float ratio = 0;   // occupied / count (used for MIXED)
 };
 
-// One coordinate of the traced line: a + (d i / n rounded to nearest, halves
-// up) for i = 0, 1, ..., that is a + floor((2 d i + n) / (2 n)), exact in
-// integers for negative d too, updated incrementally (no division per step).
+// One minor coordinate of the traced line: a + (d i / n rounded to nearest,
+// halves up) for i = 0, 1, ..., that is a + floor((2 d i + n) / (2 n)),
+// exact in integers for negative d too, kept as a remainder 0 <= rem < 2n.
+// |2 d| <= 2 n, so one step moves the coordinate by at most one voxel; the
+// move is applied to the grid index branch-free (masks from the sign bit).
 struct Stepper {
-  int value, rem, step, den;  // value = a + floor((2 d i + n) / den), 0 <= rem < den
-  Stepper(int a, int d, int n) : value(a), rem(n), step(2 * d), den(2 * n) {}  // i = 0: n / 2n = 0 rem n
-  void next() {
+  int rem, step, den, stride;
+  Stepper(int d, int n, int stride_) : rem(n), step(2 * d), den(2 * n), stride(stride_) {}  // i = 0: n / 2n = 0 rem n
+  int next() {  // the index change of this step
     rem += step;
-    while (rem >= den) {
-      rem -= den;
-      ++value;
-    }
-    while (rem < 0) {
-      rem += den;
-      --value;
-    }
+    const int under = rem >> 31;               // -1 when rem < 0
+    const int over = (den - 1 - rem) >> 31;    // -1 when rem >= den
+    rem += (under & den) - (over & den);
+    return (over & stride) - (under & stride);
   }
 };
 
 // Traces the line from voxel a toward voxel b: max(|d|) voxels (at least
-// one), a included, b excluded, the minor axes rounded to nearest.
+// one), a included, b excluded, the minor axes rounded to nearest. The major
+// axis moves one voxel per step; the two others follow their Steppers.
 Line trace(const OccupancyGrid& g, const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
   const Eigen::Vector3i d = b - a;
-  const int n = std::max({std::abs(d.x()), std::abs(d.y()), std::abs(d.z())});
+  const Eigen::Vector3i ad = d.cwiseAbs();
+  const int n = std::max({ad.x(), ad.y(), ad.z()});
   Line L;
   L.count = std::max(n, 1);
+  int idx = OccupancyGrid::index(a.x(), a.y(), a.z());
   if (n == 0) {
-    L.occupied = g.occupied(a.x(), a.y(), a.z()) ? 1 : 0;
+    L.occupied = g.occupied(idx) ? 1 : 0;
   } else {
-    Stepper x(a.x(), d.x(), n), y(a.y(), d.y(), n), z(a.z(), d.z(), n);
-    for (int i = 0; i < L.count; ++i) {
-      L.occupied += g.occupied(x.value, y.value, z.value) ? 1 : 0;
-      x.next();
-      y.next();
-      z.next();
+    const int major = ad.x() == n ? 0 : (ad.y() == n ? 1 : 2);
+    const int m1 = major == 0 ? 1 : 0, m2 = major == 2 ? 1 : 2;
+    const int major_step = (d[major] > 0 ? 1 : -1) * OccupancyGrid::stride(major);
+    Stepper s1(d[m1], n, OccupancyGrid::stride(m1)), s2(d[m2], n, OccupancyGrid::stride(m2));
+    int occupied = 0;
+    for (int i = 0; i < n; ++i) {
+      occupied += g.occupied(idx);
+      idx += major_step + s1.next() + s2.next();
     }
+    L.occupied = occupied;
   }
   if (L.occupied >= L.count - 1) {
     L.cls = kOn;
