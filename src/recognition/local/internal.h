@@ -67,6 +67,7 @@ class DescriptorIndex {
                  std::vector<std::pair<int, float>>* out) const;
 
  private:
+  void build_projection();
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -3,17 +3,22 @@
 // descriptors (FPFH, 33) use a FLANN single kd-tree (the index
 // pcl::KdTreeFLANN builds). For high-dimensional ones (SHOT, 352) a kd-tree
 // visits nearly every leaf (measured: no faster than a linear scan), so they
-// use an exact blocked linear scan: the squared distances of a block of
-// queries to every row come from one matrix product (|q|^2 + |d|^2 - 2 q.d,
-// Eigen's blocked GEMM), which only preselects; every row that can be among
-// the k nearest within the product's rounding margin is then measured
-// exactly, so the result is the exact scan's, bit for bit. Searches are
-// const and thread-safe, and deterministic (no randomized trees).
+// use an exact scan with a lower bound: every descriptor is also projected on
+// the kProjDim principal axes of the indexed rows (an orthonormal basis P, so
+// |P q - P d| <= |q - d| for every pair). The bounds of a block of queries to
+// every row come from one small matrix product (|Pq|^2 + |Pd|^2 - 2 Pq.Pd,
+// Eigen's blocked GEMM); rows are then measured exactly in the order of
+// their bounds until the bound exceeds the k-th best exact distance (or the
+// threshold), with a margin for the product's rounding. Every row that can
+// be among the k nearest is measured exactly and offered in ascending row
+// order, so the result is the exact scan's, bit for bit. Searches are const
+// and thread-safe, and deterministic (no randomized trees).
 #include <flann/algorithms/dist.h>
 #include <flann/algorithms/kdtree_single_index.h>
 #include <flann/util/matrix.h>
 
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 
 #include "recognition/local/internal.h"
@@ -21,7 +26,10 @@
 namespace pb::local {
 
 namespace {
-constexpr int kMaxKdTreeDim = 64;  // above this: linear scan
+constexpr int kMaxKdTreeDim = 64;  // above this: linear scan with a projected lower bound
+constexpr int kProjDim = 32;       // principal axes of the lower bound
+constexpr size_t kPcaRows = 1000;  // at most this many (evenly spaced) rows estimate the axes
+using RowMat = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 }
 
 struct DescriptorIndex::Impl {
@@ -30,6 +38,10 @@ struct DescriptorIndex::Impl {
   float max_sq_norm = 0;
   int dim = 0;
   size_t rows = 0;
+  int proj_dim = 0;
+  std::vector<float> basis;    // proj_dim x dim, orthonormal rows (principal axes)
+  std::vector<float> proj;     // rows x proj_dim: each row projected on the basis
+  std::vector<float> proj_sq;  // squared norm of each projected row
   std::unique_ptr<flann::KDTreeSingleIndex<flann::L2_Simple<float>>> index;
 };
 
@@ -51,12 +63,40 @@ void DescriptorIndex::build(const std::vector<float>& data, int dim) {
       impl_->sq_norms[r] = s;
       impl_->max_sq_norm = std::max(impl_->max_sq_norm, s);
     }
+    build_projection();
     return;
   }
   flann::Matrix<float> m(impl_->data.data(), impl_->rows, static_cast<size_t>(dim));
   impl_->index.reset(new flann::KDTreeSingleIndex<flann::L2_Simple<float>>(
       m, flann::KDTreeSingleIndexParams(15)));
   impl_->index->buildIndex();
+}
+
+// The kProjDim principal axes of (up to kPcaRows evenly spaced) rows, in
+// double (orthonormal to ~1e-15 before rounding to float), and every row's
+// projection on them.
+void DescriptorIndex::build_projection() {
+  Impl& m = *impl_;
+  const Eigen::Index dim = m.dim;
+  const size_t step = std::max<size_t>(1, (m.rows + kPcaRows - 1) / kPcaRows);
+  const Eigen::Index used = static_cast<Eigen::Index>((m.rows + step - 1) / step);
+  Eigen::MatrixXd X(used, dim);
+  for (Eigen::Index i = 0; i < used; ++i)
+    for (Eigen::Index j = 0; j < dim; ++j) X(i, j) = m.data[static_cast<size_t>(i) * step * dim + j];
+  X.rowwise() -= X.colwise().mean();
+  const Eigen::MatrixXd C = X.transpose() * X;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(C);
+  m.proj_dim = static_cast<int>(std::min<Eigen::Index>(kProjDim, dim));
+  m.basis.resize(static_cast<size_t>(m.proj_dim) * dim);
+  for (int a = 0; a < m.proj_dim; ++a)  // eigenvalues ascend: the largest last
+    for (Eigen::Index j = 0; j < dim; ++j)
+      m.basis[static_cast<size_t>(a) * dim + j] = static_cast<float>(es.eigenvectors()(j, dim - 1 - a));
+  const Eigen::Map<const RowMat> D(m.data.data(), static_cast<Eigen::Index>(m.rows), dim);
+  const Eigen::Map<const RowMat> B(m.basis.data(), m.proj_dim, dim);
+  const RowMat Z = D * B.transpose();
+  m.proj.assign(Z.data(), Z.data() + Z.size());
+  m.proj_sq.resize(m.rows);
+  for (size_t r = 0; r < m.rows; ++r) m.proj_sq[r] = Z.row(static_cast<Eigen::Index>(r)).squaredNorm();
 }
 
 size_t DescriptorIndex::size() const { return impl_->rows; }
@@ -102,36 +142,41 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
     for (int i = 0; i < n; ++i) knn(queries + static_cast<size_t>(i) * dim, k, max_sq_dist, out[i]);
     return;
   }
-  const size_t kk = std::min<size_t>(static_cast<size_t>(k), impl_->rows);
-  using RowMat = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  const Eigen::Map<const RowMat> D(impl_->data.data(), static_cast<Eigen::Index>(impl_->rows),
-                                   static_cast<Eigen::Index>(dim));
+  const Impl& m = *impl_;
+  const size_t kk = std::min<size_t>(static_cast<size_t>(k), m.rows);
   const Eigen::Map<const RowMat> Q(queries, n, static_cast<Eigen::Index>(dim));
-  const RowMat G = Q * D.transpose();  // n x rows dot products
+  const Eigen::Map<const RowMat> B(m.basis.data(), m.proj_dim, static_cast<Eigen::Index>(dim));
+  const Eigen::Map<const RowMat> Z(m.proj.data(), static_cast<Eigen::Index>(m.rows), m.proj_dim);
+  const RowMat Zq = Q * B.transpose();  // n x proj_dim
+  const RowMat G = Zq * Z.transpose();  // n x rows projected dot products
   std::vector<std::pair<float, int>> cand;
+  std::vector<std::pair<int, float>> best, measured;
   for (int i = 0; i < n; ++i) {
     out[i].clear();
     const float* q = queries + static_cast<size_t>(i) * dim;
     float qn = 0;
     for (size_t j = 0; j < dim; ++j) qn += q[j] * q[j];
-    // Rounding margin of the product form (float, dim terms): generous.
-    const float margin = 1e-4f * (qn + impl_->max_sq_norm) + 1e-30f;
+    const float zn = Zq.row(i).squaredNorm();
+    // Rounding margin of the product form and of the float basis: generous.
+    const float margin = 1e-4f * (qn + m.max_sq_norm) + 1e-30f;
     cand.clear();
-    for (size_t r = 0; r < impl_->rows; ++r) {
-      const float approx = qn + impl_->sq_norms[r] - 2.f * G(i, static_cast<Eigen::Index>(r));
-      if (approx < max_sq_dist + margin) cand.emplace_back(approx, static_cast<int>(r));
+    for (size_t r = 0; r < m.rows; ++r) {
+      const float lb = zn + m.proj_sq[r] - 2.f * G(i, static_cast<Eigen::Index>(r));
+      if (lb < max_sq_dist + margin) cand.emplace_back(lb, static_cast<int>(r));
     }
-    if (cand.size() > kk) {  // keep the rows that can be among the kk nearest
-      std::nth_element(cand.begin(), cand.begin() + static_cast<long>(kk - 1), cand.end());
-      const float limit = cand[kk - 1].first + 2.f * margin;
-      cand.erase(std::remove_if(cand.begin(), cand.end(), [&](const auto& c) { return c.first > limit; }),
-                 cand.end());
+    std::sort(cand.begin(), cand.end());
+    best.clear();
+    measured.clear();
+    for (const auto& [lb, r] : cand) {
+      const float tau = best.size() == kk ? best.back().second : max_sq_dist;
+      if (lb > tau + margin) break;  // no later row can enter the k nearest
+      const float s = sq_dist(q, m.data.data() + static_cast<size_t>(r) * dim, dim);
+      if (!(s < max_sq_dist)) continue;
+      offer(best, kk, r, s);
+      measured.emplace_back(r, s);
     }
-    std::sort(cand.begin(), cand.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
-    for (const auto& c : cand) {  // ascending rows, exact distances: as the full scan
-      const float s = sq_dist(q, impl_->data.data() + static_cast<size_t>(c.second) * dim, dim);
-      if (s < max_sq_dist) offer(out[i], kk, c.second, s);
-    }
+    std::sort(measured.begin(), measured.end());  // ascending rows: as the full scan
+    for (const auto& [r, s] : measured) offer(out[i], kk, r, s);
   }
 }
 
