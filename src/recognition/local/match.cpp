@@ -159,10 +159,26 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
     const float zn = Zq.row(i).squaredNorm();
     // Rounding margin of the product form and of the float basis: generous.
     const float margin = 1e-4f * (qn + m.max_sq_norm) + 1e-30f;
+    const auto bound = [&](size_t r) { return zn + m.proj_sq[r] - 2.f * G(i, static_cast<Eigen::Index>(r)); };
+    // First pass: the kk smallest bounds; their exact distances cap the k-th
+    // best (tau0), so only rows with a bound up to tau0 remain candidates.
     cand.clear();
     for (size_t r = 0; r < m.rows; ++r) {
-      const float lb = zn + m.proj_sq[r] - 2.f * G(i, static_cast<Eigen::Index>(r));
-      if (lb < max_sq_dist + margin) cand.emplace_back(lb, static_cast<int>(r));
+      const float lb = bound(r);
+      if (cand.size() == kk && !(lb < cand.back().first)) continue;
+      if (cand.size() == kk) cand.pop_back();
+      cand.insert(std::upper_bound(cand.begin(), cand.end(), std::make_pair(lb, static_cast<int>(r))),
+                  {lb, static_cast<int>(r)});
+    }
+    float tau0 = 0;
+    for (const auto& c : cand)
+      tau0 = std::max(tau0, sq_dist(q, m.data.data() + static_cast<size_t>(c.second) * dim, dim));
+    const float limit = std::min(tau0, max_sq_dist) + margin;
+    // Second pass: the candidates, measured in the order of their bounds.
+    cand.clear();
+    for (size_t r = 0; r < m.rows; ++r) {
+      const float lb = bound(r);
+      if (lb <= limit) cand.emplace_back(lb, static_cast<int>(r));
     }
     std::sort(cand.begin(), cand.end());
     best.clear();
