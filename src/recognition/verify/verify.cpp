@@ -24,7 +24,9 @@ PointIndex::~PointIndex() = default;
 
 size_t PointIndex::size() const { return impl_->tree.size(); }
 
-int PointIndex::nearest(const Vec3f& q, float* sq_dist) const { return impl_->tree.nearest(q, sq_dist); }
+int PointIndex::nearest(const Vec3f& q, float* sq_dist, float max_sq_dist, int hint) const {
+  return impl_->tree.nearest(q, sq_dist, max_sq_dist, hint);
+}
 
 std::vector<int> PointIndex::radius(const Vec3f& q, float r) const {
   std::vector<int> out;
@@ -38,11 +40,19 @@ int count_inliers(const std::vector<Vec3f>& model_points, const Pose& T_cam_mode
   const Eigen::Matrix3d R = T_cam_model.R;
   const Vec3 t = T_cam_model.t;
   const float thr2 = static_cast<float>(threshold_mm * threshold_mm);
-  int n = 0;
+  // The search is bounded by the threshold (squared distance <= thr2 is below
+  // the next float up): far points end their search early. The previous
+  // point's match (model points are stored in scan order, neighbours mostly
+  // adjacent) is the hint; neither changes which points count.
+  const float bound = std::nextafter(thr2, std::numeric_limits<float>::infinity());
+  int n = 0, hint = -1;
   for (const auto& p : model_points) {
     const Vec3f q = (R * p.cast<double>() + t).cast<float>();
-    float d2;
-    if (scene.nearest(q, &d2) >= 0 && d2 <= thr2) ++n;
+    const int k = scene.nearest(q, nullptr, bound, hint);
+    if (k >= 0) {
+      ++n;
+      hint = k;
+    }
   }
   return n;
 }

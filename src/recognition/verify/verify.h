@@ -2,6 +2,7 @@
 // inlier is a model point whose nearest scene point is within a threshold.
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -38,8 +39,10 @@ class PointIndex {
  public:
   explicit PointIndex(const std::vector<Vec3f>& points);
   ~PointIndex();
-  // Index of the nearest point and its squared distance; -1 if empty.
-  int nearest(const Vec3f& q, float* sq_dist = nullptr) const;
+  // Index of the nearest point with squared distance below max_sq_dist and
+  // that distance; -1 if none. `hint`: see KdTree3::nearest.
+  int nearest(const Vec3f& q, float* sq_dist = nullptr,
+              float max_sq_dist = std::numeric_limits<float>::infinity(), int hint = -1) const;
   std::vector<int> radius(const Vec3f& q, float r) const;
   size_t size() const;
 
