@@ -27,7 +27,7 @@ constexpr char kMagic[8] = {'P', 'B', 'T', 'R', 'A', 'I', 'N', '\0'};
 // one binary format for every method. 3: the project's own normals (PCA in a
 // radius on its kd-tree) replace PCL's in preprocessing: models trained by
 // version 2 are retrained.
-constexpr uint32_t kVersion = 3;
+constexpr uint32_t kVersion = 4;
 
 std::string sanitize(const std::string& name) {
   std::string o;

@@ -114,6 +114,16 @@ void KdTree3::radius(const Vec3f& q, float r, std::vector<int>& out) const {
   for (const auto& f : found) out.push_back(f.second);
 }
 
+void KdTree3::within(const Vec3f& q, float max_sq_dist, std::vector<std::pair<float, int>>& out, bool sorted) const {
+  out.clear();
+  if (nodes_.empty() || !q.allFinite() || !(max_sq_dist > 0)) return;
+  auto add = [&out, max_sq_dist](float d, int i) {
+    if (d < max_sq_dist) out.emplace_back(d, i);
+  };
+  visit_radius(0, q, max_sq_dist, add);
+  if (sorted) std::sort(out.begin(), out.end());
+}
+
 void KdTree3::radius_unsorted(const Vec3f& q, float r, std::vector<int>& out) const {
   out.clear();
   if (nodes_.empty() || !q.allFinite() || !(r > 0)) return;

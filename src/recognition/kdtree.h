@@ -6,6 +6,7 @@
 #pragma once
 
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "core/types.h"
@@ -26,6 +27,10 @@ class KdTree3 {
   // Every point within r (squared distance <= r^2), sorted by distance, then
   // index.
   void radius(const Vec3f& q, float r, std::vector<int>& out) const;
+  // Every point with squared distance below max_sq_dist (strictly, as
+  // FLANN's radius search), as (squared distance, index), sorted unless
+  // `sorted` is false (then in tree order).
+  void within(const Vec3f& q, float max_sq_dist, std::vector<std::pair<float, int>>& out, bool sorted = true) const;
   // The same set in tree order (no sort: for sums over the neighbourhood).
   void radius_unsorted(const Vec3f& q, float r, std::vector<int>& out) const;
   size_t size() const { return points_.size(); }

@@ -1,19 +1,167 @@
-// FPFH descriptors at keypoints (pcl::FPFHEstimationOMP, 33 bins). Each
-// output row is computed from its own neighbourhood only, so the result is
-// the same for any thread count. The estimator is local to the call (no
-// shared state between threads).
-#include <pcl/features/fpfh_omp.h>
+// Our FPFH (Rusu et al. 2009) at keypoints, PCL-free, as PCL's
+// FPFHEstimation defines it (fpfh_pcl.cpp keeps PCL's as the reference):
+//   - neighbourhoods: every cloud point with squared distance below r^2
+//     (FLANN's strict radius), found on the project's kd-tree (KdTree3);
+//   - SPFH of every point that is a neighbour of a keypoint: over its
+//     neighbours (itself excluded), the three angles f1, f2, f3 of the pair's
+//     Darboux frame, 11 bins each, every pair adding 100 / (neighbours - 1);
+//   - FPFH of a keypoint: the SPFHs of its neighbours weighted by
+//     1 / squared distance (PCL's weighting; coincident points skipped), in
+//     order of distance, each of the three histograms scaled to sum 100.
+// Differences from PCL, all at rounding level: the source point of a pair is
+// chosen by comparing |cos| instead of the arccos of each, and the dot
+// products are summed over three coordinates instead of four.
+// Each row depends on its own neighbourhood only: the same result for any
+// thread count.
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include "recognition/kdtree.h"
 #include "recognition/local/internal.h"
-#include "recognition/local/pcl_features.h"
 
 namespace pb::local {
 
-std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& keypoints,
-                                double radius_mm, int threads) {
-  pcl::FPFHEstimationOMP<pcl::PointXYZ, pcl::Normal, pcl::FPFHSignature33> est;
-  return describe_keypoints<pcl::FPFHSignature33>(
-      est, cloud, keypoints, radius_mm, threads, kFpfhDim, [](const pcl::FPFHSignature33& x) { return x.histogram; }, false);
+namespace {
+
+constexpr int kBins = 11;  // per angle
+
+// The pair features of (p1, n1) and (p2, n2): false when the points coincide
+// or the frame is degenerate. The source is the point whose normal is closer
+// to the line between them (smaller angle: larger |cos|).
+bool pair_features(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2, float& f1, float& f2,
+                   float& f3) {
+  Vec3f d = p2 - p1;
+  const float dist = d.norm();
+  if (dist == 0.f) return false;
+  const float c1 = n1.dot(d) / dist, c2 = n2.dot(d) / dist;
+  Vec3f u = n1, target = n2;
+  f3 = c1;
+  if (std::abs(c1) < std::abs(c2)) {
+    u = n2;
+    target = n1;
+    d = -d;
+    f3 = -c2;
+  }
+  Vec3f v = d.cross(u);
+  const float vn = v.norm();
+  if (vn == 0.f) return false;
+  v /= vn;
+  const Vec3f w = u.cross(v);
+  f2 = v.dot(target);
+  f1 = std::atan2(w.dot(target), u.dot(target));
+  return true;
+}
+
+// Bin of x (PCL's: floor in double, clamped; a NaN lands in bin 0 as PCL's
+// clamped conversion does on x86).
+inline int bin_of(double x) {
+  if (!(x >= 0)) return 0;
+  return std::min(static_cast<int>(std::floor(x)), kBins - 1);
+}
+
+using Hist = std::array<float, kFpfhDim>;
+
+Hist spfh(const std::vector<Vec3f>& pts, const std::vector<Vec3f>& normals, int p,
+          const std::vector<std::pair<float, int>>& nn) {
+  Hist h{};
+  const float incr = 100.f / static_cast<float>(nn.size() - 1);
+  const double inv_2pi = static_cast<double>(1.0f / (2.0f * static_cast<float>(M_PI)));
+  for (const auto& [d2, q] : nn) {
+    if (q == p) continue;
+    float f1, f2, f3;
+    if (!pair_features(pts[p], normals[p], pts[q], normals[q], f1, f2, f3)) continue;
+    h[bin_of(kBins * ((f1 + M_PI) * inv_2pi))] += incr;
+    h[kBins + bin_of(kBins * ((f2 + 1.0) * 0.5))] += incr;
+    h[2 * kBins + bin_of(kBins * ((f3 + 1.0) * 0.5))] += incr;
+  }
+  return h;
+}
+
+}  // namespace
+
+std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& keypoints, double radius_mm,
+                                int threads) {
+  std::vector<float> out(keypoints.size() * kFpfhDim, std::numeric_limits<float>::quiet_NaN());
+  if (keypoints.empty() || !cloud.has_normals() || !(radius_mm > 0)) return out;
+  const std::vector<Vec3f>& pts = cloud.points;
+  const int n = static_cast<int>(pts.size());
+  // The tree holds the finite points (search results are cloud indices).
+  std::vector<int> finite;
+  std::vector<Vec3f> fpts;
+  for (int i = 0; i < n; ++i)
+    if (pts[i].allFinite()) {
+      finite.push_back(i);
+      fpts.push_back(pts[i]);
+    }
+  const KdTree3 tree(fpts);
+  const float r2 = static_cast<float>(radius_mm * radius_mm);
+  const auto neighbours = [&](int p, std::vector<std::pair<float, int>>& nn, bool sorted) {
+    tree.within(pts[p], r2, nn, sorted);
+    for (auto& e : nn) e.second = finite[static_cast<size_t>(e.second)];
+  };
+  const int nthreads = omp_threads(threads);
+
+  // Which points need an SPFH: every neighbour of a (finite) keypoint.
+  std::vector<int> row_of(static_cast<size_t>(n), -1);
+  std::vector<int> needed;
+  {
+    std::vector<std::pair<float, int>> nn;
+    for (int k : keypoints) {
+      if (k < 0 || k >= n || !pts[k].allFinite()) continue;
+      neighbours(k, nn, false);
+      for (const auto& e : nn)
+        if (row_of[static_cast<size_t>(e.second)] < 0) {
+          row_of[static_cast<size_t>(e.second)] = static_cast<int>(needed.size());
+          needed.push_back(e.second);
+        }
+    }
+  }
+  std::vector<Hist> spfhs(needed.size());
+#pragma omp parallel num_threads(nthreads) if (needed.size() > 256)
+  {
+    std::vector<std::pair<float, int>> nn;
+#pragma omp for schedule(dynamic, 64)
+    for (long i = 0; i < static_cast<long>(needed.size()); ++i) {
+      const int p = needed[static_cast<size_t>(i)];
+      neighbours(p, nn, false);  // every pair adds the same amount: order-free
+      spfhs[static_cast<size_t>(i)] = spfh(pts, cloud.normals, p, nn);
+    }
+  }
+
+  // FPFH: the weighted SPFHs of each keypoint's neighbours.
+#pragma omp parallel num_threads(nthreads) if (keypoints.size() > 64)
+  {
+    std::vector<std::pair<float, int>> nn;
+#pragma omp for schedule(dynamic, 16)
+    for (long i = 0; i < static_cast<long>(keypoints.size()); ++i) {
+      const int k = keypoints[static_cast<size_t>(i)];
+      if (k < 0 || k >= n || !pts[k].allFinite()) continue;
+      neighbours(k, nn, true);  // weighted sums: in order of distance, as PCL
+      Hist h{};
+      std::array<double, 3> sum{0, 0, 0};
+      for (const auto& [d2, q] : nn) {
+        if (d2 == 0.f) continue;
+        const float weight = 1.f / d2;
+        const Hist& s = spfhs[static_cast<size_t>(row_of[static_cast<size_t>(q)])];
+        for (int j = 0; j < kFpfhDim; ++j) {
+          const float v = s[j] * weight;
+          sum[j / kBins] += v;
+          h[j] += v;
+        }
+      }
+      float* row = out.data() + static_cast<size_t>(i) * kFpfhDim;
+      for (int j = 0; j < kFpfhDim; ++j) {
+        const double total = sum[j / kBins];
+        row[j] = static_cast<float>(total != 0 ? h[j] * (100.0 / total) : h[j]);
+      }
+    }
+  }
+  return out;
 }
 
 }  // namespace pb::local

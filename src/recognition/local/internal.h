@@ -2,9 +2,10 @@
 // voting). PCL-free: each function converts to PCL types inside its own .cpp
 // file, so the PCL compile cost is spread over several small units:
 //   keypoints.cpp  keypoints (the shared voxel grid, PCL-free)
-//   fpfh.cpp       FPFH (pcl::FPFHEstimationOMP)
+//   fpfh.cpp       FPFH (our own, on KdTree3; fpfh_pcl.cpp: PCL's, the reference)
 //   shot.cpp       SHOT (pcl::SHOTEstimationOMP)
-//   match.cpp      descriptor kd-tree (FLANN, exact search)
+//   match.cpp      exact descriptor search (FLANN kd-tree for FPFH, a
+//                  projected lower bound for SHOT)
 //   hough.cpp      BOARD reference frames + pcl::Hough3DGrouping
 //   method.cpp     the Method (train, save/load, hypothesize)
 #pragma once
@@ -35,6 +36,14 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
                                 double radius_mm, int threads);
 std::vector<float> compute_shot(const PointSet& cloud, const std::vector<int>& keypoints,
                                 double radius_mm, int threads);
+// PCL's FPFHEstimationOMP with the same inputs: the reference of our FPFH
+// (tests and the stock-PCL benchmark only).
+std::vector<float> compute_fpfh_pcl(const PointSet& cloud, const std::vector<int>& keypoints,
+                                    double radius_mm, int threads);
+
+// OpenMP threads for a `threads` setting: 0 = OMP_NUM_THREADS (as `run`
+// gives its workers), 1 without OpenMP.
+int omp_threads(int threads);
 
 // BOARD local reference frames (pcl::BOARDLocalReferenceFrameEstimation,
 // holes filled) at `keypoints`, cloud as surface; row-major

@@ -21,17 +21,17 @@
 namespace pb {
 
 
-namespace {
-
-using namespace local;
-
-int omp_threads(int threads) {
+int local::omp_threads(int threads) {
 #ifdef _OPENMP
   return threads > 0 ? threads : omp_get_max_threads();  // OMP_NUM_THREADS, as run gives its workers
 #else
   return 1;
 #endif
 }
+
+namespace {
+
+using namespace local;
 
 enum class Kind : uint32_t { Fpfh = 1, Shot = 2 };
 
