@@ -122,8 +122,13 @@ bool encode(std::vector<unsigned char>* out, int width, int height, int bit_dept
   png_set_write_fn(png, out, mem_write, mem_flush);
   png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), bit_depth,
                color_type, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  // Fixed settings: same input, same bytes.
-  png_set_compression_level(png, 6);
+  // Fixed settings: same input, same bytes. No row filter and zlib level 1:
+  // measured on configs/scenes/table_astra.yaml (30 images, 234 PNGs), the
+  // generator went from 19 to 25-30 images/s and the files from 2.6 to 2.9 MB
+  // (libpng's adaptive filter choice and level 6 took a third of its time;
+  // noisy depth gains nothing from the filters).
+  png_set_compression_level(png, 1);
+  png_set_filter(png, 0, PNG_FILTER_NONE);
   png_write_info(png, info);
   png_write_image(png, rows);
   png_write_end(png, nullptr);
