@@ -13,9 +13,7 @@
 // moved by at most 1.7 mm, the same 8 of 10 correct), and when the
 // project's own FPFH replaced PCL's (float rounding in the descriptors: ci
 // 4 FPFH estimates changed, demo 1 by 0.13 mm; the same correctness in every
-// record, FPFH 8 of 10 in ci, 3 in demo; then its weighted sums in kd-tree
-// order instead of distance order: 5 ci and 2 demo FPFH estimates moved by at
-// most 1.7 mm, the same correctness). A change that alters
+// record, FPFH 8 of 10 in ci, 3 in demo). A change that alters
 // results on purpose updates those files and says why in its commit.
 #include <gtest/gtest.h>
 

@@ -6,13 +6,11 @@
 //     neighbours (itself excluded), the three angles f1, f2, f3 of the pair's
 //     Darboux frame, 11 bins each, every pair adding 100 / (neighbours - 1);
 //   - FPFH of a keypoint: the SPFHs of its neighbours weighted by
-//     1 / squared distance (PCL's weighting; coincident points skipped),
-//     each of the three histograms scaled to sum 100.
-// Differences from PCL, all at rounding level: the weighted sum runs in the
-// kd-tree's order, not in order of distance (PCL sorts every neighbourhood;
-// measured: the sort was a fifth of the time on dense clouds), the source
-// point of a pair is chosen by comparing |cos| instead of the arccos of each,
-// and the dot products are summed over three coordinates instead of four.
+//     1 / squared distance (PCL's weighting; coincident points skipped), in
+//     order of distance, each of the three histograms scaled to sum 100.
+// Differences from PCL, all at rounding level: the source point of a pair is
+// chosen by comparing |cos| instead of the arccos of each, and the dot
+// products are summed over three coordinates instead of four.
 // Each row depends on its own neighbourhood only: the same result for any
 // thread count.
 #ifdef _OPENMP
@@ -102,8 +100,8 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
     }
   const KdTree3 tree(fpts);
   const float r2 = static_cast<float>(radius_mm * radius_mm);
-  const auto neighbours = [&](int p, std::vector<std::pair<float, int>>& nn) {
-    tree.within(pts[p], r2, nn, false);
+  const auto neighbours = [&](int p, std::vector<std::pair<float, int>>& nn, bool sorted) {
+    tree.within(pts[p], r2, nn, sorted);
     for (auto& e : nn) e.second = finite[static_cast<size_t>(e.second)];
   };
   const int nthreads = omp_threads(threads);
@@ -115,7 +113,7 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
     std::vector<std::pair<float, int>> nn;
     for (int k : keypoints) {
       if (k < 0 || k >= n || !pts[k].allFinite()) continue;
-      neighbours(k, nn);
+      neighbours(k, nn, false);
       for (const auto& e : nn)
         if (row_of[static_cast<size_t>(e.second)] < 0) {
           row_of[static_cast<size_t>(e.second)] = static_cast<int>(needed.size());
@@ -130,7 +128,7 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
 #pragma omp for schedule(dynamic, 64)
     for (long i = 0; i < static_cast<long>(needed.size()); ++i) {
       const int p = needed[static_cast<size_t>(i)];
-      neighbours(p, nn);
+      neighbours(p, nn, false);  // every pair adds the same amount: order-free
       spfhs[static_cast<size_t>(i)] = spfh(pts, cloud.normals, p, nn);
     }
   }
@@ -143,7 +141,7 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
     for (long i = 0; i < static_cast<long>(keypoints.size()); ++i) {
       const int k = keypoints[static_cast<size_t>(i)];
       if (k < 0 || k >= n || !pts[k].allFinite()) continue;
-      neighbours(k, nn);
+      neighbours(k, nn, true);  // weighted sums: in order of distance, as PCL
       Hist h{};
       std::array<double, 3> sum{0, 0, 0};
       for (const auto& [d2, q] : nn) {
