@@ -75,4 +75,36 @@ TEST(KdTree3, DuplicatesResolveToTheLowestIndexAndEmptyTreesFindNothing) {
   EXPECT_TRUE(out.empty());
 }
 
+// within: strictly below the bound (a point exactly at it is left out, as
+// FLANN's radius search), sorted by (distance, index) with duplicates
+// (equal distances) in index order; unsorted: the same set.
+TEST(KdTree3, WithinIsStrictAndSortedByDistanceThenIndex) {
+  std::vector<Vec3f> pts = random_cloud(3000, 11, 100.f);
+  for (int i = 0; i < 40; ++i) pts.push_back(pts[static_cast<size_t>(i) * 7]);  // exact duplicates
+  pts.push_back(Vec3f(3, 4, 0));  // exactly 5 from the origin
+  const pb::KdTree3 tree(pts);
+  pb::Rng rng(12);
+  std::vector<Vec3f> queries{Vec3f(0, 0, 0)};
+  for (int i = 0; i < 100; ++i) queries.push_back(pts[static_cast<size_t>(rng.uniform_int(0, 2999))]);
+  for (const Vec3f& q : queries) {
+    for (float max2 : {25.f, 400.f, 900.f}) {
+      std::vector<std::pair<float, int>> want;
+      for (size_t i = 0; i < pts.size(); ++i) {
+        const float d = (pts[i] - q).squaredNorm();
+        if (d < max2) want.emplace_back(d, static_cast<int>(i));
+      }
+      std::sort(want.begin(), want.end());
+      std::vector<std::pair<float, int>> got;
+      tree.within(q, max2, got);
+      EXPECT_EQ(got, want);
+      tree.within(q, max2, got, false);
+      std::sort(got.begin(), got.end());
+      EXPECT_EQ(got, want);
+    }
+  }
+  std::vector<std::pair<float, int>> at_bound;
+  tree.within(Vec3f(0, 0, 0), 25.f, at_bound);
+  for (const auto& e : at_bound) EXPECT_NE(e.second, static_cast<int>(pts.size()) - 1) << "25 is not below 25";
+}
+
 }  // namespace

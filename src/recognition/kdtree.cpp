@@ -1,6 +1,8 @@
 #include "recognition/kdtree.h"
 
 #include <algorithm>
+#include <cstdint>
+#include <cstring>
 #include <numeric>
 
 namespace pb {
@@ -117,11 +119,34 @@ void KdTree3::radius(const Vec3f& q, float r, std::vector<int>& out) const {
 void KdTree3::within(const Vec3f& q, float max_sq_dist, std::vector<std::pair<float, int>>& out, bool sorted) const {
   out.clear();
   if (nodes_.empty() || !q.allFinite() || !(max_sq_dist > 0)) return;
-  auto add = [&out, max_sq_dist](float d, int i) {
-    if (d < max_sq_dist) out.emplace_back(d, i);
+  if (!sorted) {
+    auto add = [&out, max_sq_dist](float d, int i) {
+      if (d < max_sq_dist) out.emplace_back(d, i);
+    };
+    visit_radius(0, q, max_sq_dist, add);
+    return;
+  }
+  // Sorted by (distance, index) as one 64-bit key each: a squared distance
+  // is a non-negative float, whose bits order as the values do, so the key
+  // order is the pair order (one integer compare instead of two float ones).
+  thread_local std::vector<uint64_t> keys;
+  keys.clear();
+  auto add = [max_sq_dist](float d, int i) {
+    if (d < max_sq_dist) {
+      uint32_t bits;
+      std::memcpy(&bits, &d, sizeof bits);
+      keys.push_back((static_cast<uint64_t>(bits) << 32) | static_cast<uint32_t>(i));
+    }
   };
   visit_radius(0, q, max_sq_dist, add);
-  if (sorted) std::sort(out.begin(), out.end());
+  std::sort(keys.begin(), keys.end());
+  out.reserve(keys.size());
+  for (uint64_t k : keys) {
+    const uint32_t bits = static_cast<uint32_t>(k >> 32);
+    float d;
+    std::memcpy(&d, &bits, sizeof d);
+    out.emplace_back(d, static_cast<int>(k & 0xffffffffu));
+  }
 }
 
 void KdTree3::radius_unsorted(const Vec3f& q, float r, std::vector<int>& out) const {

@@ -22,6 +22,7 @@
 #endif
 
 #include <array>
+#include <cstdint>
 #include <cmath>
 #include <limits>
 
@@ -69,21 +70,24 @@ inline int bin_of(double x) {
 }
 
 using Hist = std::array<float, kFpfhDim>;
+using Counts = std::array<uint32_t, kFpfhDim>;
 
-Hist spfh(const std::vector<Vec3f>& pts, const std::vector<Vec3f>& normals, int p,
-          const std::vector<std::pair<float, int>>& nn) {
-  Hist h{};
-  const float incr = 100.f / static_cast<float>(nn.size() - 1);
+// The three bins of a pair's features.
+inline void count_pair(float f1, float f2, float f3, uint32_t* c) {
   const double inv_2pi = static_cast<double>(1.0f / (2.0f * static_cast<float>(M_PI)));
-  for (const auto& [d2, q] : nn) {
-    if (q == p) continue;
-    float f1, f2, f3;
-    if (!pair_features(pts[p], normals[p], pts[q], normals[q], f1, f2, f3)) continue;
-    h[bin_of(kBins * ((f1 + M_PI) * inv_2pi))] += incr;
-    h[kBins + bin_of(kBins * ((f2 + 1.0) * 0.5))] += incr;
-    h[2 * kBins + bin_of(kBins * ((f3 + 1.0) * 0.5))] += incr;
-  }
-  return h;
+  ++c[bin_of(kBins * ((f1 + M_PI) * inv_2pi))];
+  ++c[kBins + bin_of(kBins * ((f2 + 1.0) * 0.5))];
+  ++c[2 * kBins + bin_of(kBins * ((f3 + 1.0) * 0.5))];
+}
+
+// True when (p, q) and (q, p) give bit-identical features: both cosines
+// finite and of different magnitude, so both calls pick the same source
+// point and compute the same frame from exactly negated inputs.
+inline bool symmetric_pair(const Vec3f& p, const Vec3f& np, const Vec3f& q, const Vec3f& nq) {
+  const Vec3f d = q - p;
+  const float dist = d.norm();
+  const float c1 = np.dot(d) / dist, c2 = nq.dot(d) / dist;
+  return std::isfinite(c1) && std::isfinite(c2) && std::abs(c1) != std::abs(c2);
 }
 
 }  // namespace
@@ -125,15 +129,55 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
         }
     }
   }
-  std::vector<Hist> spfhs(needed.size());
-#pragma omp parallel num_threads(nthreads) if (needed.size() > 256)
+  // SPFH bin counts. Each pair of needed points is computed once, by the
+  // lower index, and counted for both (symmetric_pair), else each point
+  // computes its own. Counts are integers, so their sum over threads does
+  // not depend on the order; every addition to a bin of point p adds the same
+  // 100 / (neighbours - 1), so the float histogram is that value added
+  // count times, as PCL's loop adds it.
+  const size_t rows = needed.size();
+  std::vector<int> nn_size(rows, 0);
+  std::vector<std::vector<Counts>> counts(static_cast<size_t>(nthreads));
+#pragma omp parallel num_threads(nthreads) if (rows > 256)
   {
+#ifdef _OPENMP
+    std::vector<Counts>& mine = counts[static_cast<size_t>(omp_get_thread_num())];
+#else
+    std::vector<Counts>& mine = counts[0];
+#endif
+    mine.assign(rows, Counts{});
     std::vector<std::pair<float, int>> nn;
 #pragma omp for schedule(dynamic, 64)
-    for (long i = 0; i < static_cast<long>(needed.size()); ++i) {
+    for (long i = 0; i < static_cast<long>(rows); ++i) {
       const int p = needed[static_cast<size_t>(i)];
-      neighbours(p, nn, false);  // every pair adds the same amount: order-free
-      spfhs[static_cast<size_t>(i)] = spfh(pts, cloud.normals, p, nn);
+      neighbours(p, nn, false);
+      nn_size[static_cast<size_t>(i)] = static_cast<int>(nn.size());
+      for (const auto& e : nn) {
+        const int q = e.second;
+        const int qrow = row_of[static_cast<size_t>(q)];
+        if (q == p || (qrow >= 0 && q < p)) continue;  // itself, or counted from q
+        float f1, f2, f3;
+        const bool both = qrow >= 0 && symmetric_pair(pts[p], cloud.normals[p], pts[q], cloud.normals[q]);
+        if (pair_features(pts[p], cloud.normals[p], pts[q], cloud.normals[q], f1, f2, f3)) {
+          count_pair(f1, f2, f3, mine[static_cast<size_t>(i)].data());
+          if (both) count_pair(f1, f2, f3, mine[static_cast<size_t>(qrow)].data());
+        }
+        if (qrow >= 0 && !both &&
+            pair_features(pts[q], cloud.normals[q], pts[p], cloud.normals[p], f1, f2, f3))
+          count_pair(f1, f2, f3, mine[static_cast<size_t>(qrow)].data());
+      }
+    }
+  }
+  std::vector<Hist> spfhs(rows);
+  for (size_t i = 0; i < rows; ++i) {
+    const float incr = 100.f / static_cast<float>(nn_size[i] - 1);
+    for (int j = 0; j < kFpfhDim; ++j) {
+      uint32_t c = 0;
+      for (const auto& t : counts)
+        if (!t.empty()) c += t[i][static_cast<size_t>(j)];
+      float v = 0.f;
+      for (uint32_t k = 0; k < c; ++k) v += incr;
+      spfhs[i][static_cast<size_t>(j)] = v;
     }
   }
 
