@@ -15,15 +15,17 @@
 // Differences from PCL, all at rounding level: the source point of a pair is
 // chosen by comparing |cos| instead of the arccos of each, and the dot
 // products are summed over three coordinates instead of four.
-// Each row depends on its own neighbourhood only: the same result for any
-// thread count.
+// A pair of needed points whose two directions give bit-identical features
+// is computed once (symmetric_pair). Each row depends on its own
+// neighbourhood only and SPFH bins are integer counts: the same result for
+// any thread count.
 #ifdef _OPENMP
 #include <omp.h>
 #endif
 
 #include <array>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "recognition/kdtree.h"
