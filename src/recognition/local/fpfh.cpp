@@ -16,7 +16,7 @@
 // chosen by comparing |cos| instead of the arccos of each, and the dot
 // products are summed over three coordinates instead of four.
 // A pair of needed points whose two directions give bit-identical features
-// is computed once (symmetric_pair). Each row depends on its own
+// is computed once (pair_features' `symmetric`). Each row depends on its own
 // neighbourhood only and SPFH bins are integer counts: the same result for
 // any thread count.
 #ifdef _OPENMP
@@ -39,13 +39,18 @@ constexpr int kBins = 11;  // per angle
 
 // The pair features of (p1, n1) and (p2, n2): false when the points coincide
 // or the frame is degenerate. The source is the point whose normal is closer
-// to the line between them (smaller angle: larger |cos|).
+// to the line between them (smaller angle: larger |cos|). *symmetric: the
+// call (p2, p1) gives bit-identical features (and the same return value):
+// both cosines finite and of different magnitude, so both calls pick the
+// same source point and compute the same frame from exactly negated inputs.
 bool pair_features(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2, float& f1, float& f2,
-                   float& f3) {
+                   float& f3, bool* symmetric) {
   Vec3f d = p2 - p1;
   const float dist = d.norm();
+  *symmetric = false;
   if (dist == 0.f) return false;
   const float c1 = n1.dot(d) / dist, c2 = n2.dot(d) / dist;
+  *symmetric = std::isfinite(c1) && std::isfinite(c2) && std::abs(c1) != std::abs(c2);
   Vec3f u = n1, target = n2;
   f3 = c1;
   if (std::abs(c1) < std::abs(c2)) {
@@ -80,16 +85,6 @@ inline void count_pair(float f1, float f2, float f3, uint32_t* c) {
   ++c[bin_of(kBins * ((f1 + M_PI) * inv_2pi))];
   ++c[kBins + bin_of(kBins * ((f2 + 1.0) * 0.5))];
   ++c[2 * kBins + bin_of(kBins * ((f3 + 1.0) * 0.5))];
-}
-
-// True when (p, q) and (q, p) give bit-identical features: both cosines
-// finite and of different magnitude, so both calls pick the same source
-// point and compute the same frame from exactly negated inputs.
-inline bool symmetric_pair(const Vec3f& p, const Vec3f& np, const Vec3f& q, const Vec3f& nq) {
-  const Vec3f d = q - p;
-  const float dist = d.norm();
-  const float c1 = np.dot(d) / dist, c2 = nq.dot(d) / dist;
-  return std::isfinite(c1) && std::isfinite(c2) && std::abs(c1) != std::abs(c2);
 }
 
 }  // namespace
@@ -132,8 +127,8 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
     }
   }
   // SPFH bin counts. Each pair of needed points is computed once, by the
-  // lower index, and counted for both (symmetric_pair), else each point
-  // computes its own. Counts are integers, so their sum over threads does
+  // lower index, and counted for both when symmetric (pair_features), else
+  // each point computes its own. Counts are integers, so their sum over threads does
   // not depend on the order; every addition to a bin of point p adds the same
   // 100 / (neighbours - 1), so the float histogram is that value added
   // count times, as PCL's loop adds it.
@@ -159,13 +154,13 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
         const int qrow = row_of[static_cast<size_t>(q)];
         if (q == p || (qrow >= 0 && q < p)) continue;  // itself, or counted from q
         float f1, f2, f3;
-        const bool both = qrow >= 0 && symmetric_pair(pts[p], cloud.normals[p], pts[q], cloud.normals[q]);
-        if (pair_features(pts[p], cloud.normals[p], pts[q], cloud.normals[q], f1, f2, f3)) {
+        bool symmetric = false;
+        if (pair_features(pts[p], cloud.normals[p], pts[q], cloud.normals[q], f1, f2, f3, &symmetric)) {
           count_pair(f1, f2, f3, mine[static_cast<size_t>(i)].data());
-          if (both) count_pair(f1, f2, f3, mine[static_cast<size_t>(qrow)].data());
+          if (qrow >= 0 && symmetric) count_pair(f1, f2, f3, mine[static_cast<size_t>(qrow)].data());
         }
-        if (qrow >= 0 && !both &&
-            pair_features(pts[q], cloud.normals[q], pts[p], cloud.normals[p], f1, f2, f3))
+        if (qrow >= 0 && !symmetric &&
+            pair_features(pts[q], cloud.normals[q], pts[p], cloud.normals[p], f1, f2, f3, &symmetric))
           count_pair(f1, f2, f3, mine[static_cast<size_t>(qrow)].data());
       }
     }

@@ -148,7 +148,7 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
   const Eigen::Map<const RowMat> B(m.basis.data(), m.proj_dim, static_cast<Eigen::Index>(dim));
   const Eigen::Map<const RowMat> Z(m.proj.data(), static_cast<Eigen::Index>(m.rows), m.proj_dim);
   const RowMat Zq = Q * B.transpose();  // n x proj_dim
-  const RowMat G = Zq * Z.transpose();  // n x rows projected dot products
+  RowMat G = Zq * Z.transpose();  // n x rows projected dot products, then the bounds
   std::vector<std::pair<float, int>> cand;
   std::vector<std::pair<int, float>> best, measured;
   for (int i = 0; i < n; ++i) {
@@ -159,12 +159,14 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
     const float zn = Zq.row(i).squaredNorm();
     // Rounding margin of the product form and of the float basis: generous.
     const float margin = 1e-4f * (qn + m.max_sq_norm) + 1e-30f;
-    const auto bound = [&](size_t r) { return zn + m.proj_sq[r] - 2.f * G(i, static_cast<Eigen::Index>(r)); };
-    // First pass: the kk smallest bounds; their exact distances cap the k-th
-    // best (tau0), so only rows with a bound up to tau0 remain candidates.
+    // First pass: the bounds (in place of the dot products) and the kk
+    // smallest of them; their exact distances cap the k-th best (tau0), so
+    // only rows with a bound up to tau0 remain candidates.
+    float* lbs = G.row(i).data();
     cand.clear();
     for (size_t r = 0; r < m.rows; ++r) {
-      const float lb = bound(r);
+      const float lb = zn + m.proj_sq[r] - 2.f * lbs[r];
+      lbs[r] = lb;
       if (cand.size() == kk && !(lb < cand.back().first)) continue;
       if (cand.size() == kk) cand.pop_back();
       cand.insert(std::upper_bound(cand.begin(), cand.end(), std::make_pair(lb, static_cast<int>(r))),
@@ -176,10 +178,8 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
     const float limit = std::min(tau0, max_sq_dist) + margin;
     // Second pass: the candidates, measured in the order of their bounds.
     cand.clear();
-    for (size_t r = 0; r < m.rows; ++r) {
-      const float lb = bound(r);
-      if (lb <= limit) cand.emplace_back(lb, static_cast<int>(r));
-    }
+    for (size_t r = 0; r < m.rows; ++r)
+      if (lbs[r] <= limit) cand.emplace_back(lbs[r], static_cast<int>(r));
     std::sort(cand.begin(), cand.end());
     best.clear();
     measured.clear();
