@@ -2,6 +2,7 @@
 #pragma once
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -26,9 +27,15 @@ inline std::string slurp(const std::string& path) {
   return ss.str();
 }
 
-// Runs `posebench ARGS` in `cwd`, capturing stdout and stderr.
+// Runs `posebench ARGS` in `cwd`, capturing stdout and stderr (through
+// files of this process's own, so tests running at once in one cwd, e.g.
+// the source tree, never read each other's output).
 inline Run run(const std::string& args, const std::string& cwd) {
-  const std::string o = cwd + "/.stdout", e = cwd + "/.stderr";
+  static int counter = 0;
+  const std::string base = (std::filesystem::temp_directory_path() /
+                            ("posebench_cli_" + std::to_string(::getpid()) + "_" + std::to_string(counter++)))
+                               .string();
+  const std::string o = base + ".stdout", e = base + ".stderr";
   const std::string cmd = "cd '" + cwd + "' && '" + std::string(POSEBENCH_BINARY) + "' " + args + " >'" + o +
                           "' 2>'" + e + "'";
   const int st = std::system(cmd.c_str());

@@ -1,4 +1,4 @@
-// posebench run EXPERIMENT.yaml [--out results/NAME] [--jobs N]
+// posebench run EXPERIMENT.yaml [--out results/NAME] [--jobs N] [--shard I/N]
 #include <iostream>
 
 #include "cli/command.h"
@@ -17,19 +17,30 @@ static pb::cli::Command run_cmd("run", "run an experiment (YAML): trials in para
   app.add_option("--cache", opt.cache_dir, "training cache folder ('' = none)");
   app.add_option("--scenes", opt.scenes_dir, "where generated scene sets go");
   app.add_flag("--quiet,-q", opt.quiet, "no progress output");
+  std::string shard;
+  app.add_option("--shard", shard,
+                 "run only shard I of N (0 <= I < N) of the trials, into OUT/shards/I-of-N.*; shards run "
+                 "concurrently or one after another on one OUT (also on a shared file system), then "
+                 "`posebench merge OUT` gives the records of one run");
   std::string summary_file;
   app.add_option("--json-summary", summary_file,
                  "write what this invocation did as JSON (trials, already recorded, ran, statuses, wall time, "
                  "jobs, load) to FILE; OUT/runs.jsonl keeps one such line per invocation that ran trials");
   PB_CLI_PARSE(app, argc, argv);
   opt.binary = pb::cli::self_path();
+  if (app.count("--shard")) opt.shard = pb::parse_shard(shard);
   const pb::ExperimentConfig cfg = pb::load_experiment(config);
   const pb::RunSummary s = pb::run_experiment(cfg, opt);
   const std::string out = opt.out_dir.empty() ? "results/" + cfg.name : opt.out_dir;
-  std::cout << "experiment " << cfg.name << " (" << cfg.hash << "): " << s.total << " trials, "
+  std::cout << "experiment " << cfg.name << " (" << cfg.hash << ")"
+            << (opt.shard.active() ? ", shard " + opt.shard.label() : std::string()) << ": " << s.total << " trials, "
             << s.already_done << " already recorded, " << s.ran << " run now (ok " << s.ok << ", no hypothesis "
-            << s.no_hypothesis << ", error " << s.errors << ", timeout " << s.timeouts << ") in " << s.seconds
-            << " s\nrecords: " << out << "/records.jsonl\n";
+            << s.no_hypothesis << ", error " << s.errors << ", timeout " << s.timeouts << ") in " << s.seconds << " s\n";
+  if (opt.shard.active())
+    std::cout << "records: " << out << "/shards/" << opt.shard.name() << ".records.jsonl (merge with `posebench merge "
+              << out << "`)\n";
+  else
+    std::cout << "records: " << out << "/records.jsonl\n";
   if (!summary_file.empty()) {
     nlohmann::json j = pb::summary_json(s);
     j["experiment"] = cfg.name;

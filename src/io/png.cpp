@@ -16,6 +16,7 @@
 #include <fstream>
 
 #include "core/error.h"
+#include "core/file_lock.h"
 
 namespace pb {
 
@@ -282,7 +283,7 @@ PngHeader read_png_header(const std::string& path) {
 }
 
 void atomic_write_bytes(const std::string& path, const void* data, size_t size) {
-  const std::string tmp = path + ".tmp";
+  const std::string tmp = unique_temp_path(path);  // concurrent writers of one path never share a temp file
   std::FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) throw InputError(path, "output", std::string("cannot write file: ") + std::strerror(errno));
   const size_t n = size ? std::fwrite(data, 1, size, f) : 0;

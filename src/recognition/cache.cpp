@@ -3,17 +3,14 @@
 // (key text, descriptor, the preprocessed views, the method's state).
 // Written to a temporary file and renamed into place, so readers never see
 // a partial file; anything unreadable is rebuilt, never misread.
-#include <unistd.h>
-
-#include <atomic>
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
-#include <thread>
 
 #include "core/error.h"
+#include "core/file_lock.h"
 #include "core/hash.h"
 #include "recognition/model.h"
 #include "recognition/registry.h"
@@ -141,10 +138,7 @@ void write(const std::string& path, const Key& key, const TrainedModel& m) {
   std::error_code ec;
   std::filesystem::create_directories(std::filesystem::path(path).parent_path(), ec);
   if (ec) throw InputError(path, "cache", "cannot create the cache directory: " + ec.message());
-  static std::atomic<uint64_t> counter{0};
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid()) + "." +
-                          std::to_string(std::hash<std::thread::id>()(std::this_thread::get_id())) + "." +
-                          std::to_string(counter++);
+  const std::string tmp = unique_temp_path(path);
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) throw InputError(path, "cache", "cannot write the training cache file");

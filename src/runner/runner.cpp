@@ -16,11 +16,14 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <unordered_set>
 
 #include "core/error.h"
 #include "core/timer.h"
 #include "core/yaml.h"
 #include "io/png.h"
+#include "core/file_lock.h"
+#include "runner/merge.h"
 #include "runner/pool.h"
 #include "runner/store.h"
 #include "runner/trial.h"
@@ -69,8 +72,11 @@ void prepare_scenes(ExperimentConfig& cfg, const RunOptions& opt) {
     const std::string h = hash_hex(gen.dump()).substr(0, 8);
     const fs::path dir = fs::path(opt.scenes_dir) / (src.name + "_" + h);
     src.dataset = dir.string();
-    if (fs::exists(dir / "models" / "models_info.json") && fs::exists(dir / "camera.json")) continue;
+    const auto complete = [&] { return fs::exists(dir / "models" / "models_info.json") && fs::exists(dir / "camera.json"); };
+    if (complete()) continue;
     fs::create_directories(opt.scenes_dir);
+    const FileLock lock = FileLock::acquire((fs::path(opt.scenes_dir) / (src.name + "_" + h + ".lock")).string());
+    if (complete()) continue;  // another process generated it while this one waited
     const fs::path cfg_path = fs::path(opt.scenes_dir) / (src.name + "_" + h + ".config.json");
     atomic_write_text(cfg_path.string(), gen.dump(2) + "\n");
     const std::string log = (fs::path(opt.scenes_dir) / (src.name + "_" + h + ".log")).string();
@@ -157,7 +163,7 @@ double load15() {
 }  // namespace
 
 nlohmann::json summary_json(const RunSummary& s) {
-  return {{"started", s.started},
+  nlohmann::json j = {{"started", s.started},
           {"wall_s", s.seconds},
           {"total", s.total},
           {"already_recorded", s.already_done},
@@ -168,6 +174,8 @@ nlohmann::json summary_json(const RunSummary& s) {
           {"omp_threads", s.omp_threads},
           {"load15_end", std::isfinite(s.load15_end) ? nlohmann::json(s.load15_end) : nlohmann::json(nullptr)},
           {"host_cores", s.host_cores}};
+  if (!s.shard.empty()) j["shard"] = s.shard;
+  return j;
 }
 
 RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
@@ -180,8 +188,29 @@ RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
   ResultStore::check(out, cfg.hash);
   prepare_scenes(cfg, opt);
   const std::vector<Trial> trials = expand_trials(cfg);
-  ResultStore store(out, cfg.canonical, cfg.hash);
-  sum.total = trials.size();
+  std::vector<std::string> keys;
+  for (const Trial& t : trials) keys.push_back(t.key);
+  if (!opt.shard.active() && !ResultStore::shard_record_files(out).empty()) {
+    ResultStore::write_trial_list(out, cfg.hash, keys);
+    const MergeReport m = merge_results(out);
+    if (!opt.quiet)
+      std::cerr << "posebench run: merged " << m.records << " records of earlier shards into " << out
+                << "/records.jsonl first\n";
+  }
+  ResultStore store(out, cfg.canonical, cfg.hash, opt.shard.active() ? opt.shard.name() : "");
+  ResultStore::write_trial_list(out, cfg.hash, keys);
+  // A shard skips what is recorded anywhere in OUT: its own earlier records
+  // (the store), a merged run's, another shard's (also of another N).
+  std::unordered_set<std::string> done_elsewhere;
+  if (opt.shard.active()) {
+    std::vector<std::string> files = ResultStore::shard_record_files(out);
+    files.push_back((fs::path(out) / "records.jsonl").string());
+    for (const auto& f : files)
+      if (f != store.records_path())
+        for (const auto& r : ResultStore::read_file(f)) done_elsewhere.insert(r.key);
+  }
+  const std::vector<bool> mine = shard_membership(keys, opt.shard);
+  sum.shard = opt.shard.active() ? opt.shard.label() : "";
   sum.jobs = opt.jobs;
   sum.host_cores = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN));
   sum.omp_threads = omp_threads_per_worker(opt.jobs, sum.host_cores);
@@ -189,10 +218,13 @@ RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
   std::vector<TrialRecord> inputs;
   std::deque<long> pending;
   for (long i = 0; i < static_cast<long>(trials.size()); ++i) {
-    inputs.push_back(trial_record(trials[static_cast<size_t>(i)]));
-    if (!store.has(trials[static_cast<size_t>(i)].key)) pending.push_back(i);
+    const auto u = static_cast<size_t>(i);
+    inputs.push_back(trial_record(trials[u]));
+    if (!mine[u]) continue;
+    ++sum.total;
+    if (!store.has(keys[u]) && !done_elsewhere.count(keys[u])) pending.push_back(i);
   }
-  sum.already_done = trials.size() - pending.size();
+  sum.already_done = sum.total - pending.size();
   if (!opt.quiet && sum.already_done)
     std::cerr << "posebench run: resuming: " << sum.already_done << " of " << sum.total
               << " trials already recorded\n";
@@ -200,7 +232,7 @@ RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
     PoolOptions po;
     po.binary = opt.binary;
     po.context = context_json(cfg, opt.cache_dir).dump();
-    po.log_path = (fs::path(out) / "workers.log").string();
+    po.log_path = store.own_file("workers", "log");
     po.jobs = opt.jobs;
     po.omp_threads = sum.omp_threads;
     po.timeout_s = cfg.timeout_s;

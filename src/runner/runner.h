@@ -8,6 +8,7 @@
 #include <string>
 
 #include "runner/experiment.h"
+#include "runner/shard.h"
 
 namespace pb {
 
@@ -18,13 +19,15 @@ struct RunOptions {
   std::string scenes_dir = "scenes";  // where generated scene sets go
   std::string binary;              // the posebench executable (workers, generator)
   bool quiet = false;              // no progress output
+  Shard shard;                     // run only this shard's trials, into OUT/shards/ (runner/shard.h)
 };
 
 // What one `posebench run` did: OUT/runs.jsonl gets one line of it per
 // invocation that ran trials, `run --json-summary FILE` writes it to FILE.
 struct RunSummary {
   std::string started;     // UTC, ISO 8601
-  size_t total = 0;        // trials of the experiment
+  std::string shard;       // "I/N" for a sharded run, "" otherwise
+  size_t total = 0;        // trials of the experiment (of this shard, when sharded)
   size_t already_done = 0; // found in the store at start (resume)
   size_t ran = 0;          // run now
   size_t ok = 0, no_hypothesis = 0, errors = 0, timeouts = 0;  // of those run now
@@ -38,9 +41,16 @@ nlohmann::json summary_json(const RunSummary& s);
 
 // Renders every `generate:` scene source that is not yet materialized (into
 // scenes_dir/<name>_<hash8>, by running `posebench generate`) and points its
-// `dataset` there. InputError if generation fails.
+// `dataset` there. InputError if generation fails. Concurrent runs sharing
+// scenes_dir (the shards of a sweep) generate each set once: the first takes
+// scenes_dir/<name>_<hash8>.lock and generates, the others wait for it and
+// then find the set complete (the generator renames a finished folder into
+// place, so a set is never seen half written).
 void prepare_scenes(ExperimentConfig& cfg, const RunOptions& opt);
 
+// Runs what is missing. With opt.shard, only that shard's trials, skipping
+// any already recorded in OUT (by any shard or a merged run); without, shard
+// records found in OUT are merged into OUT/records.jsonl first.
 RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt);
 
 // The worker side: reads a context line, then one trial per line on stdin,
