@@ -7,7 +7,8 @@ cd "$ROOT"
 
 PACKAGES=(build-essential cmake pkg-config ccache libpcl-dev libeigen3-dev libosmesa6-dev
           libassimp-dev nlohmann-json3-dev libyaml-cpp-dev libbenchmark-dev libgtest-dev
-          libpng-dev libcli11-dev python3 python3-matplotlib)
+          libpng-dev libcli11-dev python3 python3-matplotlib
+          slurm-wlm munge)  # a one-node Slurm for the sweep scripts' test (scripts/slurm)
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
