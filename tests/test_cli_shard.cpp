@@ -119,16 +119,26 @@ TEST_P(ShardCount, ConcurrentShardsMergedEqualOneMachinesRecords) {
   for (int i = 0; i < n; ++i) pids.push_back(spawn(shard_args(base, i, n)));
   for (int i = 0; i < n; ++i) EXPECT_EQ(wait_exit(pids[static_cast<size_t>(i)]), 0) << "shard " << i << "/" << n;
 
-  // Each shard wrote only its own file; together they cover every trial once.
+  // Each shard wrote only its own file; together they cover every trial
+  // once. Every model was trained once, by one shard, for all of them: the
+  // others waited for its training cache file.
   size_t in_shards = 0;
+  std::map<std::string, int> trained;
   for (int i = 0; i < n; ++i) {
     const std::string f = base + "/r/shards/" + std::to_string(i) + "-of-" + std::to_string(n) + ".records.jsonl";
+    std::ifstream in(f);
+    std::string line;
+    while (std::getline(in, line)) {
+      const auto j = nlohmann::json::parse(line);
+      trained[j["descriptor"]] += j["train_from_cache"] == false;
+    }
     const size_t k = comparable(f).size();
     EXPECT_GE(k, 16u / static_cast<size_t>(n)) << f;  // balanced: floor or ceil of 16 / n
     EXPECT_LE(k, (16u + static_cast<size_t>(n) - 1) / static_cast<size_t>(n)) << f;
     in_shards += k;
   }
   EXPECT_EQ(in_shards, 16u);
+  EXPECT_EQ(trained, (std::map<std::string, int>{{"cesf", 1}, {"cvfh", 1}, {"fpfh", 1}, {"shot", 1}}));
   EXPECT_FALSE(fs::exists(base + "/r/records.jsonl"));
 
   const auto m = pbcli::run("merge '" + base + "/r' --require-complete", kSrc);

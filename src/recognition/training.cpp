@@ -1,6 +1,9 @@
 // Training (offline): preprocess the training views the caller rendered,
 // let the descriptor method describe them, and keep the result in memory and
 // in the on-disk cache (cache.cpp).
+#include <filesystem>
+
+#include "core/file_lock.h"
 #include "core/random.h"
 #include "recognition/model.h"
 #include "recognition/preprocess/voxel_grid.h"
@@ -65,13 +68,23 @@ std::shared_ptr<const TrainedModel> train_model(const TrainingViews& input, cons
   }
 
   const cache::Key key = cache::training_key(input, s);
+  FileLock training_lock;
   if (!opt.cache_dir.empty()) {
     m->cache_file = cache::file_name(opt.cache_dir, input.model_name, s.descriptor, key);
-    if (cache::read(m->cache_file, key, *m)) {
+    const auto from_file = [&] {
+      if (!cache::read(m->cache_file, key, *m)) return false;
       m->derive_model_frame();
       if (from_cache) *from_cache = true;
-      return m;
-    }
+      return true;
+    };
+    if (from_file()) return m;
+    // Processes sharing the cache (workers, the shards of a sweep) train a
+    // model once: the first takes FILE.lock and trains, the others wait for
+    // it and then read what it wrote.
+    std::error_code ec;
+    std::filesystem::create_directories(std::filesystem::path(m->cache_file).parent_path(), ec);
+    training_lock = FileLock::acquire(m->cache_file + ".lock");
+    if (from_file()) return m;
   }
 
   for (size_t i = 0; i < input.views.size(); ++i) {
