@@ -141,6 +141,11 @@ TEST_P(ShardCount, ConcurrentShardsMergedEqualOneMachinesRecords) {
   EXPECT_EQ(trained, (std::map<std::string, int>{{"cesf", 1}, {"cvfh", 1}, {"fpfh", 1}, {"shot", 1}}));
   EXPECT_FALSE(fs::exists(base + "/r/records.jsonl"));
 
+  // Before the merge the reporter says what to do.
+  const auto early = pbcli::run("report '" + base + "/r' --format csv", kSrc);
+  EXPECT_EQ(early.code, 2) << early.err;
+  EXPECT_NE(early.err.find("posebench merge"), std::string::npos) << early.err;
+
   const auto m = pbcli::run("merge '" + base + "/r' --require-complete", kSrc);
   ASSERT_EQ(m.code, 0) << m.out << m.err;
   EXPECT_NE(m.out.find("merged 16 of 16 trials"), std::string::npos) << m.out;

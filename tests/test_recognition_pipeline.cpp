@@ -359,8 +359,16 @@ TEST_F(Pipeline, CacheKeyAndCorruptFiles) {
   EXPECT_FALSE(cached);
   pb::test::train(*mesh_, s, opt, &cached, name);
   EXPECT_TRUE(cached);
-  // No temporary files are left behind.
-  for (const auto& e : fs::directory_iterator(opt.cache_dir)) EXPECT_EQ(e.path().extension(), ".bin") << e.path();
+  // No temporary files are left behind: cache files, and beside each the
+  // lock its trainer held (kept: removing a lock file others may wait on
+  // would let two processes hold "the" lock).
+  for (const auto& e : fs::directory_iterator(opt.cache_dir)) {
+    const std::string p = e.path().string();
+    if (e.path().extension() == ".lock")
+      EXPECT_TRUE(fs::exists(p.substr(0, p.size() - 5))) << p;
+    else
+      EXPECT_EQ(e.path().extension(), ".bin") << p;
+  }
   // An unwritable cache location is an input error naming it.
   const fs::path blocker = dir / "a_file";
   std::ofstream(blocker) << "x";
