@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -370,4 +371,156 @@ TEST(Bop, DepthSizeMismatchIsAnInputError) {
   const BopDataset ds(root);
   const SceneInfo s = ds.load_scene("test", 7);
   expect_error([&] { ds.load_depth("test", 7, s.images.at(5)); }, p, "depth");
+}
+
+// ------------------------------------------------ validation where data enters
+
+namespace {
+
+// Rewrites one JSON file of the test dataset through `edit`.
+template <typename F>
+void edit_json(const std::string& path, F&& edit) {
+  nlohmann::json j = nlohmann::json::parse(slurp(path));
+  edit(j);
+  std::ofstream(path, std::ios::trunc) << j.dump();
+}
+
+}  // namespace
+
+TEST(BopValidation, CameraJsonIntrinsicsAndDepthScale) {
+  TempDir tmp;
+  const std::string cam = tmp / "camera.json";
+  const auto with = [&](const std::string& fields) {
+    std::ofstream(cam, std::ios::trunc) << "{" + fields + "}";
+  };
+  const std::string size = R"("width": 640, "height": 480, )";
+  with(size + R"("fx": 0, "fy": 500, "cx": 320, "cy": 240)");
+  expect_error([&] { read_camera_json(cam); }, cam, "fx");
+  with(size + R"("fx": 500, "fy": -1, "cx": 320, "cy": 240)");
+  expect_error([&] { read_camera_json(cam); }, cam, "fy");
+  with(size + R"("fx": 0.9, "fy": 1.2, "cx": 0.5, "cy": 0.5)");  // normalized by the image size
+  expect_error([&] { read_camera_json(cam); }, cam, "fx");
+  with(size + R"("fx": 500, "fy": 500, "cx": 320, "cy": 4800)");
+  expect_error([&] { read_camera_json(cam); }, cam, "cy");
+  with(size + R"("fx": 500, "fy": 500, "cx": 320, "cy": null)");
+  expect_error([&] { read_camera_json(cam); }, cam, "cy");
+  double scale = 0;
+  with(size + R"("fx": 500, "fy": 500, "cx": 320, "cy": 240, "depth_scale": 0)");
+  expect_error([&] { read_camera_json(cam, &scale); }, cam, "depth_scale");
+  with(size + R"("fx": 500, "fy": 500, "cx": 320, "cy": 240, "depth_scale": 0.1)");
+  EXPECT_NO_THROW(read_camera_json(cam, &scale));
+  EXPECT_EQ(scale, 0.1);
+}
+
+TEST(BopValidation, SceneCameraMatrixIsCheckedPerImage) {
+  TempDir tmp;
+  const std::string root = tmp / "ds";
+  write_dataset(root, 1.0);
+  const std::string dir = root + "/test/000007";
+  const std::string cam = dir + "/scene_camera.json";
+  const std::string good = slurp(cam);
+  // fx = 0: the defect that gave exit 0 and "no hypothesis".
+  edit_json(cam, [](auto& j) { j["5"]["cam_K"][0] = 0; });
+  expect_error([&] { read_scene_json(dir); }, cam, "5.cam_K.fx");
+  std::ofstream(cam, std::ios::trunc) << good;
+  edit_json(cam, [](auto& j) { j["10"]["cam_K"][1] = 0.5; });  // skew
+  expect_error([&] { read_scene_json(dir); }, cam, "10.cam_K");
+  std::ofstream(cam, std::ios::trunc) << good;
+  edit_json(cam, [](auto& j) { j["0"]["cam_K"][8] = 0; });  // not [.. 0 0 1]
+  expect_error([&] { read_scene_json(dir); }, cam, "0.cam_K");
+  std::ofstream(cam, std::ios::trunc) << good;
+  edit_json(cam, [](auto& j) { j["0"]["depth_scale"] = -1; });
+  expect_error([&] { read_scene_json(dir); }, cam, "0.depth_scale");
+  // The principal point against the image size (64 x 48), known to the dataset.
+  std::ofstream(cam, std::ios::trunc) << good;
+  edit_json(cam, [](auto& j) { j["5"]["cam_K"][2] = 1000.0; });
+  EXPECT_NO_THROW(read_scene_json(dir));
+  const BopDataset ds(root);
+  expect_error([&] { ds.load_scene("test", 7); }, cam, "5.cam_K.cx");
+}
+
+TEST(BopValidation, PosesMustBeRotations) {
+  TempDir tmp;
+  const std::string root = tmp / "ds";
+  const SceneInfo written = write_dataset(root, 1.0);
+  const std::string dir = root + "/test/000007";
+  const std::string gt = dir + "/scene_gt.json";
+  const std::string good = slurp(gt);
+  // Scaled by 1.001, a reflection, a shear: each named by file and entry.
+  edit_json(gt, [](auto& j) {
+    for (auto& v : j["10"][2]["cam_R_m2c"]) v = v.template get<double>() * 1.001;
+  });
+  expect_error([&] { read_scene_json(dir); }, gt, "10[2].cam_R_m2c");
+  std::ofstream(gt, std::ios::trunc) << good;
+  edit_json(gt, [](auto& j) {
+    for (int c = 0; c < 3; ++c) j["5"][0]["cam_R_m2c"][c] = -j["5"][0]["cam_R_m2c"][c].template get<double>();
+  });
+  expect_error([&] { read_scene_json(dir); }, gt, "5[0].cam_R_m2c");
+  std::ofstream(gt, std::ios::trunc) << good;
+  edit_json(gt, [](auto& j) { j["0"][0]["cam_R_m2c"][1] = j["0"][0]["cam_R_m2c"][1].template get<double>() + 1e-5; });
+  expect_error([&] { read_scene_json(dir); }, gt, "0[0].cam_R_m2c");
+  // Rounding in the 8th digit (as in BOP's own files) is accepted.
+  std::ofstream(gt, std::ios::trunc) << good;
+  edit_json(gt, [](auto& j) {
+    for (auto& v : j["0"][0]["cam_R_m2c"]) v = std::round(v.template get<double>() * 1e8) / 1e8;
+  });
+  EXPECT_NO_THROW(read_scene_json(dir));
+}
+
+TEST(BopValidation, SceneGtInfoFieldsAreOptional) {
+  TempDir tmp;
+  const std::string root = tmp / "ds";
+  write_dataset(root, 1.0);
+  const std::string dir = root + "/test/000007";
+  const std::string info = dir + "/scene_gt_info.json";
+  // No bbox_obj anywhere (many converted datasets): read, boxes "not given".
+  edit_json(info, [](auto& j) {
+    for (auto& [id, list] : j.items())
+      for (auto& e : list) e.erase("bbox_obj");
+  });
+  SceneInfo s = read_scene_json(dir);
+  EXPECT_EQ(s.images.at(5).gt_info.at(1).bbox_obj, (std::array<int, 4>{{-1, -1, 0, 0}}));
+  EXPECT_NEAR(s.images.at(5).gt_info.at(1).visib_fract, 100.0 / 120.0, 1e-12);
+  // visib_fract missing: from the pixel counts; those missing too: unknown.
+  edit_json(info, [](auto& j) {
+    j["5"][1].erase("visib_fract");
+    j["10"][0] = nlohmann::json::object();
+  });
+  s = read_scene_json(dir);
+  EXPECT_NEAR(s.images.at(5).gt_info.at(1).visib_fract, 100.0 / 121.0, 1e-12);
+  EXPECT_TRUE(std::isnan(s.images.at(10).gt_info.at(0).visib_fract));
+  EXPECT_EQ(s.images.at(10).gt_info.at(0).px_count_all, -1);
+  // A present field of the wrong type is still an error.
+  edit_json(info, [](auto& j) { j["0"][0]["bbox_visib"] = "wide"; });
+  expect_error([&] { read_scene_json(dir); }, info, "0[0].bbox_visib");
+  // No scene_gt_info.json at all: the scene reads, without gt_info.
+  fs::remove(info);
+  EXPECT_TRUE(read_scene_json(dir).images.at(5).gt_info.empty());
+}
+
+TEST(BopValidation, SymmetryTransformsMustBeRigid) {
+  TempDir tmp;
+  const std::string root = tmp / "ds";
+  write_dataset(root, 1.0);
+  const std::string mi = root + "/models/models_info.json";
+  const std::string good = slurp(mi);
+  edit_json(mi, [](auto& j) { j["1"]["symmetries_discrete"][1][0] = -2.0; });
+  expect_error([&] { read_models_info(mi); }, mi, "1.symmetries_discrete[1]");
+  std::ofstream(mi, std::ios::trunc) << good;
+  edit_json(mi, [](auto& j) { j["1"]["symmetries_discrete"][0][15] = 2.0; });
+  expect_error([&] { read_models_info(mi); }, mi, "1.symmetries_discrete[0]");
+  std::ofstream(mi, std::ios::trunc) << good;
+  edit_json(mi, [](auto& j) { j["3"]["diameter"] = 0; });
+  expect_error([&] { read_models_info(mi); }, mi, "3.diameter");
+  std::ofstream(mi, std::ios::trunc) << good;
+  edit_json(mi, [](auto& j) { j["3"]["symmetries_continuous"][0]["axis"] = {0, 0, 0}; });
+  expect_error([&] { read_models_info(mi); }, mi, "3.symmetries_continuous[0].axis");
+  // Six significant digits, as some datasets write them: accepted.
+  std::ofstream(mi, std::ios::trunc) << good;
+  edit_json(mi, [](auto& j) {
+    const double c = std::cos(0.3), s = std::sin(0.3);
+    const double r6[] = {std::round(c * 1e6) / 1e6, std::round(s * 1e6) / 1e6};
+    j["1"]["symmetries_discrete"][0] = {r6[0], -r6[1], 0, 0.1, r6[1], r6[0], 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  });
+  EXPECT_NO_THROW(read_models_info(mi));
 }

@@ -20,6 +20,7 @@
 #include "core/error.h"
 #include "io/bop_internal.h"
 #include "io/png.h"
+#include "io/validate.h"
 
 namespace fs = std::filesystem;
 
@@ -190,6 +191,10 @@ std::map<int, ModelInfo> read_models_info(const std::string& path) {
         Mat4 T;
         for (int r = 0; r < 4; ++r)
           for (int c = 0; c < 4; ++c) T(r, c) = v[4 * r + c];
+        const std::string field = s.path + "[" + std::to_string(i) + "]";
+        if (T(3, 0) != 0 || T(3, 1) != 0 || T(3, 2) != 0 || T(3, 3) != 1)
+          throw InputError(path, field, "the last row of a symmetry transform must be 0 0 0 1");
+        validate_rotation(T.topLeftCorner<3, 3>(), kSymmetryRotationTolerance, path, field);
         m.symmetries_discrete.push_back(T);
       }
     }
@@ -271,8 +276,7 @@ Intrinsics read_camera_json(const std::string& path, double* depth_scale) {
   K.height = r.key("height").integer();
   if (K.width <= 0) throw InputError(path, "width", "must be positive");
   if (K.height <= 0) throw InputError(path, "height", "must be positive");
-  if (!(K.fx > 0)) throw InputError(path, "fx", "must be positive");
-  if (!(K.fy > 0)) throw InputError(path, "fy", "must be positive");
+  validate_intrinsics(K, path, "");
   if (depth_scale) {
     *depth_scale = r.has("depth_scale") ? r.key("depth_scale").num() : 1.0;
     if (!(*depth_scale > 0)) throw InputError(path, "depth_scale", "must be positive");
@@ -342,7 +346,9 @@ SceneInfo read_scene_json(const std::string& scene_dir) {
     ImageInfo im;
     im.im_id = parse_id(it.key(), cam_path);
     const JRef e{it.value(), cam_path, it.key()};
-    im.K = Intrinsics::from_K(mat3_rowmajor(e.key("cam_K").nums(9)), 0, 0);
+    const Mat3 K = mat3_rowmajor(e.key("cam_K").nums(9));
+    validate_camera_matrix(K, 0, 0, cam_path, e.join("cam_K"));  // the image size is checked with the dataset's
+    im.K = Intrinsics::from_K(K, 0, 0);
     im.depth_scale = e.has("depth_scale") ? e.key("depth_scale").num() : 1.0;
     if (!(im.depth_scale > 0)) throw InputError(cam_path, e.join("depth_scale"), "must be positive");
     scene.images[im.im_id] = im;
@@ -354,6 +360,7 @@ SceneInfo read_scene_json(const std::string& scene_dir) {
       GtObject o;
       o.obj_id = e.key("obj_id").integer();
       o.T_cam_model.R = mat3_rowmajor(e.key("cam_R_m2c").nums(9));
+      validate_rotation(o.T_cam_model.R, kPoseRotationTolerance, list.file, e.join("cam_R_m2c"));
       const auto t = e.key("cam_t_m2c").nums(3);
       o.T_cam_model.t = Vec3(t[0], t[1], t[2]);
       im.gt.push_back(o);
@@ -364,11 +371,27 @@ SceneInfo read_scene_json(const std::string& scene_dir) {
       throw InputError(list.file, list.path,
                        std::to_string(list.j.size()) + " entries but scene_gt.json has " +
                            std::to_string(im.gt.size()));
+    // Every field is meta information (bop_toolkit's calc_gt_info.py) and
+    // optional here: converted datasets often lack some. A missing box stays
+    // (-1, -1, 0, 0), a missing count -1; a missing visib_fract is
+    // px_count_visib / px_count_all when both are given, else unknown (NaN).
     for (size_t i = 0; i < list.j.size(); ++i) {
-      const JRef e = list.at(i);  // braced initialization reads the keys in this order
-      im.gt_info.push_back(GtInfo{e.key("bbox_obj").int4(), e.key("bbox_visib").int4(),
-                                  e.key("px_count_all").integer(), e.key("px_count_valid").integer(),
-                                  e.key("px_count_visib").integer(), e.key("visib_fract").num()});
+      const JRef e = list.at(i);
+      if (!e.j.is_object()) throw InputError(list.file, e.path, "expected a JSON object");
+      GtInfo gi;
+      const auto count = [&](const char* k) { return e.has(k) ? e.key(k).integer() : -1; };
+      if (e.has("bbox_obj")) gi.bbox_obj = e.key("bbox_obj").int4();
+      if (e.has("bbox_visib")) gi.bbox_visib = e.key("bbox_visib").int4();
+      gi.px_count_all = count("px_count_all");
+      gi.px_count_valid = count("px_count_valid");
+      gi.px_count_visib = count("px_count_visib");
+      if (e.has("visib_fract"))
+        gi.visib_fract = e.key("visib_fract").num();
+      else if (gi.px_count_all > 0 && gi.px_count_visib >= 0)
+        gi.visib_fract = static_cast<double>(gi.px_count_visib) / gi.px_count_all;
+      else
+        gi.visib_fract = std::nan("");
+      im.gt_info.push_back(gi);
     }
   });
   return scene;

@@ -36,13 +36,14 @@ struct GtObject {
 };
 
 // Per ground truth statistics (scene_gt_info.json).
+// scene_gt_info.json, every field optional when read (see read_scene_json).
 struct GtInfo {
-  std::array<int, 4> bbox_obj{{-1, -1, 0, 0}};    // x, y, w, h
+  std::array<int, 4> bbox_obj{{-1, -1, 0, 0}};    // x, y, w, h; (-1, -1, 0, 0) = not given
   std::array<int, 4> bbox_visib{{-1, -1, 0, 0}};
-  int px_count_all = 0;
+  int px_count_all = 0;    // -1 = not given (when read)
   int px_count_valid = 0;
   int px_count_visib = 0;
-  double visib_fract = 0;
+  double visib_fract = 0;  // NaN = unknown (when read)
 };
 
 struct ImageInfo {

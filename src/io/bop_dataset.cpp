@@ -7,6 +7,7 @@
 #include "io/bop_internal.h"
 #include "io/mesh_io.h"
 #include "io/png.h"
+#include "io/validate.h"
 
 namespace fs = std::filesystem;
 
@@ -85,6 +86,7 @@ SceneInfo BopDataset::load_scene(const std::string& split, int scene_id) const {
         im.K.height = h.height;
       }
     }
+    validate_intrinsics(im.K, join_path(dir, "scene_camera.json"), std::to_string(id) + ".cam_K");
   }
   return s;
 }

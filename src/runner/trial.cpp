@@ -169,7 +169,8 @@ void run(TrialRecord& rec, const TrialContext& ctx) {
   if (!gt) return;  // nothing to judge against: no `correct` (as the records always had it)
   rec.gt = PoseRecord::from(gt->T_cam_model);
   const size_t gi = static_cast<size_t>(gt - &im.gt[0]);
-  if (gi < im.gt_info.size()) rec.visib_fract = im.gt_info[gi].visib_fract;
+  if (gi < im.gt_info.size() && std::isfinite(im.gt_info[gi].visib_fract))  // NaN: not given
+    rec.visib_fract = im.gt_info[gi].visib_fract;
   if (res.status == "ok")
     evaluate(res.T_cam_model, *gt, ds, im, obj_id, *mesh, ctx, rec);
   else
