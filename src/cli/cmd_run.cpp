@@ -17,6 +17,10 @@ static pb::cli::Command run_cmd("run", "run an experiment (YAML): trials in para
   app.add_option("--cache", opt.cache_dir, "training cache folder ('' = none)");
   app.add_option("--scenes", opt.scenes_dir, "where generated scene sets go");
   app.add_flag("--quiet,-q", opt.quiet, "no progress output");
+  app.add_option("--memory-limit-mb", opt.memory_limit_mb,
+                 "memory cap per trial (the worker's address space, RLIMIT_AS, in MB); a trial over it is "
+                 "recorded with status out_of_memory and the sweep goes on")
+      ->check(CLI::PositiveNumber);
   std::string shard;
   app.add_option("--shard", shard,
                  "run only shard I of N (0 <= I < N) of the trials, into OUT/shards/I-of-N.*; shards run "
@@ -35,7 +39,8 @@ static pb::cli::Command run_cmd("run", "run an experiment (YAML): trials in para
   std::cout << "experiment " << cfg.name << " (" << cfg.hash << ")"
             << (opt.shard.active() ? ", shard " + opt.shard.label() : std::string()) << ": " << s.total << " trials, "
             << s.already_done << " already recorded, " << s.ran << " run now (ok " << s.ok << ", no hypothesis "
-            << s.no_hypothesis << ", error " << s.errors << ", timeout " << s.timeouts << ") in " << s.seconds << " s\n";
+            << s.no_hypothesis << ", error " << s.errors << ", timeout " << s.timeouts
+            << (s.out_of_memory ? ", out of memory " + std::to_string(s.out_of_memory) : std::string()) << ") in " << s.seconds << " s\n";
   if (opt.shard.active())
     std::cout << "records: " << out << "/shards/" << opt.shard.name() << ".records.jsonl (merge with `posebench merge "
               << out << "`)\n";

@@ -337,7 +337,8 @@ nlohmann::json record_schema() {
                 "in every record with status ok and a gt (the judged ones); false = when the trial got that far "
                 "(message, init with registration_only, gt and visib_fract when the image has the object, "
                 "judgements when the experiment declares them)",
-                "a trial whose worker crashed or timed out (status error or timeout) has the always-required "
+                "a trial whose worker crashed, timed out or ran out of memory (status error, timeout or "
+                "out_of_memory) has the always-required "
                 "keys, message and correct = false only",
                 "type object with \"fields\": those keys only; with \"values\": any keys, each value as given; "
                 "with \"free\": true: any keys and values",

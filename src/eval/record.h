@@ -61,7 +61,7 @@ struct TrialRecord {
   // status ok, "when_gt" = in every record with status ok and `gt`). A trial
   // whose worker crashed or timed out has the trial, status, message and
   // correct = false only, as before the typed record.
-  std::string status;          // ok | no_hypothesis | error | timeout
+  std::string status;          // ok | no_hypothesis | error | timeout | out_of_memory
   std::optional<bool> correct;  // the thesis's judgement: with a GT pose (false without an estimate), or a failed worker
   std::optional<double> wall_s;  // wall time of the whole trial in its worker (s); none when the worker failed
   std::optional<std::string> message;

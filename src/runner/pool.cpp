@@ -3,6 +3,8 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -26,21 +28,30 @@ struct Worker {
   Timer started;
 };
 
-Worker spawn_worker(const std::string& binary, const std::string& ctx_line, const std::string& log_path,
-                    int omp_threads) {
+Worker spawn_worker(const PoolOptions& opt) {
   int to_child[2], from_child[2];
   if (pipe(to_child) != 0 || pipe(from_child) != 0) throw std::runtime_error("pipe failed");
+  const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid < 0) throw std::runtime_error("fork failed");
   if (pid == 0) {
+    // A worker dies with its runner (killed or not): no orphan goes on
+    // computing a trial whose record nobody will write.
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (getppid() != parent) _exit(127);
+    if (opt.memory_limit_mb > 0) {
+      const rlim_t bytes = static_cast<rlim_t>(opt.memory_limit_mb) * 1024 * 1024;
+      const rlimit lim{bytes, bytes};
+      setrlimit(RLIMIT_AS, &lim);
+    }
     dup2(to_child[0], 0);
     dup2(from_child[1], 1);
-    const int fd = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+    const int fd = ::open(opt.log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
     if (fd >= 0) dup2(fd, 2);
     close(to_child[1]);
     close(from_child[0]);
-    setenv("OMP_NUM_THREADS", std::to_string(omp_threads).c_str(), 1);
-    execl(binary.c_str(), binary.c_str(), "worker", static_cast<char*>(nullptr));
+    setenv("OMP_NUM_THREADS", std::to_string(opt.omp_threads).c_str(), 1);
+    execl(opt.binary.c_str(), opt.binary.c_str(), "worker", static_cast<char*>(nullptr));
     _exit(127);
   }
   close(to_child[0]);
@@ -51,7 +62,7 @@ Worker spawn_worker(const std::string& binary, const std::string& ctx_line, cons
   w.out_fd = from_child[0];
   fcntl(w.out_fd, F_SETFD, FD_CLOEXEC);
   fcntl(w.in_fd, F_SETFD, FD_CLOEXEC);
-  const std::string line = ctx_line + "\n";
+  const std::string line = opt.context + "\n";
   if (write(w.in_fd, line.data(), line.size()) != static_cast<ssize_t>(line.size()))
     throw std::runtime_error("cannot talk to worker");
   return w;
@@ -89,7 +100,7 @@ class Pool {
   }
 
  private:
-  Worker spawn() { return spawn_worker(opt_.binary, opt_.context, opt_.log_path, opt_.omp_threads); }
+  Worker spawn() { return spawn_worker(opt_); }
 
   // The input record with a failure outcome (the worker's own record is
   // lost: no times, no wall_s).
@@ -175,8 +186,11 @@ class Pool {
     const long ti = w.trial;
     w.pid = -1;
     if (ti >= 0) {
-      const std::string why = WIFSIGNALED(status) ? "worker crashed (signal " + std::to_string(WTERMSIG(status)) + ")"
-                                                  : "worker exited (code " + std::to_string(WEXITSTATUS(status)) + ")";
+      std::string why = WIFSIGNALED(status) ? "worker crashed (signal " + std::to_string(WTERMSIG(status)) + ")"
+                                            : "worker exited (code " + std::to_string(WEXITSTATUS(status)) + ")";
+      if (opt_.memory_limit_mb > 0 && WIFSIGNALED(status))
+        why += " under a memory limit of " + std::to_string(opt_.memory_limit_mb) + " MB (an allocation that "
+               "failed outside C++ can end a worker this way)";
       finish(w, failed(ti, "error", why + "; see " + opt_.log_path));
     }
     w = Worker{};

@@ -25,6 +25,7 @@ struct PoolOptions {
   int jobs = 1;
   int omp_threads = 1;   // OMP_NUM_THREADS each worker gets (jobs x omp_threads <= cores: no oversubscription)
   double timeout_s = 300;
+  long memory_limit_mb = 0;  // RLIMIT_AS of each worker (0 = none): a trial over it is "out_of_memory"
 };
 
 // Runs the trials `inputs[i]` for every i in `pending`, calling on_record

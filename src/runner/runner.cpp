@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -15,14 +16,16 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <unordered_set>
+#include <vector>
 
 #include "core/error.h"
+#include "core/file_lock.h"
 #include "core/timer.h"
 #include "core/yaml.h"
 #include "io/png.h"
-#include "core/file_lock.h"
 #include "runner/merge.h"
 #include "runner/pool.h"
 #include "runner/store.h"
@@ -143,6 +146,7 @@ void count(const TrialRecord& rec, RunSummary& sum) {
   if (rec.status == "ok") ++sum.ok;
   else if (rec.status == "no_hypothesis") ++sum.no_hypothesis;
   else if (rec.status == "timeout") ++sum.timeouts;
+  else if (rec.status == "out_of_memory") ++sum.out_of_memory;
   else ++sum.errors;
 }
 
@@ -169,7 +173,7 @@ nlohmann::json summary_json(const RunSummary& s) {
           {"already_recorded", s.already_done},
           {"ran", s.ran},
           {"status_counts", {{"ok", s.ok}, {"no_hypothesis", s.no_hypothesis}, {"error", s.errors},
-                             {"timeout", s.timeouts}}},
+                             {"timeout", s.timeouts}, {"out_of_memory", s.out_of_memory}}},
           {"jobs", s.jobs},
           {"omp_threads", s.omp_threads},
           {"load15_end", std::isfinite(s.load15_end) ? nlohmann::json(s.load15_end) : nlohmann::json(nullptr)},
@@ -236,6 +240,7 @@ RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
     po.jobs = opt.jobs;
     po.omp_threads = sum.omp_threads;
     po.timeout_s = cfg.timeout_s;
+    po.memory_limit_mb = opt.memory_limit_mb;
     Progress progress(opt.quiet, pending.size());
     run_in_workers(po, inputs, pending, [&](long, const TrialRecord& rec) {
       store.append(rec);
@@ -250,6 +255,43 @@ RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
   return sum;
 }
 
+namespace {
+
+// For testing the runner only (documented in README, "Testing hooks"):
+// POSEBENCH_INJECT_FAULT="KIND:TEXT[;KIND:TEXT...]" makes a worker fail on
+// every trial whose key contains TEXT: segfault (SIGSEGV), abort, exit (exit
+// code 3), hang (sleeps until the trial's time-out) or oom (allocates until
+// an allocation fails; only under a memory limit).
+void inject_fault(const std::string& key) {
+  const char* env = std::getenv("POSEBENCH_INJECT_FAULT");
+  if (!env || !*env) return;
+  std::stringstream spec(env);
+  std::string item;
+  while (std::getline(spec, item, ';')) {
+    const size_t colon = item.find(':');
+    if (colon == std::string::npos || key.find(item.substr(colon + 1)) == std::string::npos) continue;
+    const std::string kind = item.substr(0, colon);
+    std::cerr << "posebench worker: injected fault '" << kind << "' on " << key << std::endl;
+    if (kind == "segfault") raise(SIGSEGV);
+    if (kind == "abort") std::abort();
+    if (kind == "exit") _exit(3);
+    if (kind == "hang")
+      for (;;) pause();
+    if (kind == "oom") {
+      rlimit lim{};
+      if (getrlimit(RLIMIT_AS, &lim) != 0 || lim.rlim_cur == RLIM_INFINITY)
+        throw std::runtime_error("injected fault 'oom' needs a memory limit (run --memory-limit-mb)");
+      std::vector<std::unique_ptr<char[]>> hog;
+      for (;;) {
+        hog.emplace_back(new char[64 << 20]);
+        std::memset(hog.back().get(), 1, 64 << 20);
+      }
+    }
+  }
+}
+
+}  // namespace
+
 int worker_main() {
   std::string line;
   if (!std::getline(std::cin, line)) return 0;
@@ -258,7 +300,18 @@ int worker_main() {
     if (line.empty()) continue;
     nlohmann::json out;
     try {
-      out = run_trial(record_from_json(nlohmann::json::parse(line), "runner input", 0), ctx);
+      const TrialRecord trial = record_from_json(nlohmann::json::parse(line), "runner input", 0);
+      try {
+        inject_fault(trial.key);
+      } catch (const std::bad_alloc&) {
+        TrialRecord rec = trial;
+        rec.status = "out_of_memory";
+        rec.message = "an allocation failed (injected fault)";
+        rec.correct = false;
+        std::cout << nlohmann::json(rec).dump() << "\n" << std::flush;
+        continue;
+      }
+      out = run_trial(trial, ctx);
     } catch (const std::exception& e) {
       out = {{"status", "error"}, {"message", e.what()}};  // unreadable input: the runner records the error
     }

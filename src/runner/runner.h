@@ -19,6 +19,7 @@ struct RunOptions {
   std::string scenes_dir = "scenes";  // where generated scene sets go
   std::string binary;              // the posebench executable (workers, generator)
   bool quiet = false;              // no progress output
+  long memory_limit_mb = 0;        // per-trial memory cap (RLIMIT_AS of each worker; 0 = none)
   Shard shard;                     // run only this shard's trials, into OUT/shards/ (runner/shard.h)
 };
 
@@ -30,7 +31,7 @@ struct RunSummary {
   size_t total = 0;        // trials of the experiment (of this shard, when sharded)
   size_t already_done = 0; // found in the store at start (resume)
   size_t ran = 0;          // run now
-  size_t ok = 0, no_hypothesis = 0, errors = 0, timeouts = 0;  // of those run now
+  size_t ok = 0, no_hypothesis = 0, errors = 0, timeouts = 0, out_of_memory = 0;  // of those run now
   double seconds = 0;      // wall time of the invocation, scene generation included
   int jobs = 1;            // worker processes
   int omp_threads = 0;     // OMP_NUM_THREADS of each worker (omp_threads_per_worker: the user's, else cores / jobs)

@@ -4,10 +4,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "core/error.h"
 #include "io/png.h"
@@ -201,13 +204,33 @@ bool ResultStore::has(const std::string& key) const { return index_.count(key) >
 
 namespace {
 
+// For testing the runner only (README, "Testing hooks"):
+// POSEBENCH_TESTING_SLOW_APPEND_MS=N writes each record in two halves with N
+// ms between them, so a test can kill the runner in the middle of an append.
+long slow_append_ms() {
+  static const long ms = [] {
+    const char* env = std::getenv("POSEBENCH_TESTING_SLOW_APPEND_MS");
+    return env ? std::strtol(env, nullptr, 10) : 0L;
+  }();
+  return ms;
+}
+
 // Appends `line` to `path` and flushes it to the disk.
 void append_durably(const std::string& path, const std::string& line) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
   if (fd < 0) throw std::runtime_error("cannot open " + path + " for appending");
   size_t off = 0;
   while (off < line.size()) {
-    const ssize_t n = ::write(fd, line.data() + off, line.size() - off);
+    size_t chunk = line.size() - off;
+    if (slow_append_ms() > 0 && off == 0 && line.size() > 1) {
+      chunk = line.size() / 2;
+      ::fdatasync(fd);
+    }
+    const ssize_t n = ::write(fd, line.data() + off, chunk);
+    if (slow_append_ms() > 0 && off == 0 && n > 0) {
+      ::fdatasync(fd);
+      std::this_thread::sleep_for(std::chrono::milliseconds(slow_append_ms()));
+    }
     if (n <= 0) {
       ::close(fd);
       throw std::runtime_error("write failed: " + path);

@@ -1,6 +1,7 @@
 #include "runner/trial.h"
 
 #include <cmath>
+#include <new>
 #include <map>
 #include <memory>
 
@@ -238,6 +239,11 @@ TrialRecord run_trial(const TrialRecord& trial, const TrialContext& ctx) {
   Timer wall;
   try {
     run(rec, ctx);
+  } catch (const std::bad_alloc&) {  // over the run's --memory-limit-mb (RLIMIT_AS), or out of memory
+    rec = trial;
+    rec.status = "out_of_memory";
+    rec.message = "an allocation failed: the trial needs more memory than the worker may use";
+    rec.correct = false;
   } catch (const InputError& e) {
     rec.status = "error";
     rec.message = e.what();
