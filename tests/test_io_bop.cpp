@@ -404,6 +404,10 @@ TEST(BopValidation, CameraJsonIntrinsicsAndDepthScale) {
   expect_error([&] { read_camera_json(cam); }, cam, "cy");
   with(size + R"("fx": 500, "fy": 500, "cx": 320, "cy": null)");
   expect_error([&] { read_camera_json(cam); }, cam, "cy");
+  // Found by fuzz/fuzz_bop_camera.cpp: a number too large for a double made
+  // the JSON library throw out_of_range, which escaped as an internal error.
+  with(size + R"("fx": 955.4e50067, "fy": 500, "cx": 320, "cy": 240)");
+  expect_error([&] { read_camera_json(cam); }, cam, "");
   double scale = 0;
   with(size + R"("fx": 500, "fy": 500, "cx": 320, "cy": 240, "depth_scale": 0)");
   expect_error([&] { read_camera_json(cam, &scale); }, cam, "depth_scale");

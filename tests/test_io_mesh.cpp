@@ -1,7 +1,9 @@
 // Mesh loading (assimp) and binary PLY writing.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -14,6 +16,11 @@ namespace fs = std::filesystem;
 using namespace pb;
 
 namespace {
+
+std::string pbtest_slurp(const std::string& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
 
 struct TempDir {
   fs::path path;
@@ -172,4 +179,37 @@ TEST(MeshIo, BadFilesAreInputErrors) {
   const std::string folder = tmp / "folder.obj";
   fs::create_directory(folder);
   expect_mesh_error([&] { load_mesh(folder); }, folder);
+}
+
+// Found by fuzz/fuzz_mesh.cpp: assimp crashed (SIGSEGV) on a face whose
+// vertex index is out of range. The PLY check rejects it, ascii or binary,
+// and still accepts the same file with valid indices.
+TEST(MeshIo, PlyFaceIndexOutOfRangeIsAnInputErrorNotACrash) {
+  TempDir tmp;
+  const std::string head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                           "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                           "0 0 0\n10 0 0\n0 10 0\n";
+  const std::string good = tmp / "good.ply", bad = tmp / "bad.ply", negative = tmp / "negative.ply";
+  std::ofstream(good) << head << "3 0 1 2\n";
+  std::ofstream(bad) << head << "3 0 1 77777\n";
+  std::ofstream(negative) << head << "3 0 -1 2\n";
+  EXPECT_EQ(load_mesh(good).faces.size(), 1u);
+  expect_mesh_error([&] { load_mesh(bad); }, bad);
+  expect_mesh_error([&] { load_mesh(negative); }, negative);
+  // Binary: the fuzzer's input, a mutated copy of a generated model.
+  Mesh m;
+  m.vertices = {{0, 0, 0}, {10, 0, 0}, {0, 10, 0}};
+  m.faces = {{0, 1, 2}};
+  const std::string bin = tmp / "bin.ply";
+  write_ply(bin, m);
+  std::string bytes = pbtest_slurp(bin);
+  EXPECT_EQ(load_mesh(bin).faces.size(), 1u);
+  const int32_t huge = 0x7878c6f8;
+  std::memcpy(&bytes[bytes.size() - 4], &huge, 4);  // the last index of the one face
+  std::ofstream(bin, std::ios::binary | std::ios::trunc) << bytes;
+  expect_mesh_error([&] { load_mesh(bin); }, bin);
+  // A count the file cannot hold is rejected before anything is allocated.
+  const std::string big = tmp / "big.ply";
+  std::ofstream(big) << "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nend_header\n1234";
+  expect_mesh_error([&] { load_mesh(big); }, big);
 }

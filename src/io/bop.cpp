@@ -40,7 +40,7 @@ json read_json(const std::string& path) {
   ss << in.rdbuf();
   try {
     return json::parse(ss.str());
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse_error, and out_of_range for a number like 1e99999
     throw InputError(path, "", std::string("malformed JSON: ") + e.what());
   }
 }

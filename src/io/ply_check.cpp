@@ -1,0 +1,185 @@
+#include "io/ply_check.h"
+
+#include <cctype>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "core/error.h"
+
+namespace pb {
+
+namespace {
+
+struct Property {
+  std::string name;
+  int size = 0;        // bytes of a scalar (or of each list item)
+  int count_size = 0;  // > 0: a list, with a count of this many bytes
+  bool is_float = false;
+};
+
+struct Element {
+  std::string name;
+  uint64_t count = 0;
+  std::vector<Property> props;
+};
+
+int type_size(const std::string& t, bool* is_float) {
+  *is_float = t == "float" || t == "float32" || t == "double" || t == "float64";
+  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+  if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" || t == "float32") return 4;
+  if (t == "double" || t == "float64") return 8;
+  return 0;
+}
+
+// The body reader: ascii tokens or binary values in either byte order.
+class Body {
+ public:
+  Body(const std::string& path, const std::string& bytes, size_t pos, int format)
+      : path_(path), b_(bytes), pos_(pos), format_(format) {}
+  // One value as a double (integers exactly up to 2^53).
+  double value(int size, bool is_float) {
+    if (format_ == 0) return token();
+    if (size < 1 || size > 8) fail("bad value size");
+    if (pos_ + static_cast<size_t>(size) > b_.size()) fail("the data ends before the declared elements do");
+    unsigned char raw[8];
+    std::memcpy(raw, b_.data() + pos_, static_cast<size_t>(size));
+    pos_ += static_cast<size_t>(size);
+    if (format_ == 2)
+      for (int i = 0; i < size / 2; ++i) std::swap(raw[i], raw[size - 1 - i]);
+    if (is_float) {
+      if (size == 4) {
+        float f;
+        std::memcpy(&f, raw, 4);
+        return f;
+      }
+      double d;
+      std::memcpy(&d, raw, 8);
+      return d;
+    }
+    uint64_t u = 0;
+    std::memcpy(&u, raw, static_cast<size_t>(size));
+    const int bits = 8 * size;
+    if (bits < 64 && (u >> (bits - 1)) & 1u && signed_) u |= ~uint64_t{0} << bits;  // sign-extend
+    return signed_ ? static_cast<double>(static_cast<int64_t>(u)) : static_cast<double>(u);
+  }
+  void set_signed(bool s) { signed_ = s; }
+  [[noreturn]] void fail(const std::string& why) const { throw InputError(path_, "mesh", "broken PLY: " + why); }
+
+ private:
+  double token() {
+    while (pos_ < b_.size() && std::isspace(static_cast<unsigned char>(b_[pos_]))) ++pos_;
+    if (pos_ >= b_.size()) fail("the data ends before the declared elements do");
+    const size_t start = pos_;
+    while (pos_ < b_.size() && !std::isspace(static_cast<unsigned char>(b_[pos_]))) ++pos_;
+    const std::string t = b_.substr(start, pos_ - start);
+    char* end = nullptr;
+    const double v = std::strtod(t.c_str(), &end);
+    if (end != t.c_str() + t.size()) fail("'" + t.substr(0, 20) + "' is not a number");
+    return v;
+  }
+  const std::string& path_;
+  const std::string& b_;
+  size_t pos_;
+  int format_;  // 0 ascii, 1 binary little endian, 2 binary big endian
+  bool signed_ = true;
+};
+
+bool is_signed_type(const std::string& t) { return !(t.size() > 1 && t[0] == 'u'); }
+
+}  // namespace
+
+void check_ply(const std::string& path, const std::string& bytes) {
+  const auto fail = [&](const std::string& why) { throw InputError(path, "mesh", "broken PLY: " + why); };
+  if (bytes.compare(0, 3, "ply") != 0) throw InputError(path, "mesh", "not a PLY file (no 'ply' magic)");
+  const size_t end = bytes.find("end_header");
+  if (end == std::string::npos) throw InputError(path, "mesh", "truncated PLY: the header has no 'end_header'");
+  size_t body = bytes.find('\n', end);
+  if (body == std::string::npos) fail("nothing after end_header");
+  ++body;
+  std::istringstream header(bytes.substr(0, end));
+  std::string line;
+  int format = -1;
+  std::vector<Element> elements;
+  std::vector<std::vector<bool>> signs;  // per element, per property: the (item) type is signed
+  std::getline(header, line);            // "ply"
+  while (std::getline(header, line)) {
+    std::istringstream w(line);
+    std::string key;
+    if (!(w >> key) || key == "comment" || key == "obj_info") continue;
+    if (key == "format") {
+      std::string f;
+      w >> f;
+      format = f == "ascii" ? 0 : f == "binary_little_endian" ? 1 : f == "binary_big_endian" ? 2 : -1;
+      if (format < 0) fail("unknown format '" + f + "'");
+    } else if (key == "element") {
+      Element e;
+      std::string count;
+      if (!(w >> e.name >> count) || count.empty() || count.find_first_not_of("0123456789") != std::string::npos ||
+          count.size() > 10)
+        fail("bad element line '" + line.substr(0, 60) + "'");
+      e.count = std::strtoull(count.c_str(), nullptr, 10);
+      elements.push_back(e);
+      signs.emplace_back();
+    } else if (key == "property") {
+      if (elements.empty()) fail("a property before any element");
+      std::string type;
+      w >> type;
+      Property p;
+      std::string item = type;
+      bool f = false;
+      if (type == "list") {
+        std::string ct;
+        w >> ct >> item;
+        p.count_size = type_size(ct, &f);
+        if (p.count_size == 0 || f) fail("bad list count type in '" + line.substr(0, 60) + "'");
+      }
+      p.size = type_size(item, &p.is_float);
+      if (p.size == 0 || !(w >> p.name)) fail("bad property line '" + line.substr(0, 60) + "'");
+      elements.back().props.push_back(p);
+      signs.back().push_back(is_signed_type(item));
+    } else {
+      fail("unknown header line '" + line.substr(0, 60) + "'");
+    }
+  }
+  if (format < 0) fail("no format line");
+  uint64_t vertices = 0;
+  for (const auto& e : elements)
+    if (e.name == "vertex") vertices = e.count;
+  // Each declared value needs at least one byte: counts the data cannot hold
+  // are rejected before anything is read or allocated.
+  const uint64_t avail = bytes.size() - body;
+  for (const auto& e : elements)
+    if (!e.props.empty() && e.count > avail) fail("element '" + e.name + "' declares more values than the file holds");
+  Body r(path, bytes, body, format);
+  for (size_t ei = 0; ei < elements.size(); ++ei) {
+    const Element& e = elements[ei];
+    for (uint64_t i = 0; i < e.count; ++i)
+      for (size_t pi = 0; pi < e.props.size(); ++pi) {
+        const Property& p = e.props[pi];
+        const bool indices = e.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index");
+        if (p.count_size == 0) {
+          r.set_signed(signs[ei][pi]);
+          r.value(p.size, p.is_float);
+          continue;
+        }
+        r.set_signed(false);
+        const double n = r.value(p.count_size, false);
+        if (!(n >= 0) || n != static_cast<double>(static_cast<uint64_t>(n)) || n > static_cast<double>(avail))
+          fail("a list of element '" + e.name + "' has an impossible length");
+        r.set_signed(signs[ei][pi]);
+        for (uint64_t k = 0; k < static_cast<uint64_t>(n); ++k) {
+          const double v = r.value(p.size, p.is_float);
+          if (indices && !(v >= 0 && v < static_cast<double>(vertices) && v == static_cast<double>(static_cast<int64_t>(v))))
+            fail("face " + std::to_string(i) + " has vertex index " + std::to_string(v) + " (there are " +
+                 std::to_string(vertices) + " vertices)");
+        }
+      }
+  }
+}
+
+}  // namespace pb
