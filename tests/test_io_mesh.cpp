@@ -196,6 +196,9 @@ TEST(MeshIo, PlyFaceIndexOutOfRangeIsAnInputErrorNotACrash) {
   EXPECT_EQ(load_mesh(good).faces.size(), 1u);
   expect_mesh_error([&] { load_mesh(bad); }, bad);
   expect_mesh_error([&] { load_mesh(negative); }, negative);
+  const std::string two = tmp / "two.ply";  // assimp's triangulation aborted on it
+  std::ofstream(two) << head << "2 0 1\n";
+  expect_mesh_error([&] { load_mesh(two); }, two);
   // Binary: the fuzzer's input, a mutated copy of a generated model.
   Mesh m;
   m.vertices = {{0, 0, 0}, {10, 0, 0}, {0, 10, 0}};
@@ -208,6 +211,12 @@ TEST(MeshIo, PlyFaceIndexOutOfRangeIsAnInputErrorNotACrash) {
   std::memcpy(&bytes[bytes.size() - 4], &huge, 4);  // the last index of the one face
   std::ofstream(bin, std::ios::binary | std::ios::trunc) << bytes;
   expect_mesh_error([&] { load_mesh(bin); }, bin);
+  // A comment that contains "end_header" does not end the header (assimp
+  // read on and crashed: the second fuzzing finding).
+  const std::string comment = tmp / "comment.ply";
+  std::ofstream(comment) << "ply\nformat ascii 1.0\ncomment see end_header below\nelement vertex 1\n"
+                            "property float x\n";
+  expect_mesh_error([&] { load_mesh(comment); }, comment);
   // A count the file cannot hold is rejected before anything is allocated.
   const std::string big = tmp / "big.ply";
   std::ofstream(big) << "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nend_header\n1234";

@@ -106,6 +106,10 @@ TEST(SceneConfig, Errors) {
   error_of("scenario: table\ndistractors: {pool: [boletus], count: [-1, 2]}\n", "distractors.count");
   error_of("scenario: table\ntarget_upright_probability: 2\n", "target_upright_probability");
   error_of("scenario: table\nimages: many\n", "images");
+  // A key that is not a plain name (found by fuzz/fuzz_scene_yaml.cpp:
+  // yaml-cpp's BadConversion escaped as an internal error).
+  m = error_of("scenario: table\n? [80, 20]\n: 3\n", "");
+  EXPECT_NE(m.find("a key must be a plain name"), std::string::npos) << m;
   m = error_of("scenario: table\nsensor: lidar9000\n", "sensor");
   EXPECT_NE(m.find("lidar9000"), std::string::npos) << m;
 }

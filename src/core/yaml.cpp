@@ -44,10 +44,19 @@ YamlNode YamlNode::at(size_t i) const {
 
 size_t YamlNode::size() const { return node_.IsSequence() || node_.IsMap() ? node_.size() : 0; }
 
+// A mapping key as text; a key that is not a plain scalar ("? [1, 2]",
+// found by fuzzing: yaml-cpp threw BadConversion) is an InputError.
+static std::string key_text(const YAML::Node& key, const std::string& file, const std::string& path) {
+  if (!key.IsScalar())
+    throw InputError(file, path,
+                     "a key must be a plain name (line " + std::to_string(key.Mark().line + 1) + ")");
+  return key.Scalar();
+}
+
 std::vector<std::string> YamlNode::keys() const {
   std::vector<std::string> k;
   if (node_.IsMap())
-    for (const auto& kv : node_) k.push_back(kv.first.as<std::string>());
+    for (const auto& kv : node_) k.push_back(key_text(kv.first, file_, path_));
   return k;
 }
 
@@ -55,7 +64,7 @@ void YamlNode::check_keys(const std::set<std::string>& allowed) const {
   if (!defined()) return;
   if (!node_.IsMap()) fail("expected a mapping");
   for (const auto& kv : node_) {
-    const std::string key = kv.first.as<std::string>();
+    const std::string key = key_text(kv.first, file_, path_);
     if (!allowed.count(key)) {
       std::string list;
       for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
@@ -112,7 +121,7 @@ double YamlNode::get_nonnegative(const std::string& key, double fallback) const 
 nlohmann::json yaml_to_json(const YAML::Node& n) {
   if (n.IsMap()) {
     nlohmann::json j = nlohmann::json::object();
-    for (const auto& kv : n) j[kv.first.as<std::string>()] = yaml_to_json(kv.second);
+    for (const auto& kv : n) j[key_text(kv.first, "", "")] = yaml_to_json(kv.second);
     return j;
   }
   if (n.IsSequence()) {

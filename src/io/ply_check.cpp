@@ -96,11 +96,25 @@ bool is_signed_type(const std::string& t) { return !(t.size() > 1 && t[0] == 'u'
 void check_ply(const std::string& path, const std::string& bytes) {
   const auto fail = [&](const std::string& why) { throw InputError(path, "mesh", "broken PLY: " + why); };
   if (bytes.compare(0, 3, "ply") != 0) throw InputError(path, "mesh", "not a PLY file (no 'ply' magic)");
-  const size_t end = bytes.find("end_header");
-  if (end == std::string::npos) throw InputError(path, "mesh", "truncated PLY: the header has no 'end_header'");
-  size_t body = bytes.find('\n', end);
-  if (body == std::string::npos) fail("nothing after end_header");
-  ++body;
+  // The header ends at a line that is exactly "end_header" (a comment that
+  // merely contains the word does not end it: assimp reads on, found by
+  // fuzzing).
+  size_t body = std::string::npos, end = 0;
+  for (size_t pos = 0; pos < bytes.size();) {
+    size_t nl = bytes.find('\n', pos);
+    if (nl == std::string::npos) nl = bytes.size();
+    std::string l = bytes.substr(pos, nl - pos);
+    while (!l.empty() && (l.back() == '\r' || l.back() == ' ' || l.back() == '\t')) l.pop_back();
+    if (l == "end_header") {
+      end = pos;
+      body = nl + 1;
+      break;
+    }
+    pos = nl + 1;
+  }
+  if (body == std::string::npos)
+    throw InputError(path, "mesh", "truncated PLY: the header has no 'end_header' line");
+  if (body > bytes.size()) body = bytes.size();
   std::istringstream header(bytes.substr(0, end));
   std::string line;
   int format = -1;
@@ -171,6 +185,8 @@ void check_ply(const std::string& path, const std::string& bytes) {
         const double n = r.value(p.count_size, false);
         if (!(n >= 0) || n != static_cast<double>(static_cast<uint64_t>(n)) || n > static_cast<double>(avail))
           fail("a list of element '" + e.name + "' has an impossible length");
+        if (indices && n < 3)  // assimp's triangulation asserts (abort) on such a face: found by fuzzing
+          fail("face " + std::to_string(i) + " has " + std::to_string(static_cast<int>(n)) + " vertices (3 or more)");
         r.set_signed(signs[ei][pi]);
         for (uint64_t k = 0; k < static_cast<uint64_t>(n); ++k) {
           const double v = r.value(p.size, p.is_float);
