@@ -257,7 +257,7 @@ RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
 
 namespace {
 
-// For testing the runner only (documented in README, "Testing hooks"):
+// For testing the runner only (documented in README, section CI):
 // POSEBENCH_INJECT_FAULT="KIND:TEXT[;KIND:TEXT...]" makes a worker fail on
 // every trial whose key contains TEXT: segfault (SIGSEGV), abort, exit (exit
 // code 3), hang (sleeps until the trial's time-out) or oom (allocates until
