@@ -159,6 +159,8 @@ TEST(Merge, NeedsTheTrialListAndRefusesWhileARunWrites) {
   { pb::ResultStore a(d, {{"name", "e"}}, "h", "0-of-1"); }
   EXPECT_THROW(pb::merge_results(d), pb::InputError);  // no trials.json
   pb::ResultStore::write_trial_list(d, "h", {"k0"});
+  EXPECT_THROW(pb::merge_results(d, {d + "/no_such_folder"}), pb::InputError);  // not a filesystem_error
+  pb::ResultStore::write_trial_list(d, "h", {"k0"});
   pb::ResultStore running(d, {{"name", "e"}}, "h");  // a plain run holding the folder's records
   try {
     pb::merge_results(d);

@@ -105,7 +105,9 @@ MergeReport merge_results(const std::string& dir, const std::vector<std::string>
   rep.trials = keys.size();
   std::vector<std::string> files = record_files(dir, hash);
   for (const auto& f : from) {
-    if (fs::equivalent(fs::path(f), fs::path(dir))) continue;
+    std::error_code ec;
+    if (!fs::is_directory(f, ec)) throw InputError(f, "", "no such results folder: nothing merged");
+    if (fs::equivalent(fs::path(f), fs::path(dir), ec)) continue;
     for (auto& file : record_files(f, hash)) files.push_back(std::move(file));
   }
 
