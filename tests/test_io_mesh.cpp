@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "io/mesh_io.h"
+#include "io/ply_check.h"
 
 namespace fs = std::filesystem;
 using namespace pb;
@@ -217,6 +218,13 @@ TEST(MeshIo, PlyFaceIndexOutOfRangeIsAnInputErrorNotACrash) {
   std::ofstream(comment) << "ply\nformat ascii 1.0\ncomment see end_header below\nelement vertex 1\n"
                             "property float x\n";
   expect_mesh_error([&] { load_mesh(comment); }, comment);
+  // An element without properties holds no data, whatever its count: no
+  // walk over 9999999999 empty records.
+  const std::string empty_element = tmp / "empty_element.ply";
+  std::ofstream(empty_element) << "ply\nformat ascii 1.0\nelement nothing 9999999999\nelement vertex 3\n"
+                                  "property float x\nproperty float y\nproperty float z\nelement face 1\n"
+                                  "property list uchar int vertex_indices\nend_header\n0 0 0\n10 0 0\n0 10 0\n3 0 1 2\n";
+  EXPECT_NO_THROW(check_ply(empty_element, pbtest_slurp(empty_element)));
   // A count the file cannot hold is rejected before anything is allocated.
   const std::string big = tmp / "big.ply";
   std::ofstream(big) << "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nend_header\n1234";
