@@ -8,7 +8,7 @@
 # --seconds N: each target runs N seconds (default 60); --runs N: each runs N
 # inputs instead (e.g. --runs 1000000). --light: only the targets that need
 # no PCL (all but experiment YAML and the training cache), which build in
-# minutes: CI runs `--light --seconds 4`. A crash, a sanitizer report, a
+# minutes (a smoke run: `--light --seconds 4`). A crash, a sanitizer report, a
 # time-out (> 10 s on one input) or an exception other than InputError stops
 # that target: the input is saved as build-fuzz/findings/NAME/crash-*, the
 # script goes on with the others and exits 1 at the end. Findings fixed are

@@ -1,6 +1,7 @@
 // Helpers for tests that drive the posebench binary (test_cli_*.cpp).
 #pragma once
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -9,6 +10,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
@@ -51,6 +54,27 @@ inline Run run(const std::string& args, const std::string& cwd) {
 inline void write_file(const std::string& path, const std::string& text) {
   std::filesystem::create_directories(std::filesystem::path(path).parent_path());
   std::ofstream(path) << text;
+}
+
+// The records of a records file by key, without the fields that measure
+// time (times, wall_s, train_s, train_from_cache); with dataset_name_only,
+// `dataset` (the scene folder's path) is cut to the folder's name, the scene
+// set's content hash, for runs whose scene folders differ. A key recorded
+// twice fails the test.
+inline std::map<std::string, nlohmann::json> records_by_key(const std::string& records_file,
+                                                            bool dataset_name_only = false) {
+  std::map<std::string, nlohmann::json> out;
+  std::ifstream in(records_file);
+  std::string line;
+  while (std::getline(in, line)) {
+    auto j = nlohmann::json::parse(line);
+    for (const char* k : {"times", "wall_s", "train_s", "train_from_cache"}) j.erase(k);
+    if (dataset_name_only) j["dataset"] = std::filesystem::path(j["dataset"].get<std::string>()).filename().string();
+    const std::string key = j["key"];
+    EXPECT_EQ(out.count(key), 0u) << "duplicate record " << key << " in " << records_file;
+    out[key] = j;
+  }
+  return out;
 }
 
 struct TempDir {

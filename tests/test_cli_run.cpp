@@ -26,17 +26,7 @@ std::string experiment_yaml(const std::string& scene_cfg) {
 }
 
 std::map<std::string, nlohmann::json> comparable(const std::string& dir) {
-  std::map<std::string, nlohmann::json> out;
-  std::ifstream in(dir + "/records.jsonl");
-  std::string line;
-  while (std::getline(in, line)) {
-    auto j = nlohmann::json::parse(line);
-    for (const char* k : {"times", "wall_s", "train_s", "train_from_cache"}) j.erase(k);
-    const std::string key = j["key"];
-    EXPECT_EQ(out.count(key), 0u) << "duplicate record " << key;
-    out[key] = j;
-  }
-  return out;
+  return pbcli::records_by_key(dir + "/records.jsonl");
 }
 
 class RunTest : public ::testing::Test {

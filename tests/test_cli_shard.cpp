@@ -28,22 +28,9 @@ namespace {
 const std::string kSrc = POSEBENCH_SOURCE_DIR;
 const std::string kDemo = "configs/experiments/demo.yaml";
 
-// Records by key without the fields that measure time; `dataset` (the scene
-// folder's path, which differs between the test's folders) reduced to the
-// folder's name, which is the scene set's content hash.
+// Records by key, timing aside; every run here has its own scene folder.
 std::map<std::string, nlohmann::json> comparable(const std::string& records_file) {
-  std::map<std::string, nlohmann::json> out;
-  std::ifstream in(records_file);
-  std::string line;
-  while (std::getline(in, line)) {
-    auto j = nlohmann::json::parse(line);
-    for (const char* k : {"times", "wall_s", "train_s", "train_from_cache"}) j.erase(k);
-    j["dataset"] = fs::path(j["dataset"].get<std::string>()).filename().string();
-    const std::string key = j["key"];
-    EXPECT_EQ(out.count(key), 0u) << "duplicate record " << key;
-    out[key] = j;
-  }
-  return out;
+  return pbcli::records_by_key(records_file, true);
 }
 
 std::vector<std::string> keys_in_file_order(const std::string& records_file) {

@@ -39,16 +39,7 @@ Shell sh(const std::string& cmd) {
 }
 
 std::map<std::string, nlohmann::json> comparable(const std::string& records_file) {
-  std::map<std::string, nlohmann::json> out;
-  std::ifstream in(records_file);
-  std::string line;
-  while (std::getline(in, line)) {
-    auto j = nlohmann::json::parse(line);
-    for (const char* k : {"times", "wall_s", "train_s", "train_from_cache"}) j.erase(k);
-    j["dataset"] = fs::path(j["dataset"].get<std::string>()).filename().string();
-    out[j["key"].get<std::string>()] = j;
-  }
-  return out;
+  return pbcli::records_by_key(records_file, true);  // the cluster run has its own scene folder
 }
 
 // JobState of every line `scontrol show job ID` prints (one per array task).

@@ -16,6 +16,7 @@
 #include "runner/merge.h"
 #include "runner/shard.h"
 #include "runner/store.h"
+#include "runner_test_util.h"
 
 namespace fs = std::filesystem;
 
@@ -80,29 +81,7 @@ TEST(Shard, ParsesIAndNAndRejectsTheRest) {
     EXPECT_THROW(pb::parse_shard(bad), pb::InputError) << bad;
 }
 
-pb::TrialRecord record(const std::string& key, const std::string& status, double score = 0.5) {
-  pb::TrialRecord r;
-  r.key = key;
-  r.scene = r.scenario = "table";
-  r.dataset = "d";
-  r.split = "test";
-  r.descriptor = "cvfh";
-  r.refinement = "icp";
-  r.status = status;
-  if (status == "ok") {
-    r.wall_s = 0.5;
-    r.obj_id = 2;
-    r.settings_resolved = nlohmann::json::object();
-    r.train_s = 0.1;
-    r.train_from_cache = true;
-    r.times = pb::StageTimesRecord{};
-    r.hypotheses = 1;
-    r.estimate = pb::PoseRecord{{1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 0, 700}};
-    r.score = score;
-    r.inliers = 120;
-  }
-  return r;
-}
+using pbtest::record;
 
 struct Folder {
   fs::path dir = fs::temp_directory_path() / ("posebench_merge_" + std::to_string(::getpid()));

@@ -8,37 +8,13 @@
 
 #include "core/error.h"
 #include "runner/store.h"
+#include "runner_test_util.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-// A complete record (every key required for its status) with this key and
-// status.
-pb::TrialRecord record(const std::string& key, const std::string& status) {
-  pb::TrialRecord r;
-  r.key = key;
-  r.scene = "table";
-  r.scenario = "table";
-  r.dataset = "d";
-  r.split = "test";
-  r.descriptor = "fpfh";
-  r.refinement = "icp";
-  r.status = status;
-  if (status == "ok") {  // the keys required with status ok
-    r.wall_s = 0.5;
-    r.obj_id = 2;
-    r.settings_resolved = nlohmann::json::object();
-    r.train_s = 0.1;
-    r.train_from_cache = true;
-    r.times = pb::StageTimesRecord{};
-    r.hypotheses = 1;
-    r.estimate = pb::PoseRecord{{1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 0, 700}};
-    r.score = 0.9;
-    r.inliers = 120;
-  }
-  return r;
-}
+using pbtest::record;
 
 // The trial part of a record as the runner wrote it before the typed record
 // (the same keys today).
