@@ -4,7 +4,7 @@
 # ctest there. Any report fails the test that produced it.
 #
 #   scripts/sanitize.sh            # everything (see README "CI" for the time)
-#   scripts/sanitize.sh --reduced  # the unit tests of io, eval and runner (meant for CI; not in .ci/run yet)
+#   scripts/sanitize.sh --reduced  # the unit tests of io, eval and runner (.ci/run runs it)
 #   scripts/sanitize.sh -- -R Bop  # extra ctest arguments after --
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

@@ -8,6 +8,9 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "core/error.h"
 #include "io/mesh_io.h"
@@ -227,6 +230,49 @@ TEST(MeshIo, PlyFaceIndexOutOfRangeIsAnInputErrorNotACrash) {
   EXPECT_NO_THROW(check_ply(empty_element, pbtest_slurp(empty_element)));
   // A count the file cannot hold is rejected before anything is allocated.
   const std::string big = tmp / "big.ply";
-  std::ofstream(big) << "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nend_header\n1234";
+  std::ofstream(big) << "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\n"
+                        "property float y\nproperty float z\nend_header\n1234";
   expect_mesh_error([&] { load_mesh(big); }, big);
+}
+
+// The header grammar: the third fuzzing finding was a binary PLY whose
+// property name held NUL bytes (assimp crashed reading it). Each rule below
+// is one rejected header; the valid header beside them loads.
+TEST(MeshIo, PlyHeaderGrammarIsChecked) {
+  TempDir tmp;
+  const std::string tail = "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                           "0 0 0\n10 0 0\n0 10 0\n3 0 1 2\n";
+  const std::string xyz = "property float x\nproperty float y\nproperty float z\n";
+  const auto header = [&](const std::string& first, const std::string& props) {
+    return first + "format ascii 1.0\nelement vertex 3\n" + props + tail;
+  };
+  const std::string good = tmp / "good.ply";
+  std::ofstream(good) << header("ply\n", xyz);
+  EXPECT_EQ(load_mesh(good).faces.size(), 1u);
+  const std::string crlf = tmp / "crlf.ply";  // CRLF line ends are valid
+  std::ofstream(crlf) << header("ply\r\n", xyz);
+  EXPECT_NO_THROW(check_ply(crlf, pbtest_slurp(crlf)));
+  const std::string utf8 = tmp / "utf8.ply";  // UTF-8 in a comment is valid
+  std::ofstream(utf8) << "ply\nformat ascii 1.0\ncomment cr\xc3\xa9\xc3\xa9\nelement vertex 3\n" << xyz << tail;
+  EXPECT_EQ(load_mesh(utf8).faces.size(), 1u);
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"nul_in_name", header("ply\n", "property float x\nproperty float y\nproperty float " + std::string(2, '\0') + "z\n")},
+      {"magic", header("plyx\n", xyz)},
+      {"comment_before_format", header("ply\ncomment first\n", xyz)},
+      {"no_z", header("ply\n", "property float x\nproperty float y\n")},
+      {"list_z", header("ply\n", "property float x\nproperty float y\nproperty list uchar float z\n")},
+      {"twice", header("ply\n", xyz + "property float x\n")},
+      {"extra_word", header("ply\n", "property float x\nproperty float y\nproperty float z w\n")},
+      {"bad_name", header("ply\n", xyz + "property float n$x\n")},
+      {"bad_byte_in_name", header("ply\n", xyz + "property float caf\xc3\xa9\n")},
+  };
+  for (const auto& [name, text] : bad) {
+    SCOPED_TRACE(name);
+    const std::string p = tmp / (name + ".ply");
+    std::ofstream(p, std::ios::binary) << text;
+    expect_mesh_error([&] { load_mesh(p); }, p);
+  }
+  const std::string no_vertex = tmp / "no_vertex.ply";
+  std::ofstream(no_vertex) << "ply\nformat ascii 1.0\nelement point 1\nproperty float x\nend_header\n1\n";
+  expect_mesh_error([&] { load_mesh(no_vertex); }, no_vertex);
 }

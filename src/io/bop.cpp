@@ -164,6 +164,24 @@ std::string bop_depth_path(const std::string& scene_dir, int im_id) {
 
 // ---------------------------------------------------------------- models_info
 
+std::vector<TestTarget> read_test_targets(const std::string& path) {
+  const json root = read_json(path);
+  if (!root.is_array()) throw InputError(path, "", "expected a JSON list of {scene_id, im_id, obj_id, inst_count}");
+  const JRef list{root, path, ""};
+  std::vector<TestTarget> out;
+  for (size_t i = 0; i < root.size(); ++i) {
+    const JRef e = list.at(i);
+    if (!e.j.is_object()) throw InputError(path, e.path, "expected a JSON object");
+    const auto field = [&](const char* k, int min) {
+      const int v = e.key(k).integer();
+      if (v < min) throw InputError(path, e.join(k), "must be " + std::to_string(min) + " or more");
+      return v;
+    };
+    out.push_back({field("scene_id", 0), field("im_id", 0), field("obj_id", 0), field("inst_count", 1)});
+  }
+  return out;
+}
+
 std::map<int, ModelInfo> read_models_info(const std::string& path) {
   const json root = read_json(path);
   if (!root.is_object()) throw InputError(path, "", "expected a JSON object keyed by object id");

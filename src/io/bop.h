@@ -102,6 +102,19 @@ Intrinsics read_camera_json(const std::string& path, double* depth_scale = nullp
 void write_scene_json(const std::string& scene_dir, const SceneInfo& scene);
 SceneInfo read_scene_json(const std::string& scene_dir);
 
+// One entry of a BOP test-targets file (test_targets_bop19.json): an object
+// to localize in an image and how many instances of it the image holds.
+struct TestTarget {
+  int scene_id = 0;
+  int im_id = 0;
+  int obj_id = 0;
+  int inst_count = 0;  // >= 1
+};
+// Reads a test-targets file: a JSON list of {scene_id, im_id, obj_id,
+// inst_count}, every field required, ids >= 0, inst_count >= 1. InputError
+// naming the file and the entry ("[3].obj_id") on any problem.
+std::vector<TestTarget> read_test_targets(const std::string& path);
+
 std::string bop_id(int id);  // 6 digits: 000042
 // SCENE_DIR/depth/IIIIII.png
 std::string bop_depth_path(const std::string& scene_dir, int im_id);

@@ -91,11 +91,20 @@ class Body {
 
 bool is_signed_type(const std::string& t) { return !(t.size() > 1 && t[0] == 'u'); }
 
+// Element and property names: letters, digits, '_', '-', '.'.
+bool is_name(const std::string& n) {
+  if (n.empty() || n.size() > 64) return false;
+  for (const char c : n)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.')) return false;
+  return true;
+}
+
 }  // namespace
 
 void check_ply(const std::string& path, const std::string& bytes) {
   const auto fail = [&](const std::string& why) { throw InputError(path, "mesh", "broken PLY: " + why); };
-  if (bytes.compare(0, 3, "ply") != 0) throw InputError(path, "mesh", "not a PLY file (no 'ply' magic)");
+  if (!(bytes.compare(0, 4, "ply\n") == 0 || bytes.compare(0, 5, "ply\r\n") == 0))
+    throw InputError(path, "mesh", "not a PLY file (the first line is not 'ply')");
   // The header ends at a line that is exactly "end_header" (a comment that
   // merely contains the word does not end it: assimp reads on, found by
   // fuzzing).
@@ -115,6 +124,14 @@ void check_ply(const std::string& path, const std::string& bytes) {
   if (body == std::string::npos)
     throw InputError(path, "mesh", "truncated PLY: the header has no 'end_header' line");
   if (body > bytes.size()) body = bytes.size();
+  // The header is text lines: no control bytes (assimp misread a property
+  // name holding NUL bytes and crashed: found by fuzzing). Bytes >= 0x80
+  // (UTF-8 in a comment) are fine; names are checked below.
+  for (size_t i = 0; i < end; ++i) {
+    const auto c = static_cast<unsigned char>(bytes[i]);
+    if (c < 0x20 && c != '\n' && c != '\r' && c != '\t')
+      fail("the header holds control byte " + std::to_string(c) + " at offset " + std::to_string(i));
+  }
   std::istringstream header(bytes.substr(0, end));
   std::string line;
   int format = -1;
@@ -124,8 +141,11 @@ void check_ply(const std::string& path, const std::string& bytes) {
   while (std::getline(header, line)) {
     std::istringstream w(line);
     std::string key;
-    if (!(w >> key) || key == "comment" || key == "obj_info") continue;
+    if (!(w >> key)) continue;
+    if (format < 0 && key != "format") fail("the line after 'ply' must be the format line (assimp needs it there)");
+    if (key == "comment" || key == "obj_info") continue;
     if (key == "format") {
+      if (format >= 0) fail("two format lines");
       std::string f;
       w >> f;
       format = f == "ascii" ? 0 : f == "binary_little_endian" ? 1 : f == "binary_big_endian" ? 2 : -1;
@@ -137,6 +157,9 @@ void check_ply(const std::string& path, const std::string& bytes) {
           count.size() > 10)
         fail("bad element line '" + line.substr(0, 60) + "'");
       e.count = std::strtoull(count.c_str(), nullptr, 10);
+      if (!is_name(e.name)) fail("bad element name in '" + line.substr(0, 60) + "'");
+      for (const auto& o : elements)
+        if (o.name == e.name) fail("element '" + e.name + "' is declared twice");
       elements.push_back(e);
       signs.emplace_back();
     } else if (key == "property") {
@@ -153,7 +176,11 @@ void check_ply(const std::string& path, const std::string& bytes) {
         if (p.count_size == 0 || f) fail("bad list count type in '" + line.substr(0, 60) + "'");
       }
       p.size = type_size(item, &p.is_float);
-      if (p.size == 0 || !(w >> p.name)) fail("bad property line '" + line.substr(0, 60) + "'");
+      std::string rest;
+      if (p.size == 0 || !(w >> p.name) || !is_name(p.name) || (w >> rest))
+        fail("bad property line '" + line.substr(0, 60) + "'");
+      for (const auto& o : elements.back().props)
+        if (o.name == p.name) fail("property '" + p.name + "' of element '" + elements.back().name + "' is declared twice");
       elements.back().props.push_back(p);
       signs.back().push_back(is_signed_type(item));
     } else {
@@ -161,9 +188,18 @@ void check_ply(const std::string& path, const std::string& bytes) {
     }
   }
   if (format < 0) fail("no format line");
+  // A mesh needs vertices with scalar x, y and z.
   uint64_t vertices = 0;
+  const Element* vertex = nullptr;
   for (const auto& e : elements)
-    if (e.name == "vertex") vertices = e.count;
+    if (e.name == "vertex") vertex = &e;
+  if (vertex == nullptr) fail("no 'vertex' element");
+  vertices = vertex->count;
+  for (const char* axis : {"x", "y", "z"}) {
+    bool found = false;
+    for (const auto& p : vertex->props) found = found || (p.name == axis && p.count_size == 0);
+    if (!found) fail(std::string("the vertex element has no scalar property '") + axis + "'");
+  }
   // Each declared value needs at least one byte: counts the data cannot hold
   // are rejected before anything is read or allocated.
   const uint64_t avail = bytes.size() - body;

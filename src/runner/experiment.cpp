@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <set>
 
 #include "core/error.h"
@@ -132,8 +133,8 @@ void parse_settings_and_grid(const YamlNode& root, const std::string& path, Expe
 }
 
 SceneSource parse_scene(const YamlNode& s, const std::string& path, std::set<std::string>& names) {
-  s.check_keys({"name", "generate", "dataset", "split", "scene_ids", "images", "scenario", "generator",
-                "settings", "refinements"});
+  s.check_keys({"name", "generate", "dataset", "split", "scene_ids", "images", "targets", "scenario",
+                "generator", "settings", "refinements"});
   SceneSource src;
   src.generate = resolve(path, s.get_or<std::string>("generate", ""));
   src.dataset = resolve(path, s.get_or<std::string>("dataset", ""));
@@ -148,6 +149,7 @@ SceneSource parse_scene(const YamlNode& s, const std::string& path, std::set<std
   src.scene_ids = s.get_or<std::vector<int>>("scene_ids", {});
   src.images = s.get_or<int>("images", 0);
   if (src.images < 0) s["images"].fail("must be non-negative");
+  src.targets = s.get_or<std::string>("targets", "");
   src.scenario = s.get_or<std::string>(
       "scenario", src.name.rfind("warehouse", 0) == 0 ? std::string("warehouse") : std::string("table"));
   if (src.scenario != "table" && src.scenario != "warehouse")
@@ -225,6 +227,8 @@ nlohmann::json canonical(const ExperimentConfig& c) {
                                {"scenario", s.scenario}, {"generator", s.generator_overrides},
                                {"refinements", s.refinements},
                                {"settings", s.settings}});
+  for (size_t i = 0; i < c.scenes.size(); ++i)  // only when given: older hashes stay
+    if (!c.scenes[i].targets.empty()) canon["scenes"][i]["targets"] = c.scenes[i].targets;
   canon["report"] = c.report;
   if (!c.judgements.empty()) canon["judgements"] = judgements_json(c.judgements);
   return canon;
@@ -258,6 +262,40 @@ ExperimentConfig load_experiment(const std::string& path) {
   return c;
 }
 
+namespace {
+
+// The (scene_id, im_id) pairs a scene source's test-targets file lists for
+// the object; every one must be an image of the dataset.
+std::set<std::pair<int, int>> target_images(const SceneSource& src, const BopDataset& ds, const std::string& object) {
+  std::set<std::pair<int, int>> wanted;
+  if (src.targets.empty()) return wanted;
+  const std::string file = fs::path(src.targets).is_absolute() ? src.targets : (fs::path(src.dataset) / src.targets).string();
+  if (!fs::is_regular_file(file)) throw InputError(file, "targets", "test-targets file not found");
+  const int obj = ds.resolve_object(object);
+  const auto targets = read_test_targets(file);
+  std::map<int, std::set<int>> images;  // scene -> its image ids (read once per scene)
+  for (size_t i = 0; i < targets.size(); ++i) {
+    const TestTarget& t = targets[i];
+    if (t.obj_id != obj) continue;
+    if (!images.count(t.scene_id)) {
+      const auto scenes = ds.scene_ids(src.split);
+      if (std::find(scenes.begin(), scenes.end(), t.scene_id) == scenes.end())
+        throw InputError(file, "[" + std::to_string(i) + "].scene_id",
+                         "scene " + std::to_string(t.scene_id) + " is not in split '" + src.split + "'");
+      for (const auto& [im_id, im] : ds.load_scene(src.split, t.scene_id).images) images[t.scene_id].insert(im_id);
+    }
+    if (!images[t.scene_id].count(t.im_id))
+      throw InputError(file, "[" + std::to_string(i) + "].im_id",
+                       "image " + std::to_string(t.im_id) + " is not in scene " + std::to_string(t.scene_id));
+    wanted.insert({t.scene_id, t.im_id});
+  }
+  if (wanted.empty())
+    throw InputError(file, "obj_id", "no target for object '" + object + "' (obj_id " + std::to_string(obj) + ")");
+  return wanted;
+}
+
+}  // namespace
+
 std::vector<Trial> expand_trials(const ExperimentConfig& cfg) {
   // Grid points: cartesian product in declaration order.
   std::vector<nlohmann::json> points{nlohmann::json::object()};
@@ -276,10 +314,17 @@ std::vector<Trial> expand_trials(const ExperimentConfig& cfg) {
   for (const auto& src : cfg.scenes) {
     BopDataset ds(src.dataset);
     std::vector<int> sids = src.scene_ids.empty() ? ds.scene_ids(src.split) : src.scene_ids;
+    const std::set<std::pair<int, int>> wanted = target_images(src, ds, cfg.object);
+    if (!src.targets.empty() && src.scene_ids.empty()) {
+      std::set<int> in_targets;
+      for (const auto& [sid, im_id] : wanted) in_targets.insert(sid);
+      sids.assign(in_targets.begin(), in_targets.end());
+    }
     for (int sid : sids) {
       const SceneInfo scene = ds.load_scene(src.split, sid);
       int taken = 0;
       for (const auto& [im_id, im] : scene.images) {
+        if (!src.targets.empty() && wanted.count({sid, im_id}) == 0) continue;
         if (src.images > 0 && taken >= src.images) break;
         ++taken;
         const auto& refinements = src.refinements.empty() ? cfg.refinements : src.refinements;

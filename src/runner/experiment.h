@@ -25,6 +25,10 @@ struct SceneSource {
   std::string split = "test";
   std::vector<int> scene_ids;  // empty = all scenes of the split
   int images = 0;              // first N images per scene (0 = all)
+  // A BOP test-targets file (e.g. test_targets_bop19.json; relative to the
+  // dataset root): only the images it lists for the experiment's object are
+  // trials, and scene_ids defaults to their scenes. "" = every image.
+  std::string targets;
   std::string scenario = "";   // table | warehouse: picks the translation threshold
   // Refinements for this scene set, replacing the experiment's list (the
   // thesis used ICP point-to-plane in the warehouse, point-to-point on tables).

@@ -1,0 +1,188 @@
+// BOP test-targets files (test_targets_bop19.json): read_test_targets accepts
+// the BOP layout and rejects a bad entry naming the file and the entry; an
+// experiment scene with `targets:` expands to exactly the images that file
+// lists for the experiment's object (and to their scenes when scene_ids is
+// not given); a target outside the dataset, or none for the object, is an
+// InputError naming the file and the field. Configs without `targets` keep
+// their hash (no new key in the canonical JSON).
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <set>
+#include <string>
+#include <utility>
+
+#include "core/error.h"
+#include "io/bop.h"
+#include "runner/experiment.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Dataset {
+  std::string root;
+  Dataset() {
+    std::string tmpl = (fs::temp_directory_path() / "pb_test_targets_XXXXXX").string();
+    root = mkdtemp(tmpl.data());
+    std::map<int, pb::ModelInfo> models;
+    for (int id : {1, 2}) {
+      pb::ModelInfo m;
+      m.obj_id = id;
+      m.name = id == 1 ? "ls5" : "boletus";
+      m.diameter = 100;
+      m.min = pb::Vec3(-50, -50, -50);
+      m.size = pb::Vec3(100, 100, 100);
+      models[id] = m;
+    }
+    fs::create_directories(root + "/models");
+    pb::write_models_info(root + "/models/models_info.json", models);
+    pb::Intrinsics K;
+    K.width = 64;
+    K.height = 48;
+    K.fx = K.fy = 60;
+    K.cx = 32;
+    K.cy = 24;
+    pb::write_camera_json(root + "/camera.json", K, 1.0);
+    for (int sid : {1, 2}) {  // scene 1: images 0, 1, 2; scene 2: images 0, 1
+      pb::SceneInfo s;
+      s.scene_id = sid;
+      for (int im = 0; im < (sid == 1 ? 3 : 2); ++im) {
+        pb::ImageInfo info;
+        info.im_id = im;
+        info.K = K;
+        s.images[im] = info;
+      }
+      pb::write_scene_json(root + "/test/" + pb::bop_id(sid), s);
+    }
+  }
+  ~Dataset() { fs::remove_all(root); }
+  void targets(const std::string& json) const { std::ofstream(root + "/targets.json") << json; }
+  // An experiment on this dataset; `extra` is more YAML of its scene entry.
+  std::string experiment(const std::string& extra) const {
+    const std::string path = root + "/exp.yaml";
+    std::ofstream(path) << "object: ls5\nscenes:\n  - name: s\n    dataset: " << root << "\n" << extra
+                        << "descriptors: [cvfh, esf]\nrefinements: [none]\n";
+    return path;
+  }
+};
+
+std::set<std::pair<int, int>> images_of(const std::vector<pb::Trial>& trials) {
+  std::set<std::pair<int, int>> out;
+  for (const auto& t : trials) out.insert({t.scene_id, t.im_id});
+  return out;
+}
+
+// The InputError `f` throws (a failure when it throws none).
+template <typename F>
+pb::InputError error_of(F&& f) {
+  try {
+    f();
+  } catch (const pb::InputError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no InputError";
+  return pb::InputError("", "", "");
+}
+
+const char* kTargets =
+    R"([{"im_id": 0, "inst_count": 1, "obj_id": 1, "scene_id": 1},
+        {"im_id": 2, "inst_count": 2, "obj_id": 1, "scene_id": 1},
+        {"im_id": 1, "inst_count": 1, "obj_id": 2, "scene_id": 2},
+        {"im_id": 0, "inst_count": 1, "obj_id": 1, "scene_id": 2}])";
+
+TEST(TestTargets, ReadsTheBopLayout) {
+  Dataset ds;
+  ds.targets(kTargets);
+  const auto t = pb::read_test_targets(ds.root + "/targets.json");
+  ASSERT_EQ(t.size(), 4u);
+  EXPECT_EQ(t[1].scene_id, 1);
+  EXPECT_EQ(t[1].im_id, 2);
+  EXPECT_EQ(t[1].obj_id, 1);
+  EXPECT_EQ(t[1].inst_count, 2);
+  EXPECT_EQ(t[2].obj_id, 2);
+}
+
+TEST(TestTargets, BadEntriesAreInputErrorsNamingTheEntry) {
+  Dataset ds;
+  const std::string file = ds.root + "/targets.json";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {R"({"im_id": 0})", ""},
+      {R"([{"im_id": 0, "inst_count": 1, "obj_id": 1}])", "[0].scene_id"},
+      {R"([{"im_id": 0, "inst_count": 1, "obj_id": 1, "scene_id": 1}, 7])", "[1]"},
+      {R"([{"im_id": -1, "inst_count": 1, "obj_id": 1, "scene_id": 1}])", "[0].im_id"},
+      {R"([{"im_id": 0, "inst_count": 0, "obj_id": 1, "scene_id": 1}])", "[0].inst_count"},
+      {R"([{"im_id": 0.5, "inst_count": 1, "obj_id": 1, "scene_id": 1}])", "[0].im_id"},
+      {R"([{"im_id": 0, "inst_count": 1, "obj_id": "1", "scene_id": 1}])", "[0].obj_id"},
+      {R"([{"im_id": 0, "inst_count": 1, "obj_id": 1, "scene_id": 1e30}])", "[0].scene_id"},
+      {R"([{"im_id": 0, "inst_count": 1, "obj_id": 1, "scene_id": 1})", ""},  // truncated
+  };
+  for (const auto& [text, field] : cases) {
+    SCOPED_TRACE(text);
+    ds.targets(text);
+    const pb::InputError e = error_of([&] { pb::read_test_targets(file); });
+    EXPECT_EQ(e.file(), file);
+    EXPECT_EQ(e.field(), field);
+  }
+}
+
+TEST(TestTargets, AnExperimentRunsExactlyTheListedImagesOfItsObject) {
+  Dataset ds;
+  ds.targets(kTargets);
+  const auto all = pb::expand_trials(pb::load_experiment(ds.experiment("")));
+  EXPECT_EQ(all.size(), 2u * 5);  // 5 images x 2 descriptors
+  const auto cfg = pb::load_experiment(ds.experiment("    targets: targets.json\n"));
+  const auto trials = pb::expand_trials(cfg);
+  EXPECT_EQ(trials.size(), 2u * 3);
+  EXPECT_EQ(images_of(trials), (std::set<std::pair<int, int>>{{1, 0}, {1, 2}, {2, 0}}));
+  // scene_ids still selects among them.
+  const auto one = pb::expand_trials(pb::load_experiment(ds.experiment("    targets: targets.json\n    scene_ids: [2]\n")));
+  EXPECT_EQ(images_of(one), (std::set<std::pair<int, int>>{{2, 0}}));
+  // The other object's targets: its one image.
+  const std::string path = ds.experiment("    targets: targets.json\n");
+  std::string yaml;
+  {
+    std::ifstream in(path);
+    yaml.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  std::ofstream(path) << "object: boletus" << yaml.substr(yaml.find('\n'));
+  EXPECT_EQ(images_of(pb::expand_trials(pb::load_experiment(path))), (std::set<std::pair<int, int>>{{2, 1}}));
+}
+
+TEST(TestTargets, TheHashChangesOnlyWhenTargetsAreGiven) {
+  Dataset ds;
+  ds.targets(kTargets);
+  const auto plain = pb::load_experiment(ds.experiment(""));
+  EXPECT_FALSE(plain.canonical["scenes"][0].contains("targets"));
+  const auto with = pb::load_experiment(ds.experiment("    targets: targets.json\n"));
+  EXPECT_EQ(with.canonical["scenes"][0]["targets"], "targets.json");
+  EXPECT_NE(plain.hash, with.hash);
+}
+
+TEST(TestTargets, TargetsOutsideTheDatasetOrNoneForTheObjectAreInputErrors) {
+  Dataset ds;
+  const std::string file = ds.root + "/targets.json";
+  const auto expand = [&] { pb::expand_trials(pb::load_experiment(ds.experiment("    targets: targets.json\n"))); };
+  ds.targets(R"([{"im_id": 9, "inst_count": 1, "obj_id": 1, "scene_id": 1}])");
+  pb::InputError e = error_of(expand);
+  EXPECT_EQ(e.file(), file);
+  EXPECT_EQ(e.field(), "[0].im_id");
+  ds.targets(R"([{"im_id": 0, "inst_count": 1, "obj_id": 2, "scene_id": 1},
+                 {"im_id": 0, "inst_count": 1, "obj_id": 1, "scene_id": 5}])");
+  e = error_of(expand);
+  EXPECT_EQ(e.field(), "[1].scene_id");
+  ds.targets(R"([{"im_id": 0, "inst_count": 1, "obj_id": 2, "scene_id": 1}])");
+  e = error_of(expand);
+  EXPECT_EQ(e.field(), "obj_id");
+  EXPECT_NE(std::string(e.what()).find("ls5"), std::string::npos) << e.what();
+  fs::remove(file);
+  e = error_of(expand);
+  EXPECT_EQ(e.file(), file);
+}
+
+}  // namespace
