@@ -259,6 +259,7 @@ TEST(MeshIo, PlyHeaderGrammarIsChecked) {
       {"nul_in_name", header("ply\n", "property float x\nproperty float y\nproperty float " + std::string(2, '\0') + "z\n")},
       {"magic", header("plyx\n", xyz)},
       {"comment_before_format", header("ply\ncomment first\n", xyz)},
+      {"cr_inside_a_line", header("ply\n", "property float x\nproperty float\ry\nproperty float z\n")},
       {"no_z", header("ply\n", "property float x\nproperty float y\n")},
       {"list_z", header("ply\n", "property float x\nproperty float y\nproperty list uchar float z\n")},
       {"twice", header("ply\n", xyz + "property float x\n")},

@@ -107,8 +107,12 @@ Mesh load_mesh(const std::string& path) {
   Assimp::Importer importer;
   // Drop point and line primitives; keep triangles only.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* scene = importer.ReadFile(
-      path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+  // ValidateDataStructure runs first, on what the importer produced: an
+  // importer that misreads a malformed file into inconsistent data (face
+  // indices past the vertices) is stopped there, before the post-processing
+  // steps that crashed on it (found by fuzzing).
+  const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure | aiProcess_Triangulate |
+                                                     aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
   if (!scene) throw InputError(path, "mesh", std::string("cannot read mesh: ") + importer.GetErrorString());
   if (!scene->mRootNode || scene->mNumMeshes == 0) throw InputError(path, "mesh", "file contains no mesh");
 

@@ -124,13 +124,15 @@ void check_ply(const std::string& path, const std::string& bytes) {
   if (body == std::string::npos)
     throw InputError(path, "mesh", "truncated PLY: the header has no 'end_header' line");
   if (body > bytes.size()) body = bytes.size();
-  // The header is text lines: no control bytes (assimp misread a property
-  // name holding NUL bytes and crashed: found by fuzzing). Bytes >= 0x80
+  // The header is text lines: no control bytes, CR only before LF (assimp
+  // misread a property name holding NUL bytes, and a CR inside a line, and
+  // crashed: found by fuzzing). Bytes >= 0x80
   // (UTF-8 in a comment) are fine; names are checked below.
   for (size_t i = 0; i < end; ++i) {
     const auto c = static_cast<unsigned char>(bytes[i]);
-    if (c < 0x20 && c != '\n' && c != '\r' && c != '\t')
-      fail("the header holds control byte " + std::to_string(c) + " at offset " + std::to_string(i));
+    if (c < 0x20 && c != '\n' && c != '\t' && !(c == '\r' && i + 1 < bytes.size() && bytes[i + 1] == '\n'))
+      fail("the header holds control byte " + std::to_string(c) + " at offset " + std::to_string(i) +
+           (c == '\r' ? " (a carriage return not ending a line)" : ""));
   }
   std::istringstream header(bytes.substr(0, end));
   std::string line;
