@@ -1,5 +1,7 @@
 #include "core/yaml.h"
 
+#include <algorithm>
+
 #include <cerrno>
 #include <cstdlib>
 #include <fstream>
@@ -15,7 +17,43 @@ YamlNode YamlNode::load_file(const std::string& file) {
   return load_string(ss.str(), file);
 }
 
+namespace {
+
+// The byte offset of the first byte that breaks UTF-8 (RFC 3629: no overlong
+// forms, no surrogates, nothing above U+10FFFF), or npos. YAML text is
+// Unicode; yaml-cpp passes any bytes on, and they broke JSON output later.
+size_t invalid_utf8_at(const std::string& s) {
+  size_t i = 0;
+  const size_t n = s.size();
+  while (i < n) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    int len = 0;
+    unsigned cp = 0;
+    if (c < 0x80) len = 1, cp = c;
+    else if (c >= 0xc2 && c <= 0xdf) len = 2, cp = c & 0x1fu;
+    else if (c >= 0xe0 && c <= 0xef) len = 3, cp = c & 0x0fu;
+    else if (c >= 0xf0 && c <= 0xf4) len = 4, cp = c & 0x07u;
+    else return i;
+    if (i + static_cast<size_t>(len) > n) return i;
+    for (int k = 1; k < len; ++k) {
+      const auto d = static_cast<unsigned char>(s[i + static_cast<size_t>(k)]);
+      if ((d & 0xc0u) != 0x80u) return i;
+      cp = (cp << 6) | (d & 0x3fu);
+    }
+    if ((len == 3 && (cp < 0x800 || (cp >= 0xd800 && cp <= 0xdfff))) || (len == 4 && (cp < 0x10000 || cp > 0x10ffff)))
+      return i;
+    i += static_cast<size_t>(len);
+  }
+  return std::string::npos;
+}
+
+}  // namespace
+
 YamlNode YamlNode::load_string(const std::string& text, const std::string& name) {
+  if (const size_t bad = invalid_utf8_at(text); bad != std::string::npos) {
+    const size_t line = 1 + static_cast<size_t>(std::count(text.begin(), text.begin() + static_cast<long>(bad), '\n'));
+    throw InputError(name, "", "not UTF-8 text: line " + std::to_string(line) + ", byte " + std::to_string(bad));
+  }
   try {
     YAML::Node n = YAML::Load(text);
     if (!n.IsDefined() || n.IsNull()) n = YAML::Node(YAML::NodeType::Map);

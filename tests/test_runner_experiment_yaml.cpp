@@ -1,0 +1,48 @@
+// Experiment YAML text: bytes that are not UTF-8 (found by
+// fuzz/fuzz_experiment_yaml.cpp: yaml-cpp passed them on and the JSON dump of
+// the config threw an internal error) are an InputError naming the file and
+// the line, in every YAML loader (core/yaml.cpp); UTF-8 text is accepted.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "core/error.h"
+#include "core/yaml.h"
+#include "runner/experiment.h"
+
+namespace {
+
+std::string write(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/" + name;
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
+std::string experiment(const std::string& scene_name) {
+  return "object: ls5\nscenes:\n  - name: " + scene_name + "\n    dataset: " + ::testing::TempDir() +
+         "\ndescriptors: [fpfh]\n";
+}
+
+TEST(ExperimentYaml, BytesThatAreNotUtf8AreAnInputErrorNamingFileAndLine) {
+  for (const std::string bad : {std::string("t\xff"), std::string("t\xc3"), std::string("t\xc0\xaf"),
+                                std::string("t\xed\xa0\x80"), std::string("t\xf4\x90\x80\x80")}) {
+    const std::string path = write("not_utf8.yaml", experiment(bad));
+    try {
+      pb::load_experiment(path);
+      ADD_FAILURE() << "no error";
+    } catch (const pb::InputError& e) {
+      EXPECT_EQ(e.file(), path);
+      EXPECT_NE(std::string(e.what()).find("not UTF-8 text: line 3"), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(ExperimentYaml, Utf8TextIsAccepted) {
+  const std::string path = write("utf8.yaml", experiment("caf\xc3\xa9_\xe2\x82\xac_\xf0\x9f\x93\xa6"));
+  const pb::YamlNode root = pb::YamlNode::load_file(path);
+  EXPECT_EQ(root["scenes"].at(0)["name"].as<std::string>(), "caf\xc3\xa9_\xe2\x82\xac_\xf0\x9f\x93\xa6");
+}
+
+}  // namespace
