@@ -35,6 +35,11 @@ if [ "$REDUCED" -eq 1 ]; then
     "-DPOSEBENCH_SANITIZE_SKIP=recognition;io_pcl" -DPOSEBENCH_BUILD_BENCH=OFF >/dev/null
   TARGETS=(posebench)
   for t in tests/test_io_*.cpp tests/test_eval_*.cpp tests/test_runner_*.cpp; do TARGETS+=("$(basename "${t%.cpp}")"); done
+  # The fuzz findings' replays (FuzzRegressions.NAME, labelled io or runner).
+  for d in fuzz/regressions/*/; do
+    n="$(basename "$d")"
+    case "$n" in fuzz_scene_yaml|fuzz_models_yaml|fuzz_training_cache) ;; *) TARGETS+=("replay_$n") ;; esac
+  done
   cmake --build "$DIR" -j "$JOBS" --target "${TARGETS[@]}"
   ctest --test-dir "$DIR" --output-on-failure -j "$(nproc)" -L '^(io|eval|runner)$' "${CTEST_ARGS[@]}"
 else
