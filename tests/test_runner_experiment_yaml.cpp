@@ -1,7 +1,10 @@
-// Experiment YAML text: bytes that are not UTF-8 (found by
-// fuzz/fuzz_experiment_yaml.cpp: yaml-cpp passed them on and the JSON dump of
-// the config threw an internal error) are an InputError naming the file and
-// the line, in every YAML loader (core/yaml.cpp); UTF-8 text is accepted.
+// Experiment YAML text, two findings of fuzz/fuzz_experiment_yaml.cpp, both
+// internal errors before: bytes that are not UTF-8 (yaml-cpp passed them on
+// and the JSON dump of the config threw) are an InputError naming the file
+// and the line, in every YAML loader (core/yaml.cpp), while UTF-8 text is
+// accepted; and a document that yaml-cpp reads into an invalid node (a '%'
+// directive line after content) is an InputError naming the file, not
+// YAML::InvalidNode.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -43,6 +46,16 @@ TEST(ExperimentYaml, Utf8TextIsAccepted) {
   const std::string path = write("utf8.yaml", experiment("caf\xc3\xa9_\xe2\x82\xac_\xf0\x9f\x93\xa6"));
   const pb::YamlNode root = pb::YamlNode::load_file(path);
   EXPECT_EQ(root["scenes"].at(0)["name"].as<std::string>(), "caf\xc3\xa9_\xe2\x82\xac_\xf0\x9f\x93\xa6");
+}
+
+TEST(ExperimentYaml, ADirectiveAfterContentIsAnInputError) {
+  const std::string path = write("directive.yaml", "object: ls5\nregistration_only: true\n%perturb_deg: 15\n");
+  try {
+    pb::load_experiment(path);
+    ADD_FAILURE() << "no error";
+  } catch (const pb::InputError& e) {
+    EXPECT_EQ(e.file(), path);
+  }
 }
 
 }  // namespace

@@ -17,8 +17,13 @@ namespace pb {
 // A YAML node together with the file it came from and its dotted path.
 class YamlNode {
  public:
+  // An invalid node (yaml-cpp's "zombie", e.g. a missing key of a const map,
+  // whose every type query throws YAML::InvalidNode: found by fuzzing)
+  // becomes an undefined one: absent, never an exception.
   YamlNode(YAML::Node node, std::string file, std::string path = "")
-      : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)) {}
+      : node_(node.IsDefined() ? std::move(node) : YAML::Node(YAML::NodeType::Undefined)),
+        file_(std::move(file)),
+        path_(std::move(path)) {}
 
   // Parses a file; a missing file or a syntax error is an InputError.
   static YamlNode load_file(const std::string& file);

@@ -99,6 +99,47 @@ bool is_name(const std::string& n) {
   return true;
 }
 
+// Walks the body: every declared value present; face index lists of 3 or
+// more indices, each in [0, vertices). `signs`: per element, per property,
+// whether its (item) type is signed.
+void walk_body(const std::string& path, const std::string& bytes, size_t body, int format,
+               const std::vector<Element>& elements, const std::vector<std::vector<bool>>& signs, uint64_t vertices) {
+  const auto fail = [&](const std::string& why) { throw InputError(path, "mesh", "broken PLY: " + why); };
+  // Each declared value needs at least one byte: counts the data cannot hold
+  // are rejected before anything is read or allocated.
+  const uint64_t avail = bytes.size() - body;
+  for (const auto& e : elements)
+    if (!e.props.empty() && e.count > avail) fail("element '" + e.name + "' declares more values than the file holds");
+  Body r(path, bytes, body, format);
+  for (size_t ei = 0; ei < elements.size(); ++ei) {
+    const Element& e = elements[ei];
+    if (e.props.empty()) continue;  // holds no data, whatever its count (a loop over 10^10 would hang)
+    for (uint64_t i = 0; i < e.count; ++i)
+      for (size_t pi = 0; pi < e.props.size(); ++pi) {
+        const Property& p = e.props[pi];
+        const bool indices = e.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index");
+        if (p.count_size == 0) {
+          r.set_signed(signs[ei][pi]);
+          r.value(p.size, p.is_float);
+          continue;
+        }
+        r.set_signed(false);
+        const double n = r.value(p.count_size, false);
+        if (!(n >= 0) || n != static_cast<double>(static_cast<uint64_t>(n)) || n > static_cast<double>(avail))
+          fail("a list of element '" + e.name + "' has an impossible length");
+        if (indices && n < 3)  // assimp's triangulation asserts (abort) on such a face: found by fuzzing
+          fail("face " + std::to_string(i) + " has " + std::to_string(static_cast<int>(n)) + " vertices (3 or more)");
+        r.set_signed(signs[ei][pi]);
+        for (uint64_t k = 0; k < static_cast<uint64_t>(n); ++k) {
+          const double v = r.value(p.size, p.is_float);
+          if (indices && !(v >= 0 && v < static_cast<double>(vertices) && v == static_cast<double>(static_cast<int64_t>(v))))
+            fail("face " + std::to_string(i) + " has vertex index " + std::to_string(v) + " (there are " +
+                 std::to_string(vertices) + " vertices)");
+        }
+      }
+  }
+}
+
 }  // namespace
 
 void check_ply(const std::string& path, const std::string& bytes) {
@@ -202,39 +243,7 @@ void check_ply(const std::string& path, const std::string& bytes) {
     for (const auto& p : vertex->props) found = found || (p.name == axis && p.count_size == 0);
     if (!found) fail(std::string("the vertex element has no scalar property '") + axis + "'");
   }
-  // Each declared value needs at least one byte: counts the data cannot hold
-  // are rejected before anything is read or allocated.
-  const uint64_t avail = bytes.size() - body;
-  for (const auto& e : elements)
-    if (!e.props.empty() && e.count > avail) fail("element '" + e.name + "' declares more values than the file holds");
-  Body r(path, bytes, body, format);
-  for (size_t ei = 0; ei < elements.size(); ++ei) {
-    const Element& e = elements[ei];
-    if (e.props.empty()) continue;  // holds no data, whatever its count (a loop over 10^10 would hang)
-    for (uint64_t i = 0; i < e.count; ++i)
-      for (size_t pi = 0; pi < e.props.size(); ++pi) {
-        const Property& p = e.props[pi];
-        const bool indices = e.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index");
-        if (p.count_size == 0) {
-          r.set_signed(signs[ei][pi]);
-          r.value(p.size, p.is_float);
-          continue;
-        }
-        r.set_signed(false);
-        const double n = r.value(p.count_size, false);
-        if (!(n >= 0) || n != static_cast<double>(static_cast<uint64_t>(n)) || n > static_cast<double>(avail))
-          fail("a list of element '" + e.name + "' has an impossible length");
-        if (indices && n < 3)  // assimp's triangulation asserts (abort) on such a face: found by fuzzing
-          fail("face " + std::to_string(i) + " has " + std::to_string(static_cast<int>(n)) + " vertices (3 or more)");
-        r.set_signed(signs[ei][pi]);
-        for (uint64_t k = 0; k < static_cast<uint64_t>(n); ++k) {
-          const double v = r.value(p.size, p.is_float);
-          if (indices && !(v >= 0 && v < static_cast<double>(vertices) && v == static_cast<double>(static_cast<int64_t>(v))))
-            fail("face " + std::to_string(i) + " has vertex index " + std::to_string(v) + " (there are " +
-                 std::to_string(vertices) + " vertices)");
-        }
-      }
-  }
+  walk_body(path, bytes, body, format, elements, signs, vertices);
 }
 
 }  // namespace pb
