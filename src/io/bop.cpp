@@ -162,7 +162,7 @@ std::string bop_depth_path(const std::string& scene_dir, int im_id) {
   return join_path(join_path(scene_dir, "depth"), bop_id(im_id) + ".png");
 }
 
-// ---------------------------------------------------------------- models_info
+// ---------------------------------------------------------------- test targets
 
 std::vector<TestTarget> read_test_targets(const std::string& path) {
   const json root = read_json(path);
@@ -181,6 +181,8 @@ std::vector<TestTarget> read_test_targets(const std::string& path) {
   }
   return out;
 }
+
+// ---------------------------------------------------------------- models_info
 
 std::map<int, ModelInfo> read_models_info(const std::string& path) {
   const json root = read_json(path);
