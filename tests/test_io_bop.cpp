@@ -17,21 +17,14 @@
 #include "io/bop.h"
 #include "io/mesh_io.h"
 #include "io/png.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace pb;
 
 namespace {
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    std::string tmpl = (fs::temp_directory_path() / "pb_test_bop_XXXXXX").string();
-    path = mkdtemp(tmpl.data());
-  }
-  ~TempDir() { fs::remove_all(path); }
-  std::string operator/(const std::string& f) const { return (path / f).string(); }
-};
+using pbtest::TempDir;
 
 std::string slurp(const std::string& p) {
   std::ifstream in(p, std::ios::binary);

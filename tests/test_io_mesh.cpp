@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "io/mesh_io.h"
 #include "io/ply_check.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace pb;
@@ -26,15 +27,7 @@ std::string pbtest_slurp(const std::string& p) {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    std::string tmpl = (fs::temp_directory_path() / "pb_test_mesh_XXXXXX").string();
-    path = mkdtemp(tmpl.data());
-  }
-  ~TempDir() { fs::remove_all(path); }
-  std::string operator/(const std::string& f) const { return (path / f).string(); }
-};
+using pbtest::TempDir;
 
 // Every undirected edge used by exactly two faces, once in each direction.
 bool closed_and_oriented(const Mesh& m) {

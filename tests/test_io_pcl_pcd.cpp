@@ -12,21 +12,14 @@
 
 #include "core/error.h"
 #include "io_pcl/pcd.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace pb;
 
 namespace {
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    std::string tmpl = (fs::temp_directory_path() / "pb_test_pcd_XXXXXX").string();
-    path = mkdtemp(tmpl.data());
-  }
-  ~TempDir() { fs::remove_all(path); }
-  std::string operator/(const std::string& f) const { return (path / f).string(); }
-};
+using pbtest::TempDir;
 
 struct Pcd {
   std::map<std::string, std::string> header;

@@ -17,6 +17,7 @@
 #include "io/mesh_io.h"
 #include "models/procedural.h"
 #include "models/registry.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace pb;
@@ -25,15 +26,7 @@ namespace {
 
 const std::string kSharedDir = std::string(POSEBENCH_SOURCE_DIR) + "/../shared/models";
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    std::string tmpl = (fs::temp_directory_path() / "pb_test_registry_XXXXXX").string();
-    path = mkdtemp(tmpl.data());
-  }
-  ~TempDir() { fs::remove_all(path); }
-  std::string operator/(const std::string& f) const { return (path / f).string(); }
-};
+using pbtest::TempDir;
 
 ::testing::AssertionResult closed_and_oriented(const Mesh& m) {
   std::map<std::pair<int, int>, int> directed;

@@ -11,7 +11,6 @@
 
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <map>
 #include <set>
 #include <string>
@@ -20,16 +19,16 @@
 #include "core/error.h"
 #include "io/bop.h"
 #include "runner/experiment.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
 struct Dataset {
-  std::string root;
+  pbtest::TempDir tmp{"targets"};
+  std::string root = tmp.path.string();
   Dataset() {
-    std::string tmpl = (fs::temp_directory_path() / "pb_test_targets_XXXXXX").string();
-    root = mkdtemp(tmpl.data());
     std::map<int, pb::ModelInfo> models;
     for (int id : {1, 2}) {
       pb::ModelInfo m;
@@ -61,12 +60,11 @@ struct Dataset {
       pb::write_scene_json(root + "/test/" + pb::bop_id(sid), s);
     }
   }
-  ~Dataset() { fs::remove_all(root); }
   void targets(const std::string& json) const { std::ofstream(root + "/targets.json") << json; }
   // An experiment on this dataset; `extra` is more YAML of its scene entry.
-  std::string experiment(const std::string& extra) const {
+  std::string experiment(const std::string& extra, const std::string& object = "ls5") const {
     const std::string path = root + "/exp.yaml";
-    std::ofstream(path) << "object: ls5\nscenes:\n  - name: s\n    dataset: " << root << "\n" << extra
+    std::ofstream(path) << "object: " << object << "\nscenes:\n  - name: s\n    dataset: " << root << "\n" << extra
                         << "descriptors: [cvfh, esf]\nrefinements: [none]\n";
     return path;
   }
@@ -144,14 +142,8 @@ TEST(TestTargets, AnExperimentRunsExactlyTheListedImagesOfItsObject) {
   const auto one = pb::expand_trials(pb::load_experiment(ds.experiment("    targets: targets.json\n    scene_ids: [2]\n")));
   EXPECT_EQ(images_of(one), (std::set<std::pair<int, int>>{{2, 0}}));
   // The other object's targets: its one image.
-  const std::string path = ds.experiment("    targets: targets.json\n");
-  std::string yaml;
-  {
-    std::ifstream in(path);
-    yaml.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
-  std::ofstream(path) << "object: boletus" << yaml.substr(yaml.find('\n'));
-  EXPECT_EQ(images_of(pb::expand_trials(pb::load_experiment(path))), (std::set<std::pair<int, int>>{{2, 1}}));
+  const auto other = pb::expand_trials(pb::load_experiment(ds.experiment("    targets: targets.json\n", "boletus")));
+  EXPECT_EQ(images_of(other), (std::set<std::pair<int, int>>{{2, 1}}));
 }
 
 TEST(TestTargets, TheHashChangesOnlyWhenTargetsAreGiven) {

@@ -1,6 +1,7 @@
 #include "runner/experiment.h"
 
 #include <algorithm>
+#include <climits>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -264,34 +265,42 @@ ExperimentConfig load_experiment(const std::string& path) {
 
 namespace {
 
-// The (scene_id, im_id) pairs a scene source's test-targets file lists for
-// the object; every one must be an image of the dataset.
-std::set<std::pair<int, int>> target_images(const SceneSource& src, const BopDataset& ds, const std::string& object) {
-  std::set<std::pair<int, int>> wanted;
-  if (src.targets.empty()) return wanted;
-  const std::string file = fs::path(src.targets).is_absolute() ? src.targets : (fs::path(src.dataset) / src.targets).string();
-  if (!fs::is_regular_file(file)) throw InputError(file, "targets", "test-targets file not found");
+// A scene source's test targets for the experiment's object: the file, and
+// each listed (scene_id, im_id) with the index of its first entry there (for
+// errors). Every scene must be in the split; that every image is in its
+// scene is checked as expand_trials reads the scene (check_target_images).
+struct Targets {
+  std::string file;
+  std::map<std::pair<int, int>, size_t> entry;
+};
+
+Targets read_targets(const SceneSource& src, const BopDataset& ds, const std::string& object) {
+  Targets out;
+  if (src.targets.empty()) return out;
+  out.file = fs::path(src.targets).is_absolute() ? src.targets : (fs::path(src.dataset) / src.targets).string();
+  if (!fs::is_regular_file(out.file)) throw InputError(out.file, "targets", "test-targets file not found");
   const int obj = ds.resolve_object(object);
-  const auto targets = read_test_targets(file);
-  std::map<int, std::set<int>> images;  // scene -> its image ids (read once per scene)
+  const auto targets = read_test_targets(out.file);
+  const auto scenes = ds.scene_ids(src.split);
   for (size_t i = 0; i < targets.size(); ++i) {
     const TestTarget& t = targets[i];
     if (t.obj_id != obj) continue;
-    if (!images.count(t.scene_id)) {
-      const auto scenes = ds.scene_ids(src.split);
-      if (std::find(scenes.begin(), scenes.end(), t.scene_id) == scenes.end())
-        throw InputError(file, "[" + std::to_string(i) + "].scene_id",
-                         "scene " + std::to_string(t.scene_id) + " is not in split '" + src.split + "'");
-      for (const auto& [im_id, im] : ds.load_scene(src.split, t.scene_id).images) images[t.scene_id].insert(im_id);
-    }
-    if (!images[t.scene_id].count(t.im_id))
-      throw InputError(file, "[" + std::to_string(i) + "].im_id",
-                       "image " + std::to_string(t.im_id) + " is not in scene " + std::to_string(t.scene_id));
-    wanted.insert({t.scene_id, t.im_id});
+    if (std::find(scenes.begin(), scenes.end(), t.scene_id) == scenes.end())
+      throw InputError(out.file, "[" + std::to_string(i) + "].scene_id",
+                       "scene " + std::to_string(t.scene_id) + " is not in split '" + src.split + "'");
+    out.entry.emplace(std::make_pair(t.scene_id, t.im_id), i);
   }
-  if (wanted.empty())
-    throw InputError(file, "obj_id", "no target for object '" + object + "' (obj_id " + std::to_string(obj) + ")");
-  return wanted;
+  if (out.entry.empty())
+    throw InputError(out.file, "obj_id", "no target for object '" + object + "' (obj_id " + std::to_string(obj) + ")");
+  return out;
+}
+
+void check_target_images(const Targets& targets, const SceneInfo& scene) {
+  for (auto it = targets.entry.lower_bound({scene.scene_id, INT_MIN});
+       it != targets.entry.end() && it->first.first == scene.scene_id; ++it)
+    if (!scene.images.count(it->first.second))
+      throw InputError(targets.file, "[" + std::to_string(it->second) + "].im_id",
+                       "image " + std::to_string(it->first.second) + " is not in scene " + std::to_string(scene.scene_id));
 }
 
 }  // namespace
@@ -314,17 +323,18 @@ std::vector<Trial> expand_trials(const ExperimentConfig& cfg) {
   for (const auto& src : cfg.scenes) {
     BopDataset ds(src.dataset);
     std::vector<int> sids = src.scene_ids.empty() ? ds.scene_ids(src.split) : src.scene_ids;
-    const std::set<std::pair<int, int>> wanted = target_images(src, ds, cfg.object);
+    const Targets targets = read_targets(src, ds, cfg.object);
     if (!src.targets.empty() && src.scene_ids.empty()) {
-      std::set<int> in_targets;
-      for (const auto& [sid, im_id] : wanted) in_targets.insert(sid);
-      sids.assign(in_targets.begin(), in_targets.end());
+      sids.clear();
+      for (const auto& [key, i] : targets.entry)
+        if (sids.empty() || sids.back() != key.first) sids.push_back(key.first);
     }
     for (int sid : sids) {
       const SceneInfo scene = ds.load_scene(src.split, sid);
+      check_target_images(targets, scene);
       int taken = 0;
       for (const auto& [im_id, im] : scene.images) {
-        if (!src.targets.empty() && wanted.count({sid, im_id}) == 0) continue;
+        if (!src.targets.empty() && targets.entry.count({sid, im_id}) == 0) continue;
         if (src.images > 0 && taken >= src.images) break;
         ++taken;
         const auto& refinements = src.refinements.empty() ? cfg.refinements : src.refinements;
