@@ -1,0 +1,199 @@
+#include "cli/recognize_input.h"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+#include "io/cloud.h"
+#include "io/mesh_io.h"
+#include "io/validate.h"
+#include "models/registry.h"
+#include "scenes/views.h"
+
+namespace pbcli {
+
+namespace {
+
+// True if `path` is a PLY file whose header declares zero vertices or zero
+// faces (assimp refuses such files).
+bool ply_declares_no_geometry(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  if (!std::getline(in, line) || line.rfind("ply", 0) != 0) return false;
+  long vertices = -1, faces = -1;
+  for (int n = 0; n < 200 && std::getline(in, line); ++n) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line == "end_header") return vertices == 0 || faces == 0;
+    std::istringstream ss(line);
+    std::string word, kind;
+    long count = -1;
+    if (ss >> word >> kind >> count && word == "element") {
+      if (kind == "vertex") vertices = count;
+      if (kind == "face") faces = count;
+    }
+  }
+  return false;
+}
+
+// A point-cloud model file: .pcd, or a .ply that declares no faces.
+bool is_cloud_model(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".pcd") return true;
+  if (ext != ".ply") return false;
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  for (int n = 0; n < 200 && std::getline(in, line); ++n) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line == "end_header") return true;
+    std::istringstream ss(line);
+    std::string word, kind;
+    long count = -1;
+    if (ss >> word >> kind >> count && word == "element" && kind == "face" && count > 0) return false;
+  }
+  return false;
+}
+
+// "fx,fy,cx,cy[,width,height]"; the size defaults to (w, h).
+pb::Intrinsics parse_intrinsics(const std::string& text, int w, int h) {
+  std::vector<double> v;
+  std::stringstream ss(text);
+  for (std::string tok; std::getline(ss, tok, ',');) {
+    char* end = nullptr;
+    const double x = std::strtod(tok.c_str(), &end);
+    if (tok.empty() || *end != '\0') throw pb::InputError("", "--intrinsics", "'" + tok + "' is not a number");
+    v.push_back(x);
+  }
+  if (v.size() != 4 && v.size() != 6)
+    throw pb::InputError("", "--intrinsics", "expected fx,fy,cx,cy or fx,fy,cx,cy,width,height");
+  pb::Intrinsics K;
+  K.fx = v[0], K.fy = v[1], K.cx = v[2], K.cy = v[3];
+  K.width = v.size() == 6 ? static_cast<int>(v[4]) : w;
+  K.height = v.size() == 6 ? static_cast<int>(v[5]) : h;
+  if (v.size() == 6 && (v[4] != K.width || v[5] != K.height || K.width <= 0 || K.height <= 0 || K.width > 20000 ||
+                        K.height > 20000))
+    throw pb::InputError("", "--intrinsics", "width and height must be whole numbers in 1..20000");
+  if (K.width <= 0 || K.height <= 0)
+    throw pb::InputError("", "--intrinsics", "an unorganized cloud needs the image size: fx,fy,cx,cy,width,height");
+  pb::validate_intrinsics(K, "", "--intrinsics");
+  return K;
+}
+
+RecognizeScene dataset_scene(RecognizeSource& o) {
+  const pb::BopDataset ds(o.dataset_dir);
+  if (o.scene < 0 || o.image < 0) throw pb::InputError("", "--scene", "a dataset image needs --scene and --image");
+  if (o.split.empty()) {
+    const auto sp = ds.splits();
+    if (sp.empty()) throw pb::InputError(o.dataset_dir, "split", "the dataset has no split folder with scenes");
+    o.split = std::find(sp.begin(), sp.end(), "test") != sp.end() ? "test" : sp.front();
+  }
+  const pb::SceneInfo sc = ds.load_scene(o.split, o.scene);
+  const auto it = sc.images.find(o.image);
+  if (it == sc.images.end())
+    throw pb::InputError(o.dataset_dir + "/" + o.split + "/" + pb::bop_id(o.scene) + "/scene_camera.json", "image",
+                         "no image " + std::to_string(o.image) + " in scene " + std::to_string(o.scene));
+  RecognizeScene s;
+  s.im = it->second;
+  s.depth = ds.load_depth(o.split, o.scene, s.im);
+  if (s.im.K.width <= 0 || s.im.K.height <= 0) {
+    s.im.K.width = s.depth.width;
+    s.im.K.height = s.depth.height;
+  }
+  s.source = {{"dataset", o.dataset_dir}, {"split", o.split}, {"scene", o.scene}, {"image", o.image}};
+  s.description = o.split + " scene " + std::to_string(o.scene) + " image " + std::to_string(o.image);
+  return s;
+}
+
+RecognizeScene cloud_scene(const RecognizeSource& o) {
+  const pb::PointCloudFile pc = pb::read_cloud(o.cloud, pb::parse_cloud_units(o.units, "--units"));
+  RecognizeScene s;
+  std::string how;
+  if (!o.intrinsics.empty() && !o.camera.empty())
+    throw pb::InputError("", "--intrinsics", "give --intrinsics or --camera, not both");
+  if (!o.intrinsics.empty()) {
+    s.im.K = parse_intrinsics(o.intrinsics, pc.organized() ? pc.width : 0, pc.organized() ? pc.height : 0);
+    how = "given";
+  } else if (!o.camera.empty()) {
+    s.im.K = pb::read_camera_json(o.camera);
+    how = "camera.json";
+  } else if (pc.organized()) {
+    s.im.K = pb::fit_intrinsics(pc, o.cloud);
+    how = "fitted to the organized cloud";
+  } else {
+    s.im.K = pb::virtual_camera(pc, o.cloud);
+    how = "virtual (the cloud's angular extent in 640x480)";
+  }
+  const bool grid = pc.organized() && s.im.K.width == pc.width && s.im.K.height == pc.height;
+  s.depth = grid ? pb::organized_depth(pc) : pb::project_cloud(pc, s.im.K);
+  if (s.depth.valid_count() == 0)
+    throw pb::InputError(o.cloud, "points", "no point projects into the image through the intrinsics");
+  const pb::Intrinsics& K = s.im.K;
+  s.source = {{"cloud", o.cloud},
+              {"units", pc.metres ? "m" : "mm"},
+              {"organized", pc.organized()},
+              {"intrinsics", {{"fx", K.fx}, {"fy", K.fy}, {"cx", K.cx}, {"cy", K.cy}, {"width", K.width},
+                              {"height", K.height}, {"source", how}}}};
+  std::ostringstream d;
+  d << "cloud " << o.cloud << " (" << (pc.organized() ? "organized " : "unorganized, ") << pc.width << "x" << pc.height
+    << (pc.metres ? ", metres" : ", mm") << "; intrinsics " << how << ": fx " << K.fx << " fy " << K.fy << " cx "
+    << K.cx << " cy " << K.cy << ", " << K.width << "x" << K.height << ")";
+  s.description = d.str();
+  return s;
+}
+
+}  // namespace
+
+RecognizeScene load_recognize_scene(RecognizeSource& src) {
+  if (src.cloud.empty() == src.dataset_dir.empty())
+    throw pb::InputError("", src.cloud.empty() ? "--dataset" : "--cloud",
+                         "give either --dataset with --scene and --image, or --cloud");
+  return src.cloud.empty() ? dataset_scene(src) : cloud_scene(src);
+}
+
+RecognizeObject load_recognize_object(const RecognizeSource& src) {
+  RecognizeObject obj;
+  if (src.object.empty() == src.model.empty())
+    throw pb::InputError("", "--object", "give either --object (an id or name) or --model (a mesh file in mm)");
+  if (!src.model.empty()) {
+    obj.name = std::filesystem::path(src.model).stem().string();
+    obj.info.name = obj.name;
+    if (!is_cloud_model(src.model)) {
+      obj.mesh = pb::load_mesh(src.model);
+      return obj;
+    }
+    for (const pb::Vec3f& p : pb::read_cloud(src.model, pb::parse_cloud_units(src.model_units, "--model-units")).points)
+      if (p.allFinite()) obj.cloud.push_back(p);
+    const pb::Pose T = pb::cloud_model_pose(obj.cloud);
+    for (const pb::Vec3f& p : obj.cloud) obj.mesh.vertices.push_back((p.cast<double>() - T.t).cast<float>());
+    return obj;
+  }
+  if (src.dataset_dir.empty()) {  // the model registry
+    const pb::ModelRegistry reg = pb::ModelRegistry::load_default();
+    const pb::ModelSpec& spec = reg.spec(src.object);
+    obj.mesh = reg.load_model(src.object);
+    obj.obj_id = spec.obj_id;
+    obj.name = spec.name;
+    obj.info.obj_id = spec.obj_id;
+    obj.info.name = spec.name;
+    obj.info.symmetries_discrete = spec.symmetries_discrete;
+    obj.info.symmetries_continuous = spec.symmetries_continuous;
+    return obj;
+  }
+  const pb::BopDataset ds(src.dataset_dir);
+  obj.obj_id = ds.resolve_object(src.object);
+  obj.info = ds.model_info(obj.obj_id);
+  try {
+    obj.mesh = ds.load_model(obj.obj_id);
+  } catch (const pb::InputError&) {
+    // A well-formed PLY without vertices or faces is an empty model (the
+    // result says so); a missing or broken file stays an input error.
+    if (!ply_declares_no_geometry(ds.model_path(obj.obj_id))) throw;
+  }
+  obj.name = obj.info.name.empty() ? "obj_" + pb::bop_id(obj.obj_id) : obj.info.name;
+  return obj;
+}
+
+}  // namespace pbcli
