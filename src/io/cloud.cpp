@@ -11,7 +11,7 @@
 #include <limits>
 #include <sstream>
 
-#include "core/binary_io.h"
+#include "io/le_scalar.h"
 #include "core/error.h"
 #include "io/ply_check.h"
 #include "io/validate.h"

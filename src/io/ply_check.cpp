@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/binary_io.h"
+#include "io/le_scalar.h"
 #include "core/error.h"
 
 namespace pb {
