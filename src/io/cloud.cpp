@@ -11,8 +11,8 @@
 #include <limits>
 #include <sstream>
 
-#include "io/le_scalar.h"
 #include "core/error.h"
+#include "io/le_scalar.h"
 #include "io/ply_check.h"
 #include "io/validate.h"
 

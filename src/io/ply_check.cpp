@@ -8,8 +8,8 @@
 #include <utility>
 #include <vector>
 
-#include "io/le_scalar.h"
 #include "core/error.h"
+#include "io/le_scalar.h"
 
 namespace pb {
 
