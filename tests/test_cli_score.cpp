@@ -34,12 +34,7 @@ double report_value(const std::string& report_csv, const std::string& measure) {
 
 TEST(CliScore, OurOwnCsvScoresAsTheReportDid) {
   pbcli::TempDir tmp;
-  pbcli::write_file(tmp.path + "/scene.yaml", pbcli::kSmallTableScene);
-  pbcli::write_file(tmp.path + "/exp.yaml",
-                    "name: scoretest\nseed: 3\nobject: ls5\nscenes:\n  - name: table_small\n    generate: " +
-                        tmp.path + "/scene.yaml\n    scenario: table\ndescriptors: [cvfh]\nrefinements: [icp]\n"
-                        "settings:\n  views: {views: 4}\n");
-  auto r = pbcli::run("run exp.yaml --out res -q --cache cache --scenes scenes", tmp.path);
+  auto r = pbcli::run_small_experiment(tmp.path, "scoretest", "[cvfh]");
   ASSERT_EQ(r.code, 0) << r.err;
   r = pbcli::run("report res --format csv", tmp.path);
   ASSERT_EQ(r.code, 0) << r.err;

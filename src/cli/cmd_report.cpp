@@ -5,6 +5,7 @@
 #include <tuple>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <iostream>
 #include <sstream>
 
@@ -12,6 +13,8 @@
 #include "core/error.h"
 #include "io/png.h"
 #include "eval/bop_csv.h"
+#include "report/gallery.h"
+#include "report/html.h"
 #include "report/report.h"
 #include "runner/store.h"
 
@@ -127,6 +130,24 @@ static int write_plots(const pb::Report& rep, const std::string& dir) {
   return 0;
 }
 
+// DIR/report.html: the tables, the plots in DIR/plots/ (if any) and the
+// gallery, in one self-contained page.
+static void write_html(const pb::Report& rep, const std::vector<pb::TrialRecord>& records, const std::string& dir) {
+  auto gallery = pb::select_gallery(records);
+  pb::draw_gallery(gallery);
+  std::vector<pb::HtmlPlot> plots;
+  std::error_code ec;
+  std::vector<fs::path> pngs;
+  for (const auto& e : fs::directory_iterator(fs::path(dir) / "plots", ec))
+    if (e.path().extension() == ".png") pngs.push_back(e.path());
+  std::sort(pngs.begin(), pngs.end());
+  for (const auto& p : pngs) {
+    std::ifstream in(p, std::ios::binary);
+    plots.push_back({p.stem().string(), std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>())});
+  }
+  pb::atomic_write_text((fs::path(dir) / "report.html").string(), pb::to_html(rep, gallery, plots));
+}
+
 static pb::cli::Command report_cmd("report", "tables (md, csv, tex) and plots from a results folder", [](int argc, char** argv) {
   CLI::App app{"Writes REPORT.{md,csv,tex} into the results folder (thesis values beside each cell) and, "
                "with --plots, PNG plots via scripts/plot.py (matplotlib)."};
@@ -136,6 +157,9 @@ static pb::cli::Command report_cmd("report", "tables (md, csv, tex) and plots fr
   app.add_option("results", dir, "results folder of `posebench run`")->required();
   app.add_option("--format", formats, "comma-separated: md, csv, tex");
   app.add_flag("--plots", plots, "also write PNG plots");
+  bool html = false;
+  app.add_flag("--html", html, "also write REPORT.html: one self-contained page (tables with intervals, the plots "
+                               "of --plots, a gallery of each method's worst failures and some successes)");
   app.add_option("--reference", opt.reference_file, "thesis reference values (YAML)");
   app.add_option("--table", opt.reference_table, "thesis table id to compare with (e.g. 4.1)");
   app.add_option("--plot-x", opt.plot_x, "grid path or added_noise_mm to plot against");
@@ -149,5 +173,7 @@ static pb::cli::Command report_cmd("report", "tables (md, csv, tex) and plots fr
   const pb::Report rep = pb::build_report(exp, records, opt);
   write_tables(rep, dir, formats);
   write_bop_csvs(records, dir);
-  return plots ? write_plots(rep, dir) : 0;
+  const int rc = plots ? write_plots(rep, dir) : 0;
+  if (html) write_html(rep, records, dir);
+  return rc;
 });

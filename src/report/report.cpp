@@ -127,7 +127,9 @@ double ref_value(const Reference& ref, const std::string& row, const std::string
   return c == b->second.end() ? kNaN : c->second;
 }
 
-std::string fmt(double v, const std::string& measure) {
+}  // namespace
+
+std::string format_measure(double v, const std::string& measure) {
   if (!std::isfinite(v)) return "-";
   char buf[64];
   if (measure.rfind("robustness", 0) == 0)
@@ -140,8 +142,6 @@ std::string fmt(double v, const std::string& measure) {
     std::snprintf(buf, sizeof buf, "%.1f", v);
   return buf;
 }
-
-}  // namespace
 
 namespace {
 
@@ -333,7 +333,7 @@ Report build_report(const nlohmann::json& exp, const std::vector<TrialRecord>& r
   return rep;
 }
 
-static std::string measure_label(const std::string& m) {
+std::string measure_label(const std::string& m) {
   if (m == "robustness") return "robustness";
   if (m.rfind("robustness_", 0) == 0) return "robustness, judged by " + m.substr(11);
   if (m == "translation_mm") return "translation error (mm)";
@@ -362,8 +362,8 @@ std::string to_markdown(const Report& r) {
       o << "| " << (row.scenario == last ? "" : row.scenario) << " | " << measure_label(row.measure) << " |";
       last = row.scenario;
       for (const auto& c : row.cells) {
-        o << " " << fmt(c.value, row.measure);
-        if (std::isfinite(c.reference)) o << " (" << fmt(c.reference, row.measure) << ")";
+        o << " " << format_measure(c.value, row.measure);
+        if (std::isfinite(c.reference)) o << " (" << format_measure(c.reference, row.measure) << ")";
         o << " |";
       }
       o << "\n";
@@ -419,8 +419,8 @@ std::string to_latex(const Report& r) {
       if (row.detail) continue;
       o << tex_escape(row.scenario) << " & " << tex_escape(measure_label(row.measure));
       for (const auto& c : row.cells) {
-        o << " & " << tex_escape(fmt(c.value, row.measure));
-        if (std::isfinite(c.reference)) o << " (" << tex_escape(fmt(c.reference, row.measure)) << ")";
+        o << " & " << tex_escape(format_measure(c.value, row.measure));
+        if (std::isfinite(c.reference)) o << " (" << tex_escape(format_measure(c.reference, row.measure)) << ")";
       }
       o << " \\\\\n";
     }

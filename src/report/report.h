@@ -63,6 +63,10 @@ Report build_report(const nlohmann::json& experiment, const std::vector<TrialRec
                     const ReportOptions& opt);
 
 std::string to_markdown(const Report& r);
+// A cell's value as the tables show it (robustness in %, errors in mm...;
+// "-" when undefined), and a measure's name in words.
+std::string format_measure(double v, const std::string& measure);
+std::string measure_label(const std::string& measure);
 std::string to_csv(const Report& r);
 std::string to_latex(const Report& r);
 nlohmann::json plots_json(const Report& r);
