@@ -284,7 +284,8 @@ ReportPlot plot_of(const std::vector<TrialRecord>& records, const Layout& l, con
   ReportPlot p;
   p.name = l.plot_x == "added_noise_mm" ? "robustness_vs_noise" : "robustness_vs_" + l.plot_x;
   std::replace(p.name.begin(), p.name.end(), '.', '_');
-  p.x_label = l.plot_x == "added_noise_mm" ? "added noise sigma (mm)" : l.plot_x;
+  p.x_label = plot_axis_label(l.plot_x);
+  p.title = plot_title(exp.value("name", ""), l.plot_x);
   for (const auto& scene : l.scenes)
     for (const auto& col : l.columns) {
       std::map<double, std::vector<ThesisTrial>> pts;
@@ -296,11 +297,15 @@ ReportPlot plot_of(const std::vector<TrialRecord>& records, const Layout& l, con
       if (pts.empty()) continue;
       ReportSeries s;
       s.label = col + " (" + scene + ")";
+      s.method = col;
+      s.scene = scene;
       for (const auto& [x, trials] : pts) {
         const ThesisAggregate a = thesis_aggregate(trials, thresholds_for(exp, l.scenario_of.at(scene)));
         s.x.push_back(x);
         s.robustness.push_back(a.robustness);
         s.time.push_back(a.time_mean_s);
+        s.correct.push_back(a.correct);
+        s.trials.push_back(a.trials);
       }
       p.series.push_back(s);
     }
@@ -427,24 +432,6 @@ std::string to_latex(const Report& r) {
     o << "\\hline\n\\end{tabular}\n\n";
   }
   return o.str();
-}
-
-nlohmann::json plots_json(const Report& r) {
-  nlohmann::json j = nlohmann::json::array();
-  for (const auto& p : r.plots) {
-    nlohmann::json pj = {{"name", p.name}, {"x_label", p.x_label}, {"title", r.experiment}};
-    for (const auto& s : p.series) {
-      auto clean = [](const std::vector<double>& v) {
-        nlohmann::json a = nlohmann::json::array();
-        for (double x : v) a.push_back(std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr));
-        return a;
-      };
-      pj["series"].push_back({{"label", s.label}, {"x", clean(s.x)}, {"robustness", clean(s.robustness)},
-                              {"time", clean(s.time)}});
-    }
-    j.push_back(pj);
-  }
-  return j;
 }
 
 }  // namespace pb
