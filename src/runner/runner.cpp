@@ -241,6 +241,9 @@ RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
     po.omp_threads = sum.omp_threads;
     po.timeout_s = cfg.timeout_s;
     po.memory_limit_mb = opt.memory_limit_mb;
+    if (opt.memory_limit_mb > 0 && !kMemoryLimitApplies)
+      std::cerr << "posebench run: --memory-limit-mb is not applied in this AddressSanitizer build (ASan "
+                   "reserves terabytes of address space: RLIMIT_AS would end every worker)\n";
     Progress progress(opt.quiet, pending.size());
     run_in_workers(po, inputs, pending, [&](long, const TrialRecord& rec) {
       store.append(rec);
