@@ -11,6 +11,7 @@
 
 #include "cli/command.h"
 #include "core/error.h"
+#include "core/log.h"
 #include "io/png.h"
 #include "eval/bop_csv.h"
 #include "report/gallery.h"
@@ -118,13 +119,13 @@ static int write_plots(const pb::Report& rep, const std::string& dir) {
   const std::string script = find_plot_script();
   if (script.empty()) throw pb::InputError("scripts/plot.py", "", "plot script not found");
   if (rep.plots.empty()) {
-    std::cerr << "posebench report: nothing to plot (no swept variable)\n";
+    pb::log_event(pb::LogLevel::info, "no_plot", {{"why", "no swept variable"}});
     return 0;
   }
   const std::string py = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   const std::string cmd = py + " '" + script + "' '" + data + "' '" + (fs::path(dir) / "plots").string() + "'";
   if (std::system(cmd.c_str()) != 0) {
-    std::cerr << "posebench report: plotting failed (python3-matplotlib missing?)\n";
+    pb::log_event(pb::LogLevel::error, "plot_failed", {{"script", script}, {"hint", "python3-matplotlib missing?"}});
     return 1;
   }
   return 0;
@@ -157,6 +158,7 @@ static pb::cli::Command report_cmd("report", "tables (md, csv, tex) and plots fr
   app.add_option("results", dir, "results folder of `posebench run`")->required();
   app.add_option("--format", formats, "comma-separated: md, csv, tex");
   app.add_flag("--plots", plots, "also write PNG plots");
+  pb::cli::add_log_flags(app);
   bool html = false;
   app.add_flag("--html", html, "also write REPORT.html: one self-contained page (tables with intervals, the plots "
                                "of --plots, a gallery of each method's worst failures and some successes)");

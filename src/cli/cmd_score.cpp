@@ -28,6 +28,7 @@ static pb::cli::Command score_cmd(
       app.add_option("--vsd-delta", s.vsd_delta_mm, "VSD visibility tolerance in mm (bop19: 15; ITODD 5)");
       app.add_option("--out", out, "also write OUT/scores.json (totals, recalls, every estimate's errors) and "
                                    "OUT/scores.md");
+      pb::cli::add_log_flags(app);
       PB_CLI_PARSE(app, argc, argv);
       s.vsd = !no_vsd;
       const pb::ScoreResult r = pb::score_bop_results(s);

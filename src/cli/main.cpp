@@ -7,10 +7,12 @@
 #include <algorithm>
 #include <cstdio>
 #include <exception>
+#include <memory>
 #include <iostream>
 
 #include "cli/command.h"
 #include "core/error.h"
+#include "core/log.h"
 
 namespace pb::cli {
 
@@ -25,6 +27,16 @@ std::string self_path() {
   if (n <= 0) return "posebench";
   buf[n] = '\0';
   return buf;
+}
+
+void add_log_flags(CLI::App& app, bool* quiet) {
+  auto verbose = std::make_shared<bool>(false), q = std::make_shared<bool>(false);
+  app.add_flag("-v,--verbose", *verbose, "log more: a line per finished trial");
+  app.add_flag("-q,--quiet", *q, "log warnings and errors only (no progress)");
+  app.parse_complete_callback([verbose, q, quiet] {
+    if (quiet) *quiet = *q;
+    pb::set_log_level(*q ? pb::LogLevel::warn : *verbose ? pb::LogLevel::debug : pb::LogLevel::info);
+  });
 }
 
 Command::Command(std::string name, std::string summary, CommandFn fn) {

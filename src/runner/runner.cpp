@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/log.h"
 #include "core/file_lock.h"
 #include "core/timer.h"
 #include "core/yaml.h"
@@ -83,7 +84,7 @@ void prepare_scenes(ExperimentConfig& cfg, const RunOptions& opt) {
     const fs::path cfg_path = fs::path(opt.scenes_dir) / (src.name + "_" + h + ".config.json");
     atomic_write_text(cfg_path.string(), gen.dump(2) + "\n");
     const std::string log = (fs::path(opt.scenes_dir) / (src.name + "_" + h + ".log")).string();
-    if (!opt.quiet) std::cerr << "posebench run: generating scene set '" << src.name << "' into " << dir << "\n";
+    log_event(LogLevel::info, "generate_scenes", {{"scene", src.name}, {"dataset", dir.string()}});
     const int rc = run_command({opt.binary, "generate", cfg_path.string(), "--out", dir.string()}, log);
     if (rc != 0) {
       std::ifstream in(log);
@@ -126,10 +127,10 @@ class Progress {
                     bar.c_str(), sum.ran, to_run_, 100 * frac, fmt_duration(el).c_str(),
                     fmt_duration(eta).c_str(), sum.ok, sum.no_hypothesis, sum.errors, sum.timeouts);
       std::cerr << line << (final ? "\n" : "") << std::flush;
-    } else if (final || last_print_.seconds() > 10) {
-      std::snprintf(line, sizeof line, "posebench run: %zu/%zu trials (%.0f%%), elapsed %s, ETA %s\n", sum.ran,
-                    to_run_, 100 * frac, fmt_duration(el).c_str(), fmt_duration(eta).c_str());
-      std::cerr << line;
+    } else if (final || last_print_.seconds() > 10) {  // not a terminal: a log line every 10 s
+      log_event(LogLevel::info, "progress",
+                {{"ran", sum.ran}, {"of", to_run_}, {"elapsed", fmt_duration(el)}, {"eta", fmt_duration(eta)},
+                 {"ok", sum.ok}, {"no_hypothesis", sum.no_hypothesis}, {"error", sum.errors}, {"timeout", sum.timeouts}});
       last_print_.reset();
     }
   }
@@ -197,9 +198,7 @@ RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
   if (!opt.shard.active() && !ResultStore::shard_record_files(out).empty()) {
     ResultStore::write_trial_list(out, cfg.hash, keys);
     const MergeReport m = merge_results(out);
-    if (!opt.quiet)
-      std::cerr << "posebench run: merged " << m.records << " records of earlier shards into " << out
-                << "/records.jsonl first\n";
+    log_event(LogLevel::info, "merge_shards", {{"records", m.records}, {"into", out + "/records.jsonl"}});
   }
   ResultStore store(out, cfg.canonical, cfg.hash, opt.shard.active() ? opt.shard.name() : "");
   ResultStore::write_trial_list(out, cfg.hash, keys);
@@ -229,9 +228,8 @@ RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
     if (!store.has(keys[u]) && !done_elsewhere.count(keys[u])) pending.push_back(i);
   }
   sum.already_done = sum.total - pending.size();
-  if (!opt.quiet && sum.already_done)
-    std::cerr << "posebench run: resuming: " << sum.already_done << " of " << sum.total
-              << " trials already recorded\n";
+  if (sum.already_done)
+    log_event(LogLevel::info, "resume", {{"recorded", sum.already_done}, {"trials", sum.total}});
   if (!pending.empty()) {
     PoolOptions po;
     po.binary = opt.binary;
@@ -242,12 +240,19 @@ RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
     po.timeout_s = cfg.timeout_s;
     po.memory_limit_mb = opt.memory_limit_mb;
     if (opt.memory_limit_mb > 0 && !kMemoryLimitApplies)
-      std::cerr << "posebench run: --memory-limit-mb is not applied in this AddressSanitizer build (ASan "
-                   "reserves terabytes of address space: RLIMIT_AS would end every worker)\n";
+      log_event(LogLevel::warn, "memory_limit_not_applied",
+                {{"why", "AddressSanitizer reserves terabytes of address space: RLIMIT_AS would end every worker"}});
     Progress progress(opt.quiet, pending.size());
     run_in_workers(po, inputs, pending, [&](long, const TrialRecord& rec) {
       store.append(rec);
       count(rec, sum);
+      if (log_enabled(LogLevel::debug)) {
+        nlohmann::ordered_json f = {{"key", rec.key}, {"status", rec.status}};
+        if (rec.correct) f["correct"] = *rec.correct;
+        if (rec.times) f["total_s"] = rec.times->total;
+        if (rec.message) f["message"] = *rec.message;
+        log_event(LogLevel::debug, "trial", f);
+      }
       progress.update(sum, false);
     });
     progress.update(sum, true);
@@ -274,7 +279,7 @@ void inject_fault(const std::string& key) {
     const size_t colon = item.find(':');
     if (colon == std::string::npos || key.find(item.substr(colon + 1)) == std::string::npos) continue;
     const std::string kind = item.substr(0, colon);
-    std::cerr << "posebench worker: injected fault '" << kind << "' on " << key << std::endl;
+    log_event(LogLevel::warn, "injected_fault", {{"fault", kind}, {"key", key}});
     if (kind == "segfault") raise(SIGSEGV);
     if (kind == "abort") std::abort();
     if (kind == "exit") _exit(3);
