@@ -9,8 +9,8 @@
 #include "core/error.h"
 #include "io/cloud.h"
 #include "io/mesh_io.h"
-#include "io/validate.h"
 #include "models/registry.h"
+#include "scenes/import_clouds.h"
 #include "scenes/views.h"
 
 namespace pbcli {
@@ -57,31 +57,6 @@ bool is_cloud_model(const std::string& path) {
   return false;
 }
 
-// "fx,fy,cx,cy[,width,height]"; the size defaults to (w, h).
-pb::Intrinsics parse_intrinsics(const std::string& text, int w, int h) {
-  std::vector<double> v;
-  std::stringstream ss(text);
-  for (std::string tok; std::getline(ss, tok, ',');) {
-    char* end = nullptr;
-    const double x = std::strtod(tok.c_str(), &end);
-    if (tok.empty() || *end != '\0') throw pb::InputError("", "--intrinsics", "'" + tok + "' is not a number");
-    v.push_back(x);
-  }
-  if (v.size() != 4 && v.size() != 6)
-    throw pb::InputError("", "--intrinsics", "expected fx,fy,cx,cy or fx,fy,cx,cy,width,height");
-  pb::Intrinsics K;
-  K.fx = v[0], K.fy = v[1], K.cx = v[2], K.cy = v[3];
-  K.width = v.size() == 6 ? static_cast<int>(v[4]) : w;
-  K.height = v.size() == 6 ? static_cast<int>(v[5]) : h;
-  if (v.size() == 6 && (v[4] != K.width || v[5] != K.height || K.width <= 0 || K.height <= 0 || K.width > 20000 ||
-                        K.height > 20000))
-    throw pb::InputError("", "--intrinsics", "width and height must be whole numbers in 1..20000");
-  if (K.width <= 0 || K.height <= 0)
-    throw pb::InputError("", "--intrinsics", "an unorganized cloud needs the image size: fx,fy,cx,cy,width,height");
-  pb::validate_intrinsics(K, "", "--intrinsics");
-  return K;
-}
-
 RecognizeScene dataset_scene(RecognizeSource& o) {
   const pb::BopDataset ds(o.dataset_dir);
   if (o.scene < 0 || o.image < 0) throw pb::InputError("", "--scene", "a dataset image needs --scene and --image");
@@ -109,28 +84,14 @@ RecognizeScene dataset_scene(RecognizeSource& o) {
 
 RecognizeScene cloud_scene(const RecognizeSource& o) {
   const pb::PointCloudFile pc = pb::read_cloud(o.cloud, pb::parse_cloud_units(o.units, "--units"));
+  pb::CloudScene cs = pb::cloud_scene(pc, o.cloud, o.intrinsics, o.camera);
   RecognizeScene s;
-  std::string how;
-  if (!o.intrinsics.empty() && !o.camera.empty())
-    throw pb::InputError("", "--intrinsics", "give --intrinsics or --camera, not both");
-  if (!o.intrinsics.empty()) {
-    s.im.K = parse_intrinsics(o.intrinsics, pc.organized() ? pc.width : 0, pc.organized() ? pc.height : 0);
-    how = "given";
-  } else if (!o.camera.empty()) {
-    s.im.K = pb::read_camera_json(o.camera);
-    how = "camera.json";
-  } else if (pc.organized()) {
-    s.im.K = pb::fit_intrinsics(pc, o.cloud);
-    how = "fitted to the organized cloud";
-  } else {
-    s.im.K = pb::virtual_camera(pc, o.cloud);
-    how = "virtual (the cloud's angular extent in 640x480)";
-  }
-  const bool grid = pc.organized() && s.im.K.width == pc.width && s.im.K.height == pc.height;
-  s.depth = grid ? pb::organized_depth(pc) : pb::project_cloud(pc, s.im.K);
-  if (s.depth.valid_count() == 0)
-    throw pb::InputError(o.cloud, "points", "no point projects into the image through the intrinsics");
+  s.depth = std::move(cs.depth);
+  s.im.K = cs.K;
   const pb::Intrinsics& K = s.im.K;
+  const std::string how = cs.source == "fitted"    ? "fitted to the organized cloud"
+                          : cs.source == "virtual" ? "virtual (the cloud's angular extent in 640x480)"
+                                                   : cs.source;
   s.source = {{"cloud", o.cloud},
               {"units", pc.metres ? "m" : "mm"},
               {"organized", pc.organized()},

@@ -15,6 +15,7 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -60,8 +61,50 @@ static int run_command(const std::vector<std::string>& args, const std::string& 
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
+// A `clouds:` scene set: `posebench import-clouds` into
+// scenes_dir/NAME_HASH (HASH of the clouds' bytes, their options and the
+// object), once.
+static void import_scene_clouds(SceneSource& src, const ExperimentConfig& cfg, const RunOptions& opt) {
+  std::string key = cfg.object + "\n" + src.cloud.dump();
+  for (const auto& c : src.clouds) {
+    std::ifstream in(c, std::ios::binary);
+    key += "\n" + hash_hex(std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+  }
+  const std::string h = hash_hex(key).substr(0, 8);
+  const fs::path dir = fs::path(opt.scenes_dir) / (src.name + "_" + h);
+  src.dataset = dir.string();
+  const auto complete = [&] { return fs::exists(dir / "posebench_clouds.json"); };
+  if (complete()) return;
+  fs::create_directories(opt.scenes_dir);
+  const FileLock lock = FileLock::acquire((fs::path(opt.scenes_dir) / (src.name + "_" + h + ".lock")).string());
+  if (complete()) return;
+  std::vector<std::string> args{opt.binary, "import-clouds", "--out", dir.string(), "--object", cfg.object};
+  for (const char* k : {"units", "intrinsics", "camera"})
+    if (src.cloud.contains(k)) {
+      args.push_back(std::string("--") + k);
+      std::string v;
+      if (src.cloud[k].is_array())  // intrinsics: [fx, fy, cx, cy(, width, height)]
+        for (const auto& x : src.cloud[k]) v += (v.empty() ? "" : ",") + (x.is_string() ? x.get<std::string>() : x.dump());
+      else
+        v = src.cloud[k].is_string() ? src.cloud[k].get<std::string>() : src.cloud[k].dump();
+      args.push_back(v);
+    }
+  args.insert(args.end(), src.clouds.begin(), src.clouds.end());
+  const std::string log = (fs::path(opt.scenes_dir) / (src.name + "_" + h + ".log")).string();
+  log_event(LogLevel::info, "import_clouds", {{"scene", src.name}, {"clouds", src.clouds.size()}, {"dataset", dir.string()}});
+  const int rc = run_command(args, log);
+  if (rc != 0) {
+    std::ifstream in(log);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    throw InputError(cfg.file, "scenes." + src.name + ".clouds",
+                     "importing the clouds failed (exit " + std::to_string(rc) + "): " + ss.str());
+  }
+}
+
 void prepare_scenes(ExperimentConfig& cfg, const RunOptions& opt) {
   for (auto& src : cfg.scenes) {
+    if (!src.clouds.empty()) import_scene_clouds(src, cfg, opt);
     if (src.generate.empty()) continue;
     nlohmann::json gen = yaml_to_json_file(src.generate);
     for (auto it = src.generator_overrides.begin(); it != src.generator_overrides.end(); ++it)
