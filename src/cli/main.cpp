@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <memory>
 #include <iostream>
 
@@ -71,6 +72,11 @@ int main(int argc, char** argv) {
       return pb::kExitInputError;
     } catch (const CLI::ParseError& e) {
       std::cerr << "posebench " << name << ": error: " << e.what() << "\n";
+      return pb::kExitInputError;
+    } catch (const std::filesystem::filesystem_error& e) {
+      // A path the OS refuses (a name too long, a component that is a file,
+      // no permission): the user's input, named by the error itself.
+      std::cerr << "posebench " << name << ": error: " << e.path1().string() << ": " << e.code().message() << "\n";
       return pb::kExitInputError;
     } catch (const std::exception& e) {
       std::cerr << "posebench " << name << ": internal error: " << e.what() << "\n";

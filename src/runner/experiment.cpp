@@ -50,7 +50,8 @@ static std::string resolve(const std::string& base_file, const std::string& p) {
   if (p.empty() || fs::path(p).is_absolute()) return p;
   // Paths are relative to the current directory when they exist there (the
   // usual case: run from the project root), else to the config's folder.
-  if (fs::exists(p)) return p;
+  std::error_code ec;  // a path the OS rejects (a name too long) is not there, not an exception
+  if (fs::exists(p, ec)) return p;
   return (fs::path(base_file).parent_path() / p).string();
 }
 
@@ -144,7 +145,7 @@ SceneSource parse_scene(const YamlNode& s, const std::string& path, std::set<std
   if (!src.generate.empty() + !src.dataset.empty() + !src.clouds.empty() != 1)
     s.fail("give exactly one of 'generate' (a scene config), 'dataset' (a BOP dataset) or 'clouds' (point clouds)");
   for (size_t i = 0; i < src.clouds.size(); ++i)
-    if (!fs::is_regular_file(src.clouds[i])) s["clouds"].fail("cloud " + std::to_string(i) + " not found: " + src.clouds[i]);
+    if (std::error_code ec; !fs::is_regular_file(src.clouds[i], ec)) s["clouds"].fail("cloud " + std::to_string(i) + " not found: " + src.clouds[i]);
   if (s.has("cloud")) {
     if (src.clouds.empty()) s["cloud"].fail("only valid with 'clouds'");
     s["cloud"].check_keys({"units", "intrinsics", "camera"});
@@ -152,7 +153,7 @@ SceneSource parse_scene(const YamlNode& s, const std::string& path, std::set<std
     src.cloud = yaml_to_json(s["cloud"].raw());
     if (src.cloud.contains("camera")) src.cloud["camera"] = resolve(path, src.cloud["camera"].get<std::string>());
   }
-  if (!src.generate.empty() && !fs::exists(src.generate))
+  if (std::error_code ec; !src.generate.empty() && !fs::exists(src.generate, ec))
     s["generate"].fail("scene config not found: " + src.generate);
   src.name = s.get_or<std::string>(
       "name", fs::path(!src.generate.empty() ? src.generate : !src.dataset.empty() ? src.dataset : src.clouds[0])
@@ -293,7 +294,8 @@ Targets read_targets(const SceneSource& src, const BopDataset& ds, const std::st
   Targets out;
   if (src.targets.empty()) return out;
   out.file = fs::path(src.targets).is_absolute() ? src.targets : (fs::path(src.dataset) / src.targets).string();
-  if (!fs::is_regular_file(out.file)) throw InputError(out.file, "targets", "test-targets file not found");
+  if (std::error_code ec; !fs::is_regular_file(out.file, ec))
+    throw InputError(out.file, "targets", "test-targets file not found");
   const int obj = ds.resolve_object(object);
   const auto targets = read_test_targets(out.file);
   const auto scenes = ds.scene_ids(src.split);
