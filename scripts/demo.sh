@@ -11,9 +11,10 @@ cd "$ROOT"
 JOBS="${POSEBENCH_JOBS:-$(nproc)}"
 echo "demo: running configs/experiments/demo.yaml with $JOBS worker(s) (results/demo)"
 build/posebench run configs/experiments/demo.yaml --out results/demo --jobs "$JOBS"
-build/posebench report results/demo --format md,csv,tex
+build/posebench report results/demo --format md,csv,tex --html
 preview=$(ls -d scenes/table_synthetic_*/depth_preview.png 2>/dev/null | head -1 || true)
 echo
 echo "demo: records in results/demo/records.jsonl, tables in results/demo/report.{md,csv,tex},"
+echo "      one page with tables and a failure gallery in results/demo/report.html (open it in a browser),"
 echo "      BOP results CSVs in results/demo/bop/${preview:+, a depth preview in $preview}"
 echo "      one image by hand: build/posebench recognize --dataset $(dirname "${preview:-scenes/x/y}") --scene 1 --image 0 --object ls5 --method fpfh --refine icp --overlay overlay.png"

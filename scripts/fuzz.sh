@@ -79,6 +79,9 @@ seed fuzz_bop_scene "$scene/scene_gt_info.json" 2
 # full frame, at thousands rather than tens of inputs per second.
 seed fuzz_png16 fuzz/seeds/depth_24x18.png
 for f in models/generated/box_small.ply models/generated/cylinder.ply; do seed fuzz_mesh "$f" 0; done
+# Point clouds: the first byte's low bit picks .ply (1) or .pcd (0).
+for f in fuzz/seeds/cloud_*.pcd; do seed fuzz_cloud "$f" 0; done
+seed fuzz_cloud fuzz/seeds/cloud_60.ply 1
 # The first byte picks the descriptor: its index in descriptor_names()
 # (recognition/registry.cpp, alphabetical).
 for f in "$SEEDS"/cache/*.bin; do

@@ -1,15 +1,94 @@
 #!/usr/bin/env python3
-"""Plots written by `posebench report --plots`: robustness (and time) against
+"""Plots written by `posebench report --plots`: robustness and time against
 a swept variable (noise sigma, number of hypotheses), one line per method and
-scene set, as the thesis's Figures 4.6, 4.7, 4.11 and 4.12."""
+scene set, as the thesis's Figures 4.6, 4.7, 4.11 and 4.12.
+
+Robustness is drawn with its 95% Wilson interval as a band and the number of
+trials per point stated; a line style per scene set (the family) and a
+marker and colour per method tell the series apart; the time axis is
+logarithmic when the times span more than a decade."""
 import json
+import math
 import os
 import sys
 
-import matplotlib
+Z95 = 1.959963984540054
+LINE_STYLES = ["-", "--", ":", "-."]
+MARKERS = ["o", "s", "^", "D", "v", "P", "X", "*", "<", ">"]
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+
+def wilson(k, n, z=Z95):
+    """The Wilson score interval of k successes in n trials, as (lo, hi);
+    (0, 1) for n = 0 (eval/stats.h computes the same)."""
+    if n <= 0:
+        return 0.0, 1.0
+    p = k / n
+    d = 1 + z * z / n
+    c = (p + z * z / (2 * n)) / d
+    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
+    return max(0.0, c - h), min(1.0, c + h)
+
+
+def styles(series):
+    """Per series (in order) its (line style, marker, colour index): a line
+    style per scene set, a marker and colour per method, in first-seen order."""
+    scenes, methods, out = [], [], []
+    for s in series:
+        sc, m = s.get("scene", ""), s.get("method", s.get("label", ""))
+        if sc not in scenes:
+            scenes.append(sc)
+        if m not in methods:
+            methods.append(m)
+        i, j = scenes.index(sc), methods.index(m)
+        out.append((LINE_STYLES[i % len(LINE_STYLES)], MARKERS[j % len(MARKERS)], j))
+    return out
+
+
+def log_time_axis(series):
+    """True when the positive mean times span more than a factor of 10."""
+    ts = [t for s in series for t in s.get("time", []) if t is not None and t > 0]
+    return len(ts) > 1 and max(ts) / min(ts) > 10
+
+
+def trials_note(series):
+    """'n = N trials per point' when every point has N trials, else a range."""
+    ns = sorted({n for s in series for n in s.get("trials", [])})
+    if not ns:
+        return ""
+    return "n = %d trials per point" % ns[0] if len(ns) == 1 else "n = %d to %d trials per point" % (ns[0], ns[-1])
+
+
+def draw(p, out_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    series = p.get("series", [])
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.6))
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for s, (ls, mk, ci) in zip(series, styles(series)):
+        c = colours[ci % len(colours)]
+        xs = s["x"]
+        rob = [None if v is None else 100 * v for v in s["robustness"]]
+        axes[0].plot(xs, rob, linestyle=ls, marker=mk, color=c, label=s["label"])
+        if s.get("trials"):
+            band = [wilson(k, n) for k, n in zip(s["correct"], s["trials"])]
+            axes[0].fill_between(xs, [100 * b[0] for b in band], [100 * b[1] for b in band], color=c, alpha=0.12)
+        axes[1].plot(xs, s["time"], linestyle=ls, marker=mk, color=c, label=s["label"])
+    axes[0].set_ylabel("robustness (% of trials correct; band: 95% interval)")
+    axes[0].set_ylim(-2, 102)
+    axes[1].set_ylabel("mean time per image (s)")
+    if log_time_axis(series):
+        axes[1].set_yscale("log")
+    for ax in axes:
+        ax.set_xlabel(p["x_label"])
+        ax.grid(True, alpha=0.3)
+    axes[0].legend(fontsize=7, title=trials_note(series) or None, title_fontsize=7)
+    fig.suptitle(p.get("title", ""))
+    fig.tight_layout()
+    fig.savefig(out_path, dpi=110)
+    plt.close(fig)
 
 
 def main(data_path, out_dir):
@@ -17,23 +96,8 @@ def main(data_path, out_dir):
         plots = json.load(f)
     os.makedirs(out_dir, exist_ok=True)
     for p in plots:
-        fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
-        for s in p.get("series", []):
-            xs = s["x"]
-            axes[0].plot(xs, [None if v is None else 100 * v for v in s["robustness"]], marker="o", label=s["label"])
-            axes[1].plot(xs, s["time"], marker="o", label=s["label"])
-        axes[0].set_ylabel("robustness (% correct)")
-        axes[0].set_ylim(-2, 102)
-        axes[1].set_ylabel("mean time per image (s)")
-        for ax in axes:
-            ax.set_xlabel(p["x_label"])
-            ax.grid(True, alpha=0.3)
-        axes[0].legend(fontsize=7)
-        fig.suptitle(p.get("title", ""))
-        fig.tight_layout()
         out = os.path.join(out_dir, p["name"] + ".png")
-        fig.savefig(out, dpi=110)
-        plt.close(fig)
+        draw(p, out)
         print(out)
 
 

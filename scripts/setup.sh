@@ -7,8 +7,9 @@ cd "$ROOT"
 
 PACKAGES=(build-essential cmake pkg-config ccache libpcl-dev libeigen3-dev libosmesa6-dev
           libassimp-dev nlohmann-json3-dev libyaml-cpp-dev libbenchmark-dev libgtest-dev
-          libpng-dev libcli11-dev python3 python3-matplotlib
-          slurm-wlm munge)  # a one-node Slurm for the sweep scripts' test (scripts/slurm)
+          libpng-dev libcli11-dev libspdlog-dev python3 python3-matplotlib
+          slurm-wlm munge  # a one-node Slurm for the sweep scripts' test (scripts/slurm)
+          chromium)        # headless, for the HTML report's rendering test (scripts/html_screenshot.sh)
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -107,3 +107,47 @@ TEST(CliRunSummary, RunsJsonlAndJsonSummaryCountTheTrials) {
 }
 
 }  // namespace
+
+namespace {
+
+// The lines of `text` that are log events named `event` (TIME LEVEL EVENT ...).
+std::vector<std::string> events(const std::string& text, const std::string& level, const std::string& event) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  std::string line;
+  const std::regex re("^[0-9]{4}-[0-9]{2}-[0-9]{2}T[0-9:.]+ " + level + " " + event + "( .*)?$");
+  while (std::getline(ss, line))
+    if (std::regex_match(line, re)) out.push_back(line);
+  return out;
+}
+
+}  // namespace
+
+// -v: one debug log line per finished trial with its record's key, status
+// and correctness; -q: nothing on stderr; the default: what the run does
+// (a resumed run says so) but no trial lines.
+TEST(CliRunSummary, LogLevelsAndOneLinePerTrial) {
+  pbcli::TempDir tmp;
+  const auto r = pbcli::run_small_experiment(tmp.path, "logtest", "[cvfh]");  // -q
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  // Again with -v into a fresh folder: a line per trial.
+  const std::string common = " --cache cache --scenes scenes";
+  const auto v = pbcli::run("run exp.yaml --out v -v" + common, tmp.path);
+  ASSERT_EQ(v.code, 0) << v.err;
+  const auto trials = events(v.err, "debug", "trial");
+  std::map<std::string, nlohmann::json> recs;
+  for (const auto& j : lines(tmp.path + "/v/records.jsonl")) recs[j["key"]] = j;
+  ASSERT_EQ(trials.size(), recs.size()) << v.err;
+  for (const auto& [key, j] : recs) {
+    const std::string want = "key=" + (key.find_first_of(" \"'=") == std::string::npos ? key : nlohmann::json(key).dump()) +
+                             " status=" + j["status"].get<std::string>() + " correct=" + (j.value("correct", false) ? "true" : "false");
+    EXPECT_EQ(std::count_if(trials.begin(), trials.end(), [&](const std::string& l) { return l.find(want) != std::string::npos; }), 1)
+        << want << "\n" << v.err;
+  }
+  // The default level: a resume line, no trial lines.
+  const auto d = pbcli::run("run exp.yaml --out v" + common, tmp.path);
+  ASSERT_EQ(d.code, 0) << d.err;
+  EXPECT_EQ(events(d.err, "info", "resume").size(), 1u) << d.err;
+  EXPECT_EQ(events(d.err, "debug", "trial").size(), 0u) << d.err;
+}

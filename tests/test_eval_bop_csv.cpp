@@ -132,6 +132,13 @@ TEST(EvalBopCsv, BadInputNamesLineAndField) {
   write_text(path, h + ok + "1,2,4,0.9,1 0 0 0 1 0 0 0 1,10 20 30,0.7\n");
   EXPECT_EQ(field_of(path), "line 3 time");
   EXPECT_THROW(read_bop_results_csv(temp_path("missing.csv")), InputError);
+  // R that is not a rotation: a reflection, a scaled rotation, a shear.
+  for (const char* R : {"-1 0 0 0 1 0 0 0 1", "2 0 0 0 2 0 0 0 2", "1 0.1 0 0 1 0 0 0 1"}) {
+    write_text(path, h + ok + "1,3,3,0.9," + R + ",10 20 30,0.5\n");
+    EXPECT_EQ(field_of(path), "line 3 R") << R;
+  }
+  write_text(path, h + "1,2,-3,0.9,1 0 0 0 1 0 0 0 1,10 20 30,0.5\n");
+  EXPECT_EQ(field_of(path), "line 2 obj_id");
 
   // The writer refuses two times for one image and leaves no file behind.
   BopResultRow a, b;
@@ -141,6 +148,35 @@ TEST(EvalBopCsv, BadInputNamesLineAndField) {
   EXPECT_THROW(write_bop_results_csv(out, {a, b}), InputError);
   EXPECT_FALSE(fs::exists(out));
   EXPECT_FALSE(fs::exists(out + ".tmp"));
+}
+
+// What the toolkit's check accepts: times of one image within 1 ms, and
+// unknown times (negative) beside known ones; R rounded to 6 decimals.
+TEST(EvalBopCsv, AcceptsWhatTheToolkitAccepts) {
+  const std::string path = temp_path("lenient.csv");
+  write_text(path,
+             "1,2,3,0.9,0.707107 -0.707107 0 0.707107 0.707107 0 0 0 1,10 20 30,0.5\n"
+             "1,2,4,0.9,1 0 0 0 1 0 0 0 1,10 20 30,0.5004\n"
+             "1,2,5,0.9,1 0 0 0 1 0 0 0 1,10 20 30,-1\n");
+  const std::vector<BopResultRow> rows = read_bop_results_csv(path);
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[0].line, 1);
+  EXPECT_EQ(rows[2].line, 3);
+}
+
+TEST(EvalBopCsv, ParsesTheToolkitsFileName) {
+  auto n = parse_bop_results_filename("/some/where/cosypose-pbr_lmo-test.csv");
+  ASSERT_TRUE(n.has_value());
+  EXPECT_EQ(n->method, "cosypose-pbr");
+  EXPECT_EQ(n->dataset, "lmo");
+  EXPECT_EQ(n->split, "test");
+  EXPECT_EQ(n->split_type, "");
+  n = parse_bop_results_filename("m_tless-test-primesense.csv");
+  ASSERT_TRUE(n.has_value());
+  EXPECT_EQ(n->split, "test");
+  EXPECT_EQ(n->split_type, "primesense");
+  for (const char* bad : {"results.csv", "m_lmo.csv", "m_lmo-test.txt", "_lmo-test.csv", "a_b_c-test.csv", "m_-test.csv"})
+    EXPECT_FALSE(parse_bop_results_filename(bad).has_value()) << bad;
 }
 
 TEST(EvalBopCsv, ResultsFileName) {

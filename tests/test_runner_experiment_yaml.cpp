@@ -59,3 +59,19 @@ TEST(ExperimentYaml, ADirectiveAfterContentIsAnInputError) {
 }
 
 }  // namespace
+
+// A path component longer than the OS allows (NAME_MAX) in `generate:`: the
+// filesystem check threw std::filesystem::filesystem_error out of the loader
+// (found by fuzz_experiment_yaml); now the scene config is "not found".
+TEST(ExperimentYaml, APathTooLongForTheOsIsAnInputError) {
+  const std::string long_name(300, 'x');
+  const std::string path = write("too_long.yaml", "object: ls5\nscenes:\n  - generate: configs/" + long_name +
+                                                      ".yaml\ndescriptors: [fpfh]\n");
+  try {
+    pb::load_experiment(path);
+    ADD_FAILURE() << "no error";
+  } catch (const pb::InputError& e) {
+    EXPECT_EQ(e.file(), path);
+    EXPECT_NE(std::string(e.what()).find("scene config not found"), std::string::npos) << e.what();
+  }
+}

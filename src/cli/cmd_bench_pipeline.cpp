@@ -66,7 +66,7 @@ static pb::cli::Command bench_cmd(
       app.add_option("--scenes", opt.scenes_dir, "where generated scene sets go")->capture_default_str();
       app.add_option("--table-budget-ms", table_ms, "budget per table frame")->capture_default_str();
       app.add_option("--warehouse-budget-ms", warehouse_ms, "budget per warehouse frame")->capture_default_str();
-      app.add_flag("--quiet,-q", opt.quiet, "no progress output");
+      pb::cli::add_log_flags(app, &opt.quiet);
       PB_CLI_PARSE(app, argc, argv);
 
       setenv("OMP_NUM_THREADS", std::to_string(threads).c_str(), 1);  // the worker inherits it

@@ -17,12 +17,16 @@ static pb::cli::Command cmd(
       std::string dataset, out, split = "test";
       int scene = -1, image = -1;
       bool metres = false;
+      std::string encoding = "binary";
       app.add_option("--dataset", dataset, "dataset root (with models/ and test/)")->required();
       app.add_option("--scene", scene, "scene id")->required();
       app.add_option("--image", image, "image id")->required();
       app.add_option("--split", split, "split folder")->capture_default_str();
       app.add_option("--out", out, "output .pcd file")->required();
       app.add_flag("--metres", metres, "write coordinates in metres instead of millimetres");
+      app.add_option("--encoding", encoding, "PCD data: binary, binary_compressed or ascii")
+          ->check(CLI::IsMember({"binary", "binary_compressed", "ascii"}))
+          ->capture_default_str();
       PB_CLI_PARSE(app, argc, argv);
 
       const pb::BopDataset ds(dataset);
@@ -36,7 +40,10 @@ static pb::cli::Command cmd(
                              "no image " + std::to_string(image) + " in scene " + std::to_string(scene));
       const pb::DepthImage depth = ds.load_depth(split, scene, it->second);
       const pb::OrganizedCloud cloud = pb::OrganizedCloud::from_depth(depth, it->second.K);
-      pb::write_organized_pcd(out, cloud, metres ? 0.001 : 1.0);
+      pb::write_organized_pcd(out, cloud, metres ? 0.001 : 1.0,
+                              encoding == "ascii"    ? pb::PcdEncoding::ascii
+                              : encoding == "binary" ? pb::PcdEncoding::binary
+                                                     : pb::PcdEncoding::binary_compressed);
       std::printf("wrote %s: %d x %d organized, %zu valid points (%s)\n", out.c_str(), cloud.width, cloud.height,
                   cloud.valid_count(), metres ? "m" : "mm");
       return 0;

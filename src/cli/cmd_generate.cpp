@@ -1,5 +1,7 @@
 // posebench generate CONFIG.yaml [--out DIR]: a table or warehouse scene set
 // with ground truth in the BOP layout (scenes/generator.h).
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
@@ -9,11 +11,18 @@
 
 #include "cli/command.h"
 #include "core/error.h"
+#include "core/log.h"
 #include "scenes/generator.h"
 
 namespace {
 
+// A bar on a terminal; elsewhere a debug log line per image.
 void print_progress(int done, int total) {
+  static const bool tty = isatty(2);
+  if (!tty) {
+    pb::log_event(pb::LogLevel::debug, "image_generated", {{"image", done}, {"of", total}});
+    return;
+  }
   std::fprintf(stderr, "\rgenerate: image %d / %d", done, total);
   if (done == total) std::fprintf(stderr, "\n");
 }
@@ -46,7 +55,7 @@ int generate_main(int argc, char** argv) {
   app.add_option("--out", out, "output folder (default: scenes/NAME, NAME = the config file's stem)");
   app.add_option("--images", images, "override the config's number of images");
   app.add_option("--seed", seed, "override the config's seed");
-  app.add_flag("--quiet", quiet, "no progress on stderr");
+  pb::cli::add_log_flags(app, &quiet);
   app.add_option("--threads", threads, "worker threads (0 = one per core); the output is the same for any number");
   PB_CLI_PARSE(app, argc, argv);
 

@@ -17,6 +17,7 @@ static pb::cli::Command merge_cmd(
       app.add_option("dir", dir, "results folder of the sharded run")->required();
       app.add_option("from", from, "more results folders of the same experiment to merge in");
       app.add_flag("--require-complete", require_complete, "exit 1 when trials are missing after the merge");
+      pb::cli::add_log_flags(app);
       PB_CLI_PARSE(app, argc, argv);
       const pb::MergeReport rep = pb::merge_results(dir, from);
       for (const auto& s : rep.sources) std::cout << "  " << s.records << " records from " << s.file << "\n";

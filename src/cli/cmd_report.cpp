@@ -5,13 +5,17 @@
 #include <tuple>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <iostream>
 #include <sstream>
 
 #include "cli/command.h"
 #include "core/error.h"
+#include "core/log.h"
 #include "io/png.h"
 #include "eval/bop_csv.h"
+#include "report/gallery.h"
+#include "report/html.h"
 #include "report/report.h"
 #include "runner/store.h"
 
@@ -115,16 +119,34 @@ static int write_plots(const pb::Report& rep, const std::string& dir) {
   const std::string script = find_plot_script();
   if (script.empty()) throw pb::InputError("scripts/plot.py", "", "plot script not found");
   if (rep.plots.empty()) {
-    std::cerr << "posebench report: nothing to plot (no swept variable)\n";
+    pb::log_event(pb::LogLevel::info, "no_plot", {{"why", "no swept variable"}});
     return 0;
   }
   const std::string py = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   const std::string cmd = py + " '" + script + "' '" + data + "' '" + (fs::path(dir) / "plots").string() + "'";
   if (std::system(cmd.c_str()) != 0) {
-    std::cerr << "posebench report: plotting failed (python3-matplotlib missing?)\n";
+    pb::log_event(pb::LogLevel::error, "plot_failed", {{"script", script}, {"hint", "python3-matplotlib missing?"}});
     return 1;
   }
   return 0;
+}
+
+// DIR/report.html: the tables, the plots in DIR/plots/ (if any) and the
+// gallery, in one self-contained page.
+static void write_html(const pb::Report& rep, const std::vector<pb::TrialRecord>& records, const std::string& dir) {
+  auto gallery = pb::select_gallery(records);
+  pb::draw_gallery(gallery);
+  std::vector<pb::HtmlPlot> plots;
+  std::error_code ec;
+  std::vector<fs::path> pngs;
+  for (const auto& e : fs::directory_iterator(fs::path(dir) / "plots", ec))
+    if (e.path().extension() == ".png") pngs.push_back(e.path());
+  std::sort(pngs.begin(), pngs.end());
+  for (const auto& p : pngs) {
+    std::ifstream in(p, std::ios::binary);
+    plots.push_back({p.stem().string(), std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>())});
+  }
+  pb::atomic_write_text((fs::path(dir) / "report.html").string(), pb::to_html(rep, gallery, plots));
 }
 
 static pb::cli::Command report_cmd("report", "tables (md, csv, tex) and plots from a results folder", [](int argc, char** argv) {
@@ -136,6 +158,10 @@ static pb::cli::Command report_cmd("report", "tables (md, csv, tex) and plots fr
   app.add_option("results", dir, "results folder of `posebench run`")->required();
   app.add_option("--format", formats, "comma-separated: md, csv, tex");
   app.add_flag("--plots", plots, "also write PNG plots");
+  pb::cli::add_log_flags(app);
+  bool html = false;
+  app.add_flag("--html", html, "also write REPORT.html: one self-contained page (tables with intervals, the plots "
+                               "of --plots, a gallery of each method's worst failures and some successes)");
   app.add_option("--reference", opt.reference_file, "thesis reference values (YAML)");
   app.add_option("--table", opt.reference_table, "thesis table id to compare with (e.g. 4.1)");
   app.add_option("--plot-x", opt.plot_x, "grid path or added_noise_mm to plot against");
@@ -149,5 +175,7 @@ static pb::cli::Command report_cmd("report", "tables (md, csv, tex) and plots fr
   const pb::Report rep = pb::build_report(exp, records, opt);
   write_tables(rep, dir, formats);
   write_bop_csvs(records, dir);
-  return plots ? write_plots(rep, dir) : 0;
+  const int rc = plots ? write_plots(rep, dir) : 0;
+  if (html) write_html(rep, records, dir);
+  return rc;
 });

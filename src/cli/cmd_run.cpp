@@ -16,7 +16,7 @@ static pb::cli::Command run_cmd("run", "run an experiment (YAML): trials in para
   app.add_option("--jobs,-j", opt.jobs, "parallel worker processes")->check(CLI::PositiveNumber);
   app.add_option("--cache", opt.cache_dir, "training cache folder ('' = none)");
   app.add_option("--scenes", opt.scenes_dir, "where generated scene sets go");
-  app.add_flag("--quiet,-q", opt.quiet, "no progress output");
+  pb::cli::add_log_flags(app, &opt.quiet);
   app.add_option("--memory-limit-mb", opt.memory_limit_mb,
                  "memory cap per trial (the worker's address space, RLIMIT_AS, in MB); a trial over it is "
                  "recorded with status out_of_memory and the sweep goes on")

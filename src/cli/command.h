@@ -28,6 +28,11 @@ struct CommandEntry {
 };
 std::vector<CommandEntry>& commands();
 
+// -v / --verbose (debug: a line per trial) and -q / --quiet (warnings
+// only; also sets *quiet, e.g. a command's "no progress bar") for the log
+// (core/log.h); applied when parsing succeeds.
+void add_log_flags(CLI::App& app, bool* quiet = nullptr);
+
 // Parses with CLI11. Returns -1 to go on, otherwise the exit code to return:
 // 0 after --help (printed), 2 after a usage error (message printed).
 inline int parse(CLI::App& app, int argc, char** argv) {

@@ -7,10 +7,13 @@
 #include <algorithm>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
+#include <memory>
 #include <iostream>
 
 #include "cli/command.h"
 #include "core/error.h"
+#include "core/log.h"
 
 namespace pb::cli {
 
@@ -25,6 +28,16 @@ std::string self_path() {
   if (n <= 0) return "posebench";
   buf[n] = '\0';
   return buf;
+}
+
+void add_log_flags(CLI::App& app, bool* quiet) {
+  auto verbose = std::make_shared<bool>(false), q = std::make_shared<bool>(false);
+  app.add_flag("-v,--verbose", *verbose, "log more: a line per finished trial");
+  app.add_flag("-q,--quiet", *q, "log warnings and errors only (no progress)");
+  app.parse_complete_callback([verbose, q, quiet] {
+    if (quiet) *quiet = *q;
+    pb::set_log_level(*q ? pb::LogLevel::warn : *verbose ? pb::LogLevel::debug : pb::LogLevel::info);
+  });
 }
 
 Command::Command(std::string name, std::string summary, CommandFn fn) {
@@ -59,6 +72,11 @@ int main(int argc, char** argv) {
       return pb::kExitInputError;
     } catch (const CLI::ParseError& e) {
       std::cerr << "posebench " << name << ": error: " << e.what() << "\n";
+      return pb::kExitInputError;
+    } catch (const std::filesystem::filesystem_error& e) {
+      // A path the OS refuses (a name too long, a component that is a file,
+      // no permission): the user's input, named by the error itself.
+      std::cerr << "posebench " << name << ": error: " << e.path1().string() << ": " << e.code().message() << "\n";
       return pb::kExitInputError;
     } catch (const std::exception& e) {
       std::cerr << "posebench " << name << ": internal error: " << e.what() << "\n";

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "io/validate.h"
 
 namespace pb {
 
@@ -50,6 +51,18 @@ int parse_int(const std::string& text, const std::string& path, const std::strin
     throw InputError(path, field, "'" + s + "' is not an integer");
   }
   return v;
+}
+
+// The pieces of `s` between the separators (n separators: n + 1 pieces).
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  for (;;) {
+    const size_t at = s.find(sep, start);
+    out.push_back(s.substr(start, at == std::string::npos ? std::string::npos : at - start));
+    if (at == std::string::npos) return out;
+    start = at + 1;
+  }
 }
 
 std::vector<double> parse_list(const std::string& text, size_t n, const std::string& path,
@@ -124,14 +137,7 @@ std::vector<BopResultRow> read_bop_results_csv(const std::string& path) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line_no == 1 && line.find(kHeader) != std::string::npos) continue;
     if (trim(line).empty()) continue;
-    std::vector<std::string> cols;
-    size_t start = 0;
-    for (;;) {
-      const size_t comma = line.find(',', start);
-      cols.push_back(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
-      if (comma == std::string::npos) break;
-      start = comma + 1;
-    }
+    const std::vector<std::string> cols = split(line, ',');
     const std::string L = "line " + std::to_string(line_no);
     if (cols.size() != 7) {
       throw InputError(path, L,
@@ -150,13 +156,21 @@ std::vector<BopResultRow> read_bop_results_csv(const std::string& path) {
       r.T_cam_model.t(a) = t[a];
     }
     r.time_s = parse_double(cols[6], path, L + " time");
-    auto [it, inserted] = times.emplace(std::make_pair(r.scene_id, r.im_id), std::make_pair(r.time_s, line_no));
-    if (!inserted && it->second.first != r.time_s) {
-      throw InputError(path, L + " time",
-                       "scene " + std::to_string(r.scene_id) + " image " + std::to_string(r.im_id) +
-                           " has time " + fmt(r.time_s) + " here but " + fmt(it->second.first) +
-                           " on line " + std::to_string(it->second.second) +
-                           "; BOP needs one time per image");
+    r.line = line_no;
+    if (r.scene_id < 0 || r.im_id < 0 || r.obj_id < 0) {
+      throw InputError(path, L + (r.scene_id < 0 ? " scene_id" : r.im_id < 0 ? " im_id" : " obj_id"),
+                       "ids are >= 0");
+    }
+    validate_rotation(r.T_cam_model.R, kResultRotationTolerance, path, L + " R");
+    if (r.time_s >= 0) {  // the toolkit: negative = unknown, and times within 1 ms are one time
+      auto [it, inserted] = times.emplace(std::make_pair(r.scene_id, r.im_id), std::make_pair(r.time_s, line_no));
+      if (!inserted && std::abs(it->second.first - r.time_s) > 1e-3) {
+        throw InputError(path, L + " time",
+                         "scene " + std::to_string(r.scene_id) + " image " + std::to_string(r.im_id) +
+                             " has time " + fmt(r.time_s) + " here but " + fmt(it->second.first) +
+                             " on line " + std::to_string(it->second.second) +
+                             "; BOP needs one time per image");
+      }
     }
     rows.push_back(r);
   }
@@ -182,6 +196,24 @@ std::string bop_results_filename(const std::string& method, const std::string& d
   check(dataset, "dataset");
   check(split, "split");
   return m + "_" + dataset + "-" + split + ".csv";
+}
+
+std::optional<BopResultsName> parse_bop_results_filename(const std::string& path) {
+  std::string name = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
+  if (name.size() < 5 || name.compare(name.size() - 4, 4, ".csv") != 0) return std::nullopt;
+  name.resize(name.size() - 4);
+  const size_t us = name.find('_');
+  if (us == std::string::npos || us == 0) return std::nullopt;
+  BopResultsName n;
+  n.method = name.substr(0, us);
+  const std::string rest = name.substr(us + 1);
+  if (rest.find('_') != std::string::npos) return std::nullopt;
+  const std::vector<std::string> parts = split(rest, '-');  // DATASET-SPLIT[-TYPE...]
+  if (parts.size() < 2 || parts[0].empty() || parts[1].empty()) return std::nullopt;
+  n.dataset = parts[0];
+  n.split = parts[1];
+  for (size_t i = 2; i < parts.size(); ++i) n.split_type += (i > 2 ? "_" : "") + parts[i];
+  return n;
 }
 
 }  // namespace pb

@@ -319,6 +319,7 @@ BopImageErrors bop_image_errors(const BopImageInput& in, const std::map<int, Bop
       ee.obj_id = obj_id;
       ee.score = est.score;
       ee.diameter = model.diameter;
+      ee.source = ei;
       DepthImage est_render;
       bool est_rendered = false;
       for (size_t g = 0; g < n_gt; ++g) {

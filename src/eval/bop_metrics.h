@@ -137,6 +137,7 @@ struct BopEstimateErrors {
   double score = 0;               // confidence: higher is matched first
   double diameter = 0;            // the object's diameter (mm), normalizes MSSD
   std::vector<BopPairErrors> pairs;  // one per GT of obj_id in the image
+  int source = -1;                // bop_image_errors: index into BopImageInput::estimates
 };
 
 struct BopTarget {
@@ -157,6 +158,10 @@ struct BopScoreOptions {
   std::vector<double> vsd_thresholds = bop19_vsd_thresholds();    // on the VSD error
   std::vector<double> mssd_thresholds = bop19_mssd_thresholds();  // on MSSD / diameter
   std::vector<double> mspd_thresholds = bop19_mspd_thresholds();  // on MSPD * 640 / width
+  // Taus every pair's VSD errors have; -1 = whatever the pairs have (none:
+  // VSD is not scored, ar_vsd NaN). Given, targets without any estimate
+  // still count for VSD (recall 0), as when VSD was computed but nothing was found.
+  int vsd_tau_count = -1;
 };
 
 struct BopScores {

@@ -50,7 +50,7 @@ double mean(const std::vector<double>& v) {
 }
 
 // Checks the pairs (GT index, object, diameter) and returns the number of
-// VSD taus, the same for all pairs (0 without pairs).
+// VSD taus, the same for all pairs (-1 without any pair).
 int validated_tau_count(const std::vector<BopImageErrors>& images) {
   int n_tau = -1;
   for (const BopImageErrors& im : images) {
@@ -78,14 +78,21 @@ int validated_tau_count(const std::vector<BopImageErrors>& images) {
       }
     }
   }
-  if (n_tau < 0) n_tau = 0;
-  return n_tau;
+  return n_tau;  // -1: no pair at all
 }
 
 }  // namespace
 
 BopScores bop_scores(const std::vector<BopImageErrors>& images, const BopScoreOptions& opt) {
-  const int n_tau = validated_tau_count(images);
+  int n_tau = validated_tau_count(images);
+  if (opt.vsd_tau_count >= 0) {
+    if (n_tau >= 0 && n_tau != opt.vsd_tau_count) {
+      throw std::invalid_argument("bop_scores: VSD errors with " + std::to_string(n_tau) + " taus, expected " +
+                                  std::to_string(opt.vsd_tau_count));
+    }
+    n_tau = opt.vsd_tau_count;
+  }
+  if (n_tau < 0) n_tau = 0;
 
   BopScores s;
   std::vector<std::vector<long>> tp_vsd(n_tau, std::vector<long>(opt.vsd_thresholds.size(), 0));

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "io/le_scalar.h"
 
 namespace pb {
 
@@ -39,8 +40,8 @@ int type_size(const std::string& t, bool* is_float) {
 // The body reader: ascii tokens or binary values in either byte order.
 class Body {
  public:
-  Body(const std::string& path, const std::string& bytes, size_t pos, int format)
-      : path_(path), b_(bytes), pos_(pos), format_(format) {}
+  Body(const std::string& path, const std::string& field, const std::string& bytes, size_t pos, int format)
+      : path_(path), field_(field), b_(bytes), pos_(pos), format_(format) {}
   // One value as a double (integers exactly up to 2^53).
   double value(int size, bool is_float) {
     if (format_ == 0) return token();
@@ -51,24 +52,10 @@ class Body {
     pos_ += static_cast<size_t>(size);
     if (format_ == 2)
       for (int i = 0; i < size / 2; ++i) std::swap(raw[i], raw[size - 1 - i]);
-    if (is_float) {
-      if (size == 4) {
-        float f;
-        std::memcpy(&f, raw, 4);
-        return f;
-      }
-      double d;
-      std::memcpy(&d, raw, 8);
-      return d;
-    }
-    uint64_t u = 0;
-    std::memcpy(&u, raw, static_cast<size_t>(size));
-    const int bits = 8 * size;
-    if (bits < 64 && (u >> (bits - 1)) & 1u && signed_) u |= ~uint64_t{0} << bits;  // sign-extend
-    return signed_ ? static_cast<double>(static_cast<int64_t>(u)) : static_cast<double>(u);
+    return decode_scalar_le(raw, size, is_float, signed_);
   }
   void set_signed(bool s) { signed_ = s; }
-  [[noreturn]] void fail(const std::string& why) const { throw InputError(path_, "mesh", "broken PLY: " + why); }
+  [[noreturn]] void fail(const std::string& why) const { throw InputError(path_, field_, "broken PLY: " + why); }
 
  private:
   double token() {
@@ -83,6 +70,7 @@ class Body {
     return v;
   }
   const std::string& path_;
+  const std::string& field_;
   const std::string& b_;
   size_t pos_;
   int format_;  // 0 ascii, 1 binary little endian, 2 binary big endian
@@ -99,28 +87,40 @@ bool is_name(const std::string& n) {
   return true;
 }
 
+// What the body walk is given and keeps.
+struct Walk {
+  const std::string& path;
+  const std::string& field;             // named in errors
+  std::vector<Vec3f>* xyz = nullptr;    // when set: the vertices' x, y, z
+};
+
 // Walks the body: every declared value present; face index lists of 3 or
 // more indices, each in [0, vertices). `signs`: per element, per property,
 // whether its (item) type is signed.
-void walk_body(const std::string& path, const std::string& bytes, size_t body, int format,
+void walk_body(const Walk& walk, const std::string& bytes, size_t body, int format,
                const std::vector<Element>& elements, const std::vector<std::vector<bool>>& signs, uint64_t vertices) {
-  const auto fail = [&](const std::string& why) { throw InputError(path, "mesh", "broken PLY: " + why); };
+  const std::string& path = walk.path;
+  const auto fail = [&](const std::string& why) { throw InputError(path, walk.field, "broken PLY: " + why); };
   // Each declared value needs at least one byte: counts the data cannot hold
   // are rejected before anything is read or allocated.
   const uint64_t avail = bytes.size() - body;
   for (const auto& e : elements)
     if (!e.props.empty() && e.count > avail) fail("element '" + e.name + "' declares more values than the file holds");
-  Body r(path, bytes, body, format);
+  Body r(path, walk.field, bytes, body, format);
   for (size_t ei = 0; ei < elements.size(); ++ei) {
     const Element& e = elements[ei];
     if (e.props.empty()) continue;  // holds no data, whatever its count (a loop over 10^10 would hang)
-    for (uint64_t i = 0; i < e.count; ++i)
+    const bool keep = walk.xyz && e.name == "vertex";
+    if (keep) walk.xyz->reserve(static_cast<size_t>(e.count));
+    for (uint64_t i = 0; i < e.count; ++i) {
+      Vec3f xyz = Vec3f::Zero();
       for (size_t pi = 0; pi < e.props.size(); ++pi) {
         const Property& p = e.props[pi];
         const bool indices = e.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index");
         if (p.count_size == 0) {
           r.set_signed(signs[ei][pi]);
-          r.value(p.size, p.is_float);
+          const double v = r.value(p.size, p.is_float);
+          if (keep && p.name.size() == 1 && p.name[0] >= 'x' && p.name[0] <= 'z') xyz[p.name[0] - 'x'] = static_cast<float>(v);
           continue;
         }
         r.set_signed(false);
@@ -137,15 +137,20 @@ void walk_body(const std::string& path, const std::string& bytes, size_t body, i
                  std::to_string(vertices) + " vertices)");
         }
       }
+      if (keep) walk.xyz->push_back(xyz);
+    }
   }
 }
 
 }  // namespace
 
-void check_ply(const std::string& path, const std::string& bytes) {
-  const auto fail = [&](const std::string& why) { throw InputError(path, "mesh", "broken PLY: " + why); };
+namespace {
+
+void read_ply(const Walk& walk, const std::string& bytes) {
+  const std::string& path = walk.path;
+  const auto fail = [&](const std::string& why) { throw InputError(path, walk.field, "broken PLY: " + why); };
   if (!(bytes.compare(0, 4, "ply\n") == 0 || bytes.compare(0, 5, "ply\r\n") == 0))
-    throw InputError(path, "mesh", "not a PLY file (the first line is not 'ply')");
+    throw InputError(path, walk.field, "not a PLY file (the first line is not 'ply')");
   // The header ends at a line that is exactly "end_header" (a comment that
   // merely contains the word does not end it: assimp reads on, found by
   // fuzzing).
@@ -163,7 +168,7 @@ void check_ply(const std::string& path, const std::string& bytes) {
     pos = nl + 1;
   }
   if (body == std::string::npos)
-    throw InputError(path, "mesh", "truncated PLY: the header has no 'end_header' line");
+    throw InputError(path, walk.field, "truncated PLY: the header has no 'end_header' line");
   if (body > bytes.size()) body = bytes.size();
   // The header is text lines: no control bytes, CR only before LF (assimp
   // misread a property name holding NUL bytes, and a CR inside a line, and
@@ -243,7 +248,17 @@ void check_ply(const std::string& path, const std::string& bytes) {
     for (const auto& p : vertex->props) found = found || (p.name == axis && p.count_size == 0);
     if (!found) fail(std::string("the vertex element has no scalar property '") + axis + "'");
   }
-  walk_body(path, bytes, body, format, elements, signs, vertices);
+  walk_body(walk, bytes, body, format, elements, signs, vertices);
+}
+
+}  // namespace
+
+void check_ply(const std::string& path, const std::string& bytes) { read_ply(Walk{path, "mesh"}, bytes); }
+
+std::vector<Vec3f> read_ply_vertices(const std::string& path, const std::string& bytes, const std::string& field) {
+  std::vector<Vec3f> xyz;
+  read_ply(Walk{path, field, &xyz}, bytes);
+  return xyz;
 }
 
 }  // namespace pb

@@ -7,6 +7,9 @@
 #pragma once
 
 #include <string>
+#include <vector>
+
+#include "core/types.h"
 
 namespace pb {
 
@@ -17,5 +20,9 @@ namespace pb {
 // element's vertex_indices / vertex_index list, at least 3 indices, each in
 // [0, vertex count). InputError(path, "mesh", ...) otherwise.
 void check_ply(const std::string& path, const std::string& bytes);
+
+// The same checks, keeping the vertices' x, y and z (a PLY point cloud; faces
+// may be absent). Errors name `field`.
+std::vector<Vec3f> read_ply_vertices(const std::string& path, const std::string& bytes, const std::string& field);
 
 }  // namespace pb

@@ -161,8 +161,8 @@ std::string color_name(int color_type) {
   }
 }
 
-void write_png(const std::string& path, int width, int height, int bit_depth, int color_type, int channels,
-               const unsigned char* data, const std::string& field) {
+std::vector<unsigned char> encode_png(const std::string& path, int width, int height, int bit_depth, int color_type,
+                                      int channels, const unsigned char* data, const std::string& field) {
   if (width <= 0 || height <= 0) throw InputError(path, field, "image has no pixels");
   const size_t rowbytes = static_cast<size_t>(width) * channels * (bit_depth / 8);
   std::vector<png_bytep> rows(height);
@@ -171,6 +171,12 @@ void write_png(const std::string& path, int width, int height, int bit_depth, in
   PngErr err{};
   if (!encode(&out, width, height, bit_depth, color_type, rows.data(), &err))
     throw InputError(path, field, std::string("cannot encode PNG: ") + err.msg);
+  return out;
+}
+
+void write_png(const std::string& path, int width, int height, int bit_depth, int color_type, int channels,
+               const unsigned char* data, const std::string& field) {
+  const auto out = encode_png(path, width, height, bit_depth, color_type, channels, data, field);
   atomic_write_bytes(path, out.data(), out.size());
 }
 
@@ -250,6 +256,13 @@ void write_rgb8_png(const std::string& path, int width, int height, const std::v
   if (rgb.size() != static_cast<size_t>(width) * height * 3)
     throw InputError(path, "image", "pixel count does not match width x height x 3");
   write_png(path, width, height, 8, PNG_COLOR_TYPE_RGB, 3, rgb.data(), "image");
+}
+
+std::string encode_rgb8_png(int width, int height, const std::vector<uint8_t>& rgb) {
+  if (rgb.size() != static_cast<size_t>(width) * height * 3)
+    throw InputError("", "image", "pixel count does not match width x height x 3");
+  const auto out = encode_png("", width, height, 8, PNG_COLOR_TYPE_RGB, 3, rgb.data(), "image");
+  return std::string(out.begin(), out.end());
 }
 
 PngHeader read_png_header(const std::string& path) {

@@ -24,6 +24,8 @@ void write_depth_png(const std::string& path, const DepthImage& depth, double de
 std::vector<uint8_t> read_gray8_png(const std::string& path, int* width, int* height);
 void write_gray8_png(const std::string& path, int width, int height, const std::vector<uint8_t>& px);
 void write_rgb8_png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
+// The same PNG's bytes, in memory (e.g. to embed in an HTML page).
+std::string encode_rgb8_png(int width, int height, const std::vector<uint8_t>& rgb);
 
 // Size and format of a PNG from its header (any PNG); InputError(path,
 // "image", ...) if missing or not a PNG.

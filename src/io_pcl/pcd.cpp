@@ -11,7 +11,7 @@
 
 namespace pb {
 
-void write_organized_pcd(const std::string& path, const OrganizedCloud& cloud, double scale) {
+void write_organized_pcd(const std::string& path, const OrganizedCloud& cloud, double scale, PcdEncoding encoding) {
   if (cloud.width <= 0 || cloud.height <= 0 ||
       cloud.points.size() != static_cast<size_t>(cloud.width) * cloud.height)
     throw InputError(path, "pcd", "organized cloud size does not match width x height");
@@ -33,7 +33,9 @@ void write_organized_pcd(const std::string& path, const OrganizedCloud& cloud, d
   const std::string tmp = path + ".tmp";
   int rc = -1;
   try {
-    rc = pcl::io::savePCDFileBinary(tmp, pc);
+    rc = encoding == PcdEncoding::ascii    ? pcl::io::savePCDFileASCII(tmp, pc)
+         : encoding == PcdEncoding::binary ? pcl::io::savePCDFileBinary(tmp, pc)
+                                           : pcl::io::savePCDFileBinaryCompressed(tmp, pc);
   } catch (const std::exception& e) {
     std::remove(tmp.c_str());
     throw InputError(path, "pcd", std::string("cannot write PCD: ") + e.what());
@@ -48,8 +50,9 @@ void write_organized_pcd(const std::string& path, const OrganizedCloud& cloud, d
   }
 }
 
-void write_organized_pcd(const std::string& path, const DepthImage& depth, const Intrinsics& K, double scale) {
-  write_organized_pcd(path, OrganizedCloud::from_depth(depth, K), scale);
+void write_organized_pcd(const std::string& path, const DepthImage& depth, const Intrinsics& K, double scale,
+                         PcdEncoding encoding) {
+  write_organized_pcd(path, OrganizedCloud::from_depth(depth, K), scale, encoding);
 }
 
 }  // namespace pb

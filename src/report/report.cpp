@@ -127,7 +127,9 @@ double ref_value(const Reference& ref, const std::string& row, const std::string
   return c == b->second.end() ? kNaN : c->second;
 }
 
-std::string fmt(double v, const std::string& measure) {
+}  // namespace
+
+std::string format_measure(double v, const std::string& measure) {
   if (!std::isfinite(v)) return "-";
   char buf[64];
   if (measure.rfind("robustness", 0) == 0)
@@ -140,8 +142,6 @@ std::string fmt(double v, const std::string& measure) {
     std::snprintf(buf, sizeof buf, "%.1f", v);
   return buf;
 }
-
-}  // namespace
 
 namespace {
 
@@ -284,7 +284,8 @@ ReportPlot plot_of(const std::vector<TrialRecord>& records, const Layout& l, con
   ReportPlot p;
   p.name = l.plot_x == "added_noise_mm" ? "robustness_vs_noise" : "robustness_vs_" + l.plot_x;
   std::replace(p.name.begin(), p.name.end(), '.', '_');
-  p.x_label = l.plot_x == "added_noise_mm" ? "added noise sigma (mm)" : l.plot_x;
+  p.x_label = plot_axis_label(l.plot_x);
+  p.title = plot_title(exp.value("name", ""), l.plot_x);
   for (const auto& scene : l.scenes)
     for (const auto& col : l.columns) {
       std::map<double, std::vector<ThesisTrial>> pts;
@@ -296,11 +297,15 @@ ReportPlot plot_of(const std::vector<TrialRecord>& records, const Layout& l, con
       if (pts.empty()) continue;
       ReportSeries s;
       s.label = col + " (" + scene + ")";
+      s.method = col;
+      s.scene = scene;
       for (const auto& [x, trials] : pts) {
         const ThesisAggregate a = thesis_aggregate(trials, thresholds_for(exp, l.scenario_of.at(scene)));
         s.x.push_back(x);
         s.robustness.push_back(a.robustness);
         s.time.push_back(a.time_mean_s);
+        s.correct.push_back(a.correct);
+        s.trials.push_back(a.trials);
       }
       p.series.push_back(s);
     }
@@ -333,7 +338,7 @@ Report build_report(const nlohmann::json& exp, const std::vector<TrialRecord>& r
   return rep;
 }
 
-static std::string measure_label(const std::string& m) {
+std::string measure_label(const std::string& m) {
   if (m == "robustness") return "robustness";
   if (m.rfind("robustness_", 0) == 0) return "robustness, judged by " + m.substr(11);
   if (m == "translation_mm") return "translation error (mm)";
@@ -362,8 +367,8 @@ std::string to_markdown(const Report& r) {
       o << "| " << (row.scenario == last ? "" : row.scenario) << " | " << measure_label(row.measure) << " |";
       last = row.scenario;
       for (const auto& c : row.cells) {
-        o << " " << fmt(c.value, row.measure);
-        if (std::isfinite(c.reference)) o << " (" << fmt(c.reference, row.measure) << ")";
+        o << " " << format_measure(c.value, row.measure);
+        if (std::isfinite(c.reference)) o << " (" << format_measure(c.reference, row.measure) << ")";
         o << " |";
       }
       o << "\n";
@@ -419,32 +424,14 @@ std::string to_latex(const Report& r) {
       if (row.detail) continue;
       o << tex_escape(row.scenario) << " & " << tex_escape(measure_label(row.measure));
       for (const auto& c : row.cells) {
-        o << " & " << tex_escape(fmt(c.value, row.measure));
-        if (std::isfinite(c.reference)) o << " (" << tex_escape(fmt(c.reference, row.measure)) << ")";
+        o << " & " << tex_escape(format_measure(c.value, row.measure));
+        if (std::isfinite(c.reference)) o << " (" << tex_escape(format_measure(c.reference, row.measure)) << ")";
       }
       o << " \\\\\n";
     }
     o << "\\hline\n\\end{tabular}\n\n";
   }
   return o.str();
-}
-
-nlohmann::json plots_json(const Report& r) {
-  nlohmann::json j = nlohmann::json::array();
-  for (const auto& p : r.plots) {
-    nlohmann::json pj = {{"name", p.name}, {"x_label", p.x_label}, {"title", r.experiment}};
-    for (const auto& s : p.series) {
-      auto clean = [](const std::vector<double>& v) {
-        nlohmann::json a = nlohmann::json::array();
-        for (double x : v) a.push_back(std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr));
-        return a;
-      };
-      pj["series"].push_back({{"label", s.label}, {"x", clean(s.x)}, {"robustness", clean(s.robustness)},
-                              {"time", clean(s.time)}});
-    }
-    j.push_back(pj);
-  }
-  return j;
 }
 
 }  // namespace pb

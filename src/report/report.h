@@ -36,11 +36,12 @@ struct ReportTable {
 };
 
 struct ReportSeries {                // one curve: a method on a scene set
-  std::string label;
+  std::string label, method, scene;
   std::vector<double> x, robustness, time;
+  std::vector<int> correct, trials;  // per point: robustness = correct / trials
 };
 struct ReportPlot {
-  std::string name, x_label;         // file stem, axis label
+  std::string name, x_label, title;  // file stem, axis label in words, the figure's name
   std::vector<ReportSeries> series;
 };
 
@@ -63,8 +64,22 @@ Report build_report(const nlohmann::json& experiment, const std::vector<TrialRec
                     const ReportOptions& opt);
 
 std::string to_markdown(const Report& r);
+// A cell's value as the tables show it (robustness in %, errors in mm...;
+// "-" when undefined), and a measure's name in words.
+std::string format_measure(double v, const std::string& measure);
+std::string measure_label(const std::string& measure);
 std::string to_csv(const Report& r);
 std::string to_latex(const Report& r);
+// What scripts/plot.py draws (report/plots.cpp): per plot its name, title,
+// x label and series (label, method, scene, x, robustness, time, correct,
+// trials; null for undefined values).
 nlohmann::json plots_json(const Report& r);
+// The plotted variable in words ("added noise sigma (mm)", "hypotheses
+// refined (global.top_k)", else "setting PATH").
+std::string plot_axis_label(const std::string& plot_x);
+// The plot's title: "Figure 4.6: ..." for a thesis figure's experiment
+// (named fig_4_6, fig_4_11_local...), else the experiment's name, with what
+// is plotted against what.
+std::string plot_title(const std::string& experiment, const std::string& plot_x);
 
 }  // namespace pb

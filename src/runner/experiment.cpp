@@ -12,6 +12,7 @@
 #include "io/symmetry_yaml.h"
 #include "core/random.h"
 #include "io/bop.h"
+#include "io/cloud.h"
 #include "recognition/pipeline.h"
 #include "recognition/registry.h"
 
@@ -49,7 +50,8 @@ static std::string resolve(const std::string& base_file, const std::string& p) {
   if (p.empty() || fs::path(p).is_absolute()) return p;
   // Paths are relative to the current directory when they exist there (the
   // usual case: run from the project root), else to the config's folder.
-  if (fs::exists(p)) return p;
+  std::error_code ec;  // a path the OS rejects (a name too long) is not there, not an exception
+  if (fs::exists(p, ec)) return p;
   return (fs::path(base_file).parent_path() / p).string();
 }
 
@@ -134,17 +136,29 @@ void parse_settings_and_grid(const YamlNode& root, const std::string& path, Expe
 }
 
 SceneSource parse_scene(const YamlNode& s, const std::string& path, std::set<std::string>& names) {
-  s.check_keys({"name", "generate", "dataset", "split", "scene_ids", "images", "targets", "scenario",
-                "generator", "settings", "refinements"});
+  s.check_keys({"name", "generate", "dataset", "clouds", "cloud", "split", "scene_ids", "images", "targets",
+                "scenario", "generator", "settings", "refinements"});
   SceneSource src;
   src.generate = resolve(path, s.get_or<std::string>("generate", ""));
   src.dataset = resolve(path, s.get_or<std::string>("dataset", ""));
-  if (src.generate.empty() == src.dataset.empty())
-    s.fail("give exactly one of 'generate' (a scene config) or 'dataset' (a BOP dataset)");
-  if (!src.generate.empty() && !fs::exists(src.generate))
+  for (const auto& c : s.get_or<std::vector<std::string>>("clouds", {})) src.clouds.push_back(resolve(path, c));
+  if (!src.generate.empty() + !src.dataset.empty() + !src.clouds.empty() != 1)
+    s.fail("give exactly one of 'generate' (a scene config), 'dataset' (a BOP dataset) or 'clouds' (point clouds)");
+  for (size_t i = 0; i < src.clouds.size(); ++i)
+    if (std::error_code ec; !fs::is_regular_file(src.clouds[i], ec)) s["clouds"].fail("cloud " + std::to_string(i) + " not found: " + src.clouds[i]);
+  if (s.has("cloud")) {
+    if (src.clouds.empty()) s["cloud"].fail("only valid with 'clouds'");
+    s["cloud"].check_keys({"units", "intrinsics", "camera"});
+    parse_cloud_units(s["cloud"].get_or<std::string>("units", "auto"), "cloud.units");
+    src.cloud = yaml_to_json(s["cloud"].raw());
+    if (src.cloud.contains("camera")) src.cloud["camera"] = resolve(path, src.cloud["camera"].get<std::string>());
+  }
+  if (std::error_code ec; !src.generate.empty() && !fs::exists(src.generate, ec))
     s["generate"].fail("scene config not found: " + src.generate);
   src.name = s.get_or<std::string>(
-      "name", fs::path(src.generate.empty() ? src.dataset : src.generate).stem().string());
+      "name", fs::path(!src.generate.empty() ? src.generate : !src.dataset.empty() ? src.dataset : src.clouds[0])
+                  .stem()
+                  .string());
   if (!names.insert(src.name).second) s["name"].fail("duplicate scene name '" + src.name + "'");
   src.split = s.get_or<std::string>("split", "test");
   src.scene_ids = s.get_or<std::vector<int>>("scene_ids", {});
@@ -228,8 +242,10 @@ nlohmann::json canonical(const ExperimentConfig& c) {
                                {"scenario", s.scenario}, {"generator", s.generator_overrides},
                                {"refinements", s.refinements},
                                {"settings", s.settings}});
-  for (size_t i = 0; i < c.scenes.size(); ++i)  // only when given: older hashes stay
+  for (size_t i = 0; i < c.scenes.size(); ++i) {  // only when given: older hashes stay
     if (!c.scenes[i].targets.empty()) canon["scenes"][i]["targets"] = c.scenes[i].targets;
+    if (!c.scenes[i].clouds.empty()) canon["scenes"][i]["clouds"] = {c.scenes[i].clouds, c.scenes[i].cloud};
+  }
   canon["report"] = c.report;
   if (!c.judgements.empty()) canon["judgements"] = judgements_json(c.judgements);
   return canon;
@@ -278,7 +294,8 @@ Targets read_targets(const SceneSource& src, const BopDataset& ds, const std::st
   Targets out;
   if (src.targets.empty()) return out;
   out.file = fs::path(src.targets).is_absolute() ? src.targets : (fs::path(src.dataset) / src.targets).string();
-  if (!fs::is_regular_file(out.file)) throw InputError(out.file, "targets", "test-targets file not found");
+  if (std::error_code ec; !fs::is_regular_file(out.file, ec))
+    throw InputError(out.file, "targets", "test-targets file not found");
   const int obj = ds.resolve_object(object);
   const auto targets = read_test_targets(out.file);
   const auto scenes = ds.scene_ids(src.split);

@@ -21,6 +21,12 @@ namespace pb {
 struct SceneSource {
   std::string name;          // label used in tables (e.g. "table_astra")
   std::string generate;      // generator config path ("" when dataset is given)
+  // Point clouds (.pcd, .ply; relative to the config) made into a dataset by
+  // `posebench import-clouds` (scenes/import_clouds.h) before the run, one
+  // image each; `cloud` holds its options: units (auto, mm, m), intrinsics
+  // ("fx,fy,cx,cy[,width,height]") or camera (a camera.json).
+  std::vector<std::string> clouds;
+  nlohmann::json cloud = nlohmann::json::object();
   std::string dataset;       // BOP dataset root (after generation: scenes/<name>...)
   std::string split = "test";
   std::vector<int> scene_ids;  // empty = all scenes of the split

@@ -17,6 +17,18 @@
 
 namespace pb {
 
+#if defined(__SANITIZE_ADDRESS__)
+const bool kMemoryLimitApplies = false;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+const bool kMemoryLimitApplies = false;
+#else
+const bool kMemoryLimitApplies = true;
+#endif
+#else
+const bool kMemoryLimitApplies = true;
+#endif
+
 namespace {
 
 struct Worker {
@@ -39,7 +51,7 @@ Worker spawn_worker(const PoolOptions& opt) {
     // computing a trial whose record nobody will write.
     prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (getppid() != parent) _exit(127);
-    if (opt.memory_limit_mb > 0) {
+    if (opt.memory_limit_mb > 0 && kMemoryLimitApplies) {
       const rlim_t bytes = static_cast<rlim_t>(opt.memory_limit_mb) * 1024 * 1024;
       const rlimit lim{bytes, bytes};
       setrlimit(RLIMIT_AS, &lim);
@@ -188,7 +200,7 @@ class Pool {
     if (ti >= 0) {
       std::string why = WIFSIGNALED(status) ? "worker crashed (signal " + std::to_string(WTERMSIG(status)) + ")"
                                             : "worker exited (code " + std::to_string(WEXITSTATUS(status)) + ")";
-      if (opt_.memory_limit_mb > 0 && WIFSIGNALED(status))
+      if (opt_.memory_limit_mb > 0 && kMemoryLimitApplies && WIFSIGNALED(status))
         why += " under a memory limit of " + std::to_string(opt_.memory_limit_mb) + " MB (an allocation that "
                "failed outside C++ can end a worker this way)";
       finish(w, failed(ti, "error", why + "; see " + opt_.log_path));

@@ -18,6 +18,12 @@ namespace pb {
 // recorded times are not inflated by oversubscription.
 int omp_threads_per_worker(int jobs, int host_cores);
 
+// False in an AddressSanitizer build: ASan reserves terabytes of address
+// space for its shadow memory, so an RLIMIT_AS cap would end every worker at
+// start-up, and its operator new dies instead of throwing bad_alloc. There
+// the memory limit is not applied (the runner says so).
+extern const bool kMemoryLimitApplies;
+
 struct PoolOptions {
   std::string binary;    // the posebench executable
   std::string context;   // the first line every worker reads (trial.h context_json)

@@ -15,6 +15,7 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -22,6 +23,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/log.h"
 #include "core/file_lock.h"
 #include "core/timer.h"
 #include "core/yaml.h"
@@ -59,8 +61,50 @@ static int run_command(const std::vector<std::string>& args, const std::string& 
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
+// A `clouds:` scene set: `posebench import-clouds` into
+// scenes_dir/NAME_HASH (HASH of the clouds' bytes, their options and the
+// object), once.
+static void import_scene_clouds(SceneSource& src, const ExperimentConfig& cfg, const RunOptions& opt) {
+  std::string key = cfg.object + "\n" + src.cloud.dump();
+  for (const auto& c : src.clouds) {
+    std::ifstream in(c, std::ios::binary);
+    key += "\n" + hash_hex(std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+  }
+  const std::string h = hash_hex(key).substr(0, 8);
+  const fs::path dir = fs::path(opt.scenes_dir) / (src.name + "_" + h);
+  src.dataset = dir.string();
+  const auto complete = [&] { return fs::exists(dir / "posebench_clouds.json"); };
+  if (complete()) return;
+  fs::create_directories(opt.scenes_dir);
+  const FileLock lock = FileLock::acquire((fs::path(opt.scenes_dir) / (src.name + "_" + h + ".lock")).string());
+  if (complete()) return;
+  std::vector<std::string> args{opt.binary, "import-clouds", "--out", dir.string(), "--object", cfg.object};
+  for (const char* k : {"units", "intrinsics", "camera"})
+    if (src.cloud.contains(k)) {
+      args.push_back(std::string("--") + k);
+      std::string v;
+      if (src.cloud[k].is_array())  // intrinsics: [fx, fy, cx, cy(, width, height)]
+        for (const auto& x : src.cloud[k]) v += (v.empty() ? "" : ",") + (x.is_string() ? x.get<std::string>() : x.dump());
+      else
+        v = src.cloud[k].is_string() ? src.cloud[k].get<std::string>() : src.cloud[k].dump();
+      args.push_back(v);
+    }
+  args.insert(args.end(), src.clouds.begin(), src.clouds.end());
+  const std::string log = (fs::path(opt.scenes_dir) / (src.name + "_" + h + ".log")).string();
+  log_event(LogLevel::info, "import_clouds", {{"scene", src.name}, {"clouds", src.clouds.size()}, {"dataset", dir.string()}});
+  const int rc = run_command(args, log);
+  if (rc != 0) {
+    std::ifstream in(log);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    throw InputError(cfg.file, "scenes." + src.name + ".clouds",
+                     "importing the clouds failed (exit " + std::to_string(rc) + "): " + ss.str());
+  }
+}
+
 void prepare_scenes(ExperimentConfig& cfg, const RunOptions& opt) {
   for (auto& src : cfg.scenes) {
+    if (!src.clouds.empty()) import_scene_clouds(src, cfg, opt);
     if (src.generate.empty()) continue;
     nlohmann::json gen = yaml_to_json_file(src.generate);
     for (auto it = src.generator_overrides.begin(); it != src.generator_overrides.end(); ++it)
@@ -83,7 +127,7 @@ void prepare_scenes(ExperimentConfig& cfg, const RunOptions& opt) {
     const fs::path cfg_path = fs::path(opt.scenes_dir) / (src.name + "_" + h + ".config.json");
     atomic_write_text(cfg_path.string(), gen.dump(2) + "\n");
     const std::string log = (fs::path(opt.scenes_dir) / (src.name + "_" + h + ".log")).string();
-    if (!opt.quiet) std::cerr << "posebench run: generating scene set '" << src.name << "' into " << dir << "\n";
+    log_event(LogLevel::info, "generate_scenes", {{"scene", src.name}, {"dataset", dir.string()}});
     const int rc = run_command({opt.binary, "generate", cfg_path.string(), "--out", dir.string()}, log);
     if (rc != 0) {
       std::ifstream in(log);
@@ -126,10 +170,10 @@ class Progress {
                     bar.c_str(), sum.ran, to_run_, 100 * frac, fmt_duration(el).c_str(),
                     fmt_duration(eta).c_str(), sum.ok, sum.no_hypothesis, sum.errors, sum.timeouts);
       std::cerr << line << (final ? "\n" : "") << std::flush;
-    } else if (final || last_print_.seconds() > 10) {
-      std::snprintf(line, sizeof line, "posebench run: %zu/%zu trials (%.0f%%), elapsed %s, ETA %s\n", sum.ran,
-                    to_run_, 100 * frac, fmt_duration(el).c_str(), fmt_duration(eta).c_str());
-      std::cerr << line;
+    } else if (final || last_print_.seconds() > 10) {  // not a terminal: a log line every 10 s
+      log_event(LogLevel::info, "progress",
+                {{"ran", sum.ran}, {"of", to_run_}, {"elapsed", fmt_duration(el)}, {"eta", fmt_duration(eta)},
+                 {"ok", sum.ok}, {"no_hypothesis", sum.no_hypothesis}, {"error", sum.errors}, {"timeout", sum.timeouts}});
       last_print_.reset();
     }
   }
@@ -197,9 +241,7 @@ RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
   if (!opt.shard.active() && !ResultStore::shard_record_files(out).empty()) {
     ResultStore::write_trial_list(out, cfg.hash, keys);
     const MergeReport m = merge_results(out);
-    if (!opt.quiet)
-      std::cerr << "posebench run: merged " << m.records << " records of earlier shards into " << out
-                << "/records.jsonl first\n";
+    log_event(LogLevel::info, "merge_shards", {{"records", m.records}, {"into", out + "/records.jsonl"}});
   }
   ResultStore store(out, cfg.canonical, cfg.hash, opt.shard.active() ? opt.shard.name() : "");
   ResultStore::write_trial_list(out, cfg.hash, keys);
@@ -229,9 +271,8 @@ RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
     if (!store.has(keys[u]) && !done_elsewhere.count(keys[u])) pending.push_back(i);
   }
   sum.already_done = sum.total - pending.size();
-  if (!opt.quiet && sum.already_done)
-    std::cerr << "posebench run: resuming: " << sum.already_done << " of " << sum.total
-              << " trials already recorded\n";
+  if (sum.already_done)
+    log_event(LogLevel::info, "resume", {{"recorded", sum.already_done}, {"trials", sum.total}});
   if (!pending.empty()) {
     PoolOptions po;
     po.binary = opt.binary;
@@ -241,10 +282,20 @@ RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
     po.omp_threads = sum.omp_threads;
     po.timeout_s = cfg.timeout_s;
     po.memory_limit_mb = opt.memory_limit_mb;
+    if (opt.memory_limit_mb > 0 && !kMemoryLimitApplies)
+      log_event(LogLevel::warn, "memory_limit_not_applied",
+                {{"why", "AddressSanitizer reserves terabytes of address space: RLIMIT_AS would end every worker"}});
     Progress progress(opt.quiet, pending.size());
     run_in_workers(po, inputs, pending, [&](long, const TrialRecord& rec) {
       store.append(rec);
       count(rec, sum);
+      if (log_enabled(LogLevel::debug)) {
+        nlohmann::ordered_json f = {{"key", rec.key}, {"status", rec.status}};
+        if (rec.correct) f["correct"] = *rec.correct;
+        if (rec.times) f["total_s"] = rec.times->total;
+        if (rec.message) f["message"] = *rec.message;
+        log_event(LogLevel::debug, "trial", f);
+      }
       progress.update(sum, false);
     });
     progress.update(sum, true);
@@ -271,7 +322,7 @@ void inject_fault(const std::string& key) {
     const size_t colon = item.find(':');
     if (colon == std::string::npos || key.find(item.substr(colon + 1)) == std::string::npos) continue;
     const std::string kind = item.substr(0, colon);
-    std::cerr << "posebench worker: injected fault '" << kind << "' on " << key << std::endl;
+    log_event(LogLevel::warn, "injected_fault", {{"fault", kind}, {"key", key}});
     if (kind == "segfault") raise(SIGSEGV);
     if (kind == "abort") std::abort();
     if (kind == "exit") _exit(3);

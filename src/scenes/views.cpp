@@ -4,6 +4,7 @@
 
 #include "core/error.h"
 #include "core/rotation.h"
+#include "io/cloud.h"
 #include "render/renderer.h"
 
 namespace pb {
@@ -82,6 +83,36 @@ TrainingViews training_views(const Mesh& mesh, const ViewSettings& settings, con
   } else {
     t.views = render_training_views(mesh, settings);
   }
+  return t;
+}
+
+Pose cloud_model_pose(const std::vector<Vec3f>& points_cam) {
+  Eigen::AlignedBox3f box;
+  for (const Vec3f& p : points_cam)
+    if (p.allFinite()) box.extend(p);
+  Pose T;
+  if (!box.isEmpty()) T.t = box.center().cast<double>();
+  return T;
+}
+
+TrainingViews cloud_training_views(const std::vector<Vec3f>& points_cam, const std::string& model_name) {
+  TrainingViews t;
+  t.model_name = model_name;
+  PointCloudFile c;
+  c.points = points_cam;
+  c.width = static_cast<int>(points_cam.size());
+  size_t in_front = 0;
+  for (const Vec3f& p : points_cam) in_front += p.allFinite() && p.z() > 0;
+  if (in_front < 3) {
+    t.empty_reason = "model '" + model_name + "': fewer than 3 points in front of the camera (z > 0)";
+    return t;
+  }
+  TrainingView v;
+  v.K = virtual_camera(c, model_name);
+  v.T_cam_model = cloud_model_pose(points_cam);
+  v.depth = project_cloud(c, v.K);
+  v.cloud = OrganizedCloud::from_depth(v.depth, v.K);
+  t.views.push_back(std::move(v));
   return t;
 }
 

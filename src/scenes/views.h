@@ -22,4 +22,15 @@ std::vector<TrainingView> render_training_views(const Mesh& mesh, const ViewSett
 // none with the reason when the mesh is empty or degenerate.
 TrainingViews training_views(const Mesh& mesh, const ViewSettings& settings, const std::string& model_name);
 
+// A model given as a point cloud (mm) instead of a mesh: a scan of the
+// object from one side, in the frame of the camera that saw it (as PCL's
+// tutorial models are). Its model frame: the camera's axes, the origin at
+// the centre of the points' bounding box (as BOP places a model's origin).
+Pose cloud_model_pose(const std::vector<Vec3f>& points_cam);  // T_cam_model of that one view
+// Its one training view: the points as that camera saw them, through a
+// virtual 640 x 480 camera fitted to their extent (io/cloud.h), so that
+// nearly every point keeps a pixel of its own. None, with the reason, when
+// no point lies in front of the camera.
+TrainingViews cloud_training_views(const std::vector<Vec3f>& points_cam, const std::string& model_name);
+
 }  // namespace pb

@@ -1,0 +1,96 @@
+// posebench score: our own run's BOP CSV scores as the report scored the
+// run, and a malformed results file is exit 2 naming the line and the field.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "cli_test_util.h"
+#include "test_cli_run_scene.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The report.csv value of `measure` (the one method's cell).
+double report_value(const std::string& report_csv, const std::string& measure) {
+  std::ifstream in(report_csv);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::vector<std::string> c;
+    std::stringstream ss(line);
+    std::string f;
+    while (std::getline(ss, f, ',')) c.push_back(f);
+    if (c.size() >= 6 && c[3] == measure) return std::stod(c[5]);
+  }
+  ADD_FAILURE() << "no " << measure << " in " << report_csv;
+  return -1;
+}
+
+}  // namespace
+
+TEST(CliScore, OurOwnCsvScoresAsTheReportDid) {
+  pbcli::TempDir tmp;
+  auto r = pbcli::run_small_experiment(tmp.path, "scoretest", "[cvfh]");
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = pbcli::run("report res --format csv", tmp.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+
+  // The targets: each record's image and object, as the report counts them.
+  nlohmann::json targets = nlohmann::json::array();
+  std::string dataset, split;
+  std::ifstream in(tmp.path + "/res/records.jsonl");
+  std::string line;
+  while (std::getline(in, line)) {
+    const auto j = nlohmann::json::parse(line);
+    dataset = j["dataset"];
+    split = j["split"];
+    targets.push_back({{"scene_id", j["scene_id"]}, {"im_id", j["im_id"]}, {"obj_id", j["obj_id"]}, {"inst_count", 1}});
+  }
+  ASSERT_EQ(targets.size(), 3u);
+  pbcli::write_file(tmp.path + "/targets.json", targets.dump());
+  std::vector<std::string> csvs;
+  for (const auto& e : fs::directory_iterator(tmp.path + "/res/bop")) csvs.push_back(e.path().string());
+  ASSERT_EQ(csvs.size(), 1u);
+
+  r = pbcli::run("score '" + csvs[0] + "' --dataset '" + dataset + "' --targets targets.json --out sc", tmp.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("| all | 3 |"), std::string::npos) << r.out;
+  const auto sc = nlohmann::json::parse(pbcli::slurp(tmp.path + "/sc/scores.json"));
+  EXPECT_EQ(sc["split"], split);
+  EXPECT_EQ(sc["targets_count"], 3);
+  const std::string rep = tmp.path + "/res/report.csv";
+  EXPECT_NEAR(sc["bop19_average_recall"].get<double>(), report_value(rep, "bop_ar"), 1e-5);
+  EXPECT_NEAR(sc["bop19_average_recall_mssd"].get<double>(), report_value(rep, "bop_ar_mssd"), 1e-5);
+  EXPECT_NEAR(sc["bop19_average_recall_mspd"].get<double>(), report_value(rep, "bop_ar_mspd"), 1e-5);
+  EXPECT_NEAR(sc["bop19_average_recall_vsd"].get<double>(), report_value(rep, "bop_ar_vsd"), 1e-5);
+  // Each scored estimate's MSSD is the one its record holds.
+  std::set<double> recorded, scored;
+  std::ifstream in2(tmp.path + "/res/records.jsonl");
+  while (std::getline(in2, line)) {
+    const auto j = nlohmann::json::parse(line);
+    if (j.contains("bop")) recorded.insert(j["bop"]["mssd_mm"].get<double>());
+  }
+  for (const auto& e : sc["errors"]) scored.insert(e["gts"][0]["mssd_mm"].get<double>());
+  EXPECT_FALSE(scored.empty());
+  EXPECT_EQ(scored, recorded);
+
+  // A row whose R is not a rotation: exit 2 naming the file, line and field.
+  std::string text = pbcli::slurp(csvs[0]);
+  const std::string bad_line = "line " + std::to_string(std::count(text.begin(), text.end(), '\n') + 1) + " R";
+  text += "1,0,1,0.5,1 0 0 0 1 0 0 0 -1,0 0 500,-1\n";
+  const std::string bad = tmp.path + "/bad_tablesmall-test.csv";
+  pbcli::write_file(bad, text);
+  r = pbcli::run("score '" + bad + "' --dataset '" + dataset + "'", tmp.path);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find(bad), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(bad_line), std::string::npos) << r.err;
+  // A file name without METHOD_DATASET-SPLIT and no --split.
+  pbcli::write_file(tmp.path + "/results.csv", pbcli::slurp(csvs[0]));
+  r = pbcli::run("score results.csv --dataset '" + dataset + "'", tmp.path);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("file name"), std::string::npos) << r.err;
+}
