@@ -6,11 +6,13 @@ set(_pbfuzz_libs_fuzz_training_cache pb_recognition)
 set(_pbfuzz_libs_fuzz_records_jsonl pb_eval pb_io)  # with runner/store.cpp itself: PCL-free
 set(_pbfuzz_libs_fuzz_scene_yaml pb_scenes)
 set(_pbfuzz_libs_fuzz_models_yaml pb_models)
+set(_pbfuzz_libs_fuzz_bop_results_csv pb_eval)
 set(_pbfuzz_stage_fuzz_experiment_yaml runner)
 set(_pbfuzz_stage_fuzz_records_jsonl runner)
 set(_pbfuzz_stage_fuzz_training_cache recognition)
 set(_pbfuzz_stage_fuzz_scene_yaml scenes)
 set(_pbfuzz_stage_fuzz_models_yaml models)
+set(_pbfuzz_stage_fuzz_bop_results_csv eval)
 file(GLOB POSEBENCH_FUZZ_SOURCES CONFIGURE_DEPENDS ${CMAKE_CURRENT_LIST_DIR}/fuzz_*.cpp)
 
 # posebench_fuzz_executable(TARGET NAME SOURCES...): TARGET built from

@@ -72,6 +72,7 @@ seed fuzz_models_yaml models/models.yaml
 seed fuzz_bop_camera "$SEEDS/ds/camera.json"
 seed fuzz_bop_models_info "$SEEDS/ds/models/models_info.json"
 seed fuzz_bop_test_targets fuzz/seeds/test_targets_bop19.json
+seed fuzz_bop_results_csv fuzz/seeds/results_bop19.csv 1
 seed fuzz_bop_scene "$scene/scene_camera.json" 0
 seed fuzz_bop_scene "$scene/scene_gt.json" 1
 seed fuzz_bop_scene "$scene/scene_gt_info.json" 2
