@@ -13,7 +13,9 @@ page="$(realpath "$1")" || exit 2
 [ -f "$page" ] || { echo "html_screenshot.sh: no file $1" >&2; exit 2; }
 command -v chromium >/dev/null || { echo "html_screenshot.sh: chromium not installed (apt install chromium)" >&2; exit 2; }
 size="${3:-1280,1600}"
-flags=(--headless --no-sandbox --disable-gpu --hide-scrollbars --user-data-dir="$(mktemp -d)")
+profile="$(mktemp -d)"  # a throw-away browser profile
+trap 'rm -rf "$profile"' EXIT
+flags=(--headless --no-sandbox --disable-gpu --hide-scrollbars --user-data-dir="$profile")
 status="$(chromium "${flags[@]}" --dump-dom "file://$page" 2>/dev/null | grep -o 'images loaded: [0-9]* of [0-9]*' || true)"
 chromium "${flags[@]}" --window-size="$size" --screenshot="$2" "file://$page" >/dev/null 2>&1
 [ -s "$2" ] || { echo "html_screenshot.sh: no screenshot written" >&2; exit 1; }
