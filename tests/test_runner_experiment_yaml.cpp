@@ -75,3 +75,23 @@ TEST(ExperimentYaml, APathTooLongForTheOsIsAnInputError) {
     EXPECT_NE(std::string(e.what()).find("scene config not found"), std::string::npos) << e.what();
   }
 }
+
+// Control characters YAML does not allow in a stream: yaml-cpp turned a NUL
+// byte in a name into bytes that are not UTF-8, and the experiment's JSON
+// dump threw (found by fuzz_experiment_yaml). Tabs, CR and NEL stay allowed.
+TEST(ExperimentYaml, ControlCharactersAreAnInputErrorNamingLineAndByte) {
+  for (const std::string bad : {std::string("a\0b", 3), std::string("a\x08"), std::string("a\x7f"),
+                                std::string("a\xc2\x80"), std::string("a\xef\xbf\xbf")}) {
+    const std::string path = write("control.yaml", experiment(bad));
+    try {
+      pb::load_experiment(path);
+      ADD_FAILURE() << "no error";
+    } catch (const pb::InputError& e) {
+      EXPECT_EQ(e.file(), path);
+      EXPECT_NE(std::string(e.what()).find("control character"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("line 3"), std::string::npos) << e.what();
+    }
+  }
+  const std::string ok = write("tab.yaml", "# a\tcomment\r\n" + experiment("n\xc2\x85x"));
+  EXPECT_NO_THROW(pb::YamlNode::load_file(ok));
+}
