@@ -9,8 +9,8 @@ const char* kFiles[3] = {"scene_camera.json", "scene_gt.json", "scene_gt_info.js
 const char* kValid[3] = {
     R"({"0": {"cam_K": [500, 0, 320, 0, 500, 240, 0, 0, 1], "depth_scale": 1.0}})",
     R"({"0": [{"obj_id": 1, "cam_R_m2c": [1, 0, 0, 0, 1, 0, 0, 0, 1], "cam_t_m2c": [0, 0, 1000]}]})",
-    R"({"0": [{"bbox_obj": [1, 2, 30, 40], "bbox_visib": [1, 2, 30, 40], "px_count_all": 900,)"
-    R"( "px_count_valid": 800, "px_count_visib": 700, "visib_fract": 0.78}]})"};
+    (R"({"0": [{"bbox_obj": [1, 2, 30, 40], "bbox_visib": [1, 2, 30, 40], "px_count_all": 900,)"
+     R"( "px_count_valid": 800, "px_count_visib": 700, "visib_fract": 0.78}]})")};  // one string, two lines
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
