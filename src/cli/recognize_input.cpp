@@ -17,44 +17,40 @@ namespace pbcli {
 
 namespace {
 
-// True if `path` is a PLY file whose header declares zero vertices or zero
-// faces (assimp refuses such files).
-bool ply_declares_no_geometry(const std::string& path) {
+// The vertex and face counts a PLY header declares (-1: none declared);
+// false unless `path` is a PLY whose header ends within 200 lines.
+bool ply_element_counts(const std::string& path, long* vertices, long* faces) {
   std::ifstream in(path, std::ios::binary);
   std::string line;
   if (!std::getline(in, line) || line.rfind("ply", 0) != 0) return false;
-  long vertices = -1, faces = -1;
-  for (int n = 0; n < 200 && std::getline(in, line); ++n) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line == "end_header") return vertices == 0 || faces == 0;
-    std::istringstream ss(line);
-    std::string word, kind;
-    long count = -1;
-    if (ss >> word >> kind >> count && word == "element") {
-      if (kind == "vertex") vertices = count;
-      if (kind == "face") faces = count;
-    }
-  }
-  return false;
-}
-
-// A point-cloud model file: .pcd, or a .ply that declares no faces.
-bool is_cloud_model(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext == ".pcd") return true;
-  if (ext != ".ply") return false;
-  std::ifstream in(path, std::ios::binary);
-  std::string line;
+  *vertices = *faces = -1;
   for (int n = 0; n < 200 && std::getline(in, line); ++n) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line == "end_header") return true;
     std::istringstream ss(line);
     std::string word, kind;
     long count = -1;
-    if (ss >> word >> kind >> count && word == "element" && kind == "face" && count > 0) return false;
+    if (ss >> word >> kind >> count && word == "element") {
+      if (kind == "vertex") *vertices = count;
+      if (kind == "face") *faces = count;
+    }
   }
   return false;
+}
+
+// A PLY whose header declares zero vertices or zero faces (assimp refuses
+// such files: an empty model, not an input error).
+bool ply_declares_no_geometry(const std::string& path) {
+  long v = 0, f = 0;
+  return ply_element_counts(path, &v, &f) && (v == 0 || f == 0);
+}
+
+// A point-cloud model file: .pcd, or a .ply that declares no faces.
+bool is_cloud_model(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  long v = 0, f = 0;
+  return ext == ".pcd" || (ext == ".ply" && ply_element_counts(path, &v, &f) && f <= 0);
 }
 
 RecognizeScene dataset_scene(RecognizeSource& o) {

@@ -15,6 +15,7 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <iostream>
 #include <memory>
@@ -61,45 +62,56 @@ static int run_command(const std::vector<std::string>& args, const std::string& 
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
+// Makes the scene set scenes_dir/STEM once, whatever the number of runs
+// asking for it: nothing when `complete` says it is there; else, under
+// STEM.lock, `command` (its output in STEM.log), whose failure is an
+// InputError(file, field, what + the log).
+static void make_scene_set_once(const RunOptions& opt, const std::string& stem, const std::function<bool()>& complete,
+                                const std::function<std::vector<std::string>()>& command, const std::string& file,
+                                const std::string& field, const std::string& what) {
+  if (complete()) return;
+  fs::create_directories(opt.scenes_dir);
+  const FileLock lock = FileLock::acquire((fs::path(opt.scenes_dir) / (stem + ".lock")).string());
+  if (complete()) return;  // another process made it while this one waited
+  const std::string log = (fs::path(opt.scenes_dir) / (stem + ".log")).string();
+  const int rc = run_command(command(), log);
+  if (rc != 0) {
+    std::ifstream in(log);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    throw InputError(file, field, what + " (exit " + std::to_string(rc) + "): " + ss.str());
+  }
+}
+
 // A `clouds:` scene set: `posebench import-clouds` into
 // scenes_dir/NAME_HASH (HASH of the clouds' bytes, their options and the
-// object), once.
+// object).
 static void import_scene_clouds(SceneSource& src, const ExperimentConfig& cfg, const RunOptions& opt) {
   std::string key = cfg.object + "\n" + src.cloud.dump();
   for (const auto& c : src.clouds) {
     std::ifstream in(c, std::ios::binary);
     key += "\n" + hash_hex(std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
   }
-  const std::string h = hash_hex(key).substr(0, 8);
-  const fs::path dir = fs::path(opt.scenes_dir) / (src.name + "_" + h);
+  const std::string stem = src.name + "_" + hash_hex(key).substr(0, 8);
+  const fs::path dir = fs::path(opt.scenes_dir) / stem;
   src.dataset = dir.string();
-  const auto complete = [&] { return fs::exists(dir / "posebench_clouds.json"); };
-  if (complete()) return;
-  fs::create_directories(opt.scenes_dir);
-  const FileLock lock = FileLock::acquire((fs::path(opt.scenes_dir) / (src.name + "_" + h + ".lock")).string());
-  if (complete()) return;
-  std::vector<std::string> args{opt.binary, "import-clouds", "--out", dir.string(), "--object", cfg.object};
-  for (const char* k : {"units", "intrinsics", "camera"})
-    if (src.cloud.contains(k)) {
-      args.push_back(std::string("--") + k);
+  const auto command = [&] {
+    std::vector<std::string> args{opt.binary, "import-clouds", "--out", dir.string(), "--object", cfg.object};
+    for (const char* k : {"units", "intrinsics", "camera"}) {
+      if (!src.cloud.contains(k)) continue;
       std::string v;
       if (src.cloud[k].is_array())  // intrinsics: [fx, fy, cx, cy(, width, height)]
         for (const auto& x : src.cloud[k]) v += (v.empty() ? "" : ",") + (x.is_string() ? x.get<std::string>() : x.dump());
       else
         v = src.cloud[k].is_string() ? src.cloud[k].get<std::string>() : src.cloud[k].dump();
-      args.push_back(v);
+      args.insert(args.end(), {std::string("--") + k, v});
     }
-  args.insert(args.end(), src.clouds.begin(), src.clouds.end());
-  const std::string log = (fs::path(opt.scenes_dir) / (src.name + "_" + h + ".log")).string();
-  log_event(LogLevel::info, "import_clouds", {{"scene", src.name}, {"clouds", src.clouds.size()}, {"dataset", dir.string()}});
-  const int rc = run_command(args, log);
-  if (rc != 0) {
-    std::ifstream in(log);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    throw InputError(cfg.file, "scenes." + src.name + ".clouds",
-                     "importing the clouds failed (exit " + std::to_string(rc) + "): " + ss.str());
-  }
+    args.insert(args.end(), src.clouds.begin(), src.clouds.end());
+    log_event(LogLevel::info, "import_clouds", {{"scene", src.name}, {"clouds", src.clouds.size()}, {"dataset", dir.string()}});
+    return args;
+  };
+  make_scene_set_once(opt, stem, [&] { return fs::exists(dir / "posebench_clouds.json"); }, command, cfg.file,
+                      "scenes." + src.name + ".clouds", "importing the clouds failed");
 }
 
 void prepare_scenes(ExperimentConfig& cfg, const RunOptions& opt) {
@@ -116,26 +128,18 @@ void prepare_scenes(ExperimentConfig& cfg, const RunOptions& opt) {
       gen["registry"] = fs::absolute(fs::path(src.generate).parent_path() / gen["registry"].get<std::string>())
                             .lexically_normal()
                             .string();
-    const std::string h = hash_hex(gen.dump()).substr(0, 8);
-    const fs::path dir = fs::path(opt.scenes_dir) / (src.name + "_" + h);
+    const std::string stem = src.name + "_" + hash_hex(gen.dump()).substr(0, 8);
+    const fs::path dir = fs::path(opt.scenes_dir) / stem;
     src.dataset = dir.string();
-    const auto complete = [&] { return fs::exists(dir / "models" / "models_info.json") && fs::exists(dir / "camera.json"); };
-    if (complete()) continue;
-    fs::create_directories(opt.scenes_dir);
-    const FileLock lock = FileLock::acquire((fs::path(opt.scenes_dir) / (src.name + "_" + h + ".lock")).string());
-    if (complete()) continue;  // another process generated it while this one waited
-    const fs::path cfg_path = fs::path(opt.scenes_dir) / (src.name + "_" + h + ".config.json");
-    atomic_write_text(cfg_path.string(), gen.dump(2) + "\n");
-    const std::string log = (fs::path(opt.scenes_dir) / (src.name + "_" + h + ".log")).string();
-    log_event(LogLevel::info, "generate_scenes", {{"scene", src.name}, {"dataset", dir.string()}});
-    const int rc = run_command({opt.binary, "generate", cfg_path.string(), "--out", dir.string()}, log);
-    if (rc != 0) {
-      std::ifstream in(log);
-      std::stringstream ss;
-      ss << in.rdbuf();
-      throw InputError(src.generate, "scenes." + src.name, "scene generation failed (exit " + std::to_string(rc) +
-                                                             "): " + ss.str());
-    }
+    const auto command = [&]() -> std::vector<std::string> {
+      const fs::path cfg_path = fs::path(opt.scenes_dir) / (stem + ".config.json");
+      atomic_write_text(cfg_path.string(), gen.dump(2) + "\n");
+      log_event(LogLevel::info, "generate_scenes", {{"scene", src.name}, {"dataset", dir.string()}});
+      return {opt.binary, "generate", cfg_path.string(), "--out", dir.string()};
+    };
+    make_scene_set_once(
+        opt, stem, [&] { return fs::exists(dir / "models" / "models_info.json") && fs::exists(dir / "camera.json"); },
+        command, src.generate, "scenes." + src.name, "scene generation failed");
   }
 }
 

@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "io/bop.h"
+#include "io/folder.h"
 #include "io/mesh_io.h"
 #include "io/png.h"
 #include "io/validate.h"
@@ -83,40 +84,44 @@ ImportCloudsSummary import_clouds(const ImportCloudsSettings& st, const std::str
     sum.intrinsics_source.push_back(scenes.back().source);
   }
   sum.depth_scale = max_z < 6500 ? 0.1 : 1.0;
-  fs::create_directories(dir / "models");
-  std::map<int, ModelInfo> infos;
-  for (const auto& name : st.objects) {
-    const ModelSpec& spec = reg.spec(name);
-    const Mesh mesh = reg.load_model(name);
-    write_ply((dir / "models" / ("obj_" + bop_id(spec.obj_id) + ".ply")).string(), mesh);
-    ModelInfo info = reg.info(name, mesh);
-    info.obj_id = spec.obj_id;
-    info.name = name;
-    infos[spec.obj_id] = info;
-  }
-  write_models_info((dir / "models" / "models_info.json").string(), infos);
-  SceneInfo scene;
-  scene.scene_id = 1;
-  const std::string scene_dir = (dir / "test" / bop_id(1)).string();
-  fs::create_directories(fs::path(scene_dir) / "depth");
-  nlohmann::json trace = nlohmann::json::array();
-  for (size_t i = 0; i < scenes.size(); ++i) {
-    ImageInfo im;
-    im.im_id = static_cast<int>(i);
-    im.K = scenes[i].K;
-    im.depth_scale = sum.depth_scale;
-    write_depth_png(bop_depth_path(scene_dir, im.im_id), scenes[i].depth, sum.depth_scale);
-    scene.images[im.im_id] = im;
-    trace.push_back({{"im_id", im.im_id}, {"cloud", fs::absolute(st.clouds[i]).string()},
-                     {"intrinsics", sum.intrinsics_source[i]}});
-  }
-  write_scene_json(scene_dir, scene);
-  // camera.json gives readers the image size: only when every image has the
-  // first one's (otherwise each size comes from its depth PNG).
-  bool one_size = true;
-  for (const auto& c : scenes) one_size = one_size && c.K.width == scenes[0].K.width && c.K.height == scenes[0].K.height;
-  if (one_size) write_camera_json((dir / "camera.json").string(), scenes[0].K, sum.depth_scale);
-  atomic_write_text((dir / "posebench_clouds.json").string(), nlohmann::json({{"images", trace}}).dump(2) + "\n");
+  // Filled under OUT.partial and moved into place at the end (io/folder.h):
+  // an interrupted import leaves no folder that looks complete.
+  write_folder_atomically(out, "cannot write the dataset: ", [&](const fs::path& tmp) {
+    fs::create_directories(tmp / "models");
+    std::map<int, ModelInfo> infos;
+    for (const auto& name : st.objects) {
+      const ModelSpec& spec = reg.spec(name);
+      const Mesh mesh = reg.load_model(name);
+      write_ply((tmp / "models" / ("obj_" + bop_id(spec.obj_id) + ".ply")).string(), mesh);
+      ModelInfo info = reg.info(name, mesh);
+      info.obj_id = spec.obj_id;
+      info.name = name;
+      infos[spec.obj_id] = info;
+    }
+    write_models_info((tmp / "models" / "models_info.json").string(), infos);
+    SceneInfo scene;
+    scene.scene_id = 1;
+    const std::string scene_dir = (tmp / "test" / bop_id(1)).string();
+    fs::create_directories(fs::path(scene_dir) / "depth");
+    nlohmann::json trace = nlohmann::json::array();
+    for (size_t i = 0; i < scenes.size(); ++i) {
+      ImageInfo im;
+      im.im_id = static_cast<int>(i);
+      im.K = scenes[i].K;
+      im.depth_scale = sum.depth_scale;
+      write_depth_png(bop_depth_path(scene_dir, im.im_id), scenes[i].depth, sum.depth_scale);
+      scene.images[im.im_id] = im;
+      trace.push_back({{"im_id", im.im_id}, {"cloud", fs::absolute(st.clouds[i]).string()},
+                       {"intrinsics", sum.intrinsics_source[i]}});
+    }
+    write_scene_json(scene_dir, scene);
+    // camera.json gives readers the image size: only when every image has the
+    // first one's (otherwise each size comes from its depth PNG).
+    bool one_size = true;
+    for (const auto& c : scenes) one_size = one_size && c.K.width == scenes[0].K.width && c.K.height == scenes[0].K.height;
+    if (one_size) write_camera_json((tmp / "camera.json").string(), scenes[0].K, sum.depth_scale);
+    atomic_write_text((tmp / "posebench_clouds.json").string(), nlohmann::json({{"images", trace}}).dump(2) + "\n");
+  });
   sum.images = static_cast<int>(scenes.size());
   return sum;
 }
