@@ -110,6 +110,31 @@ TEST_F(Pipeline, FindsTheLBlockWithFpfhAndIcp) {
   EXPECT_LT(pbtest::angle_deg(r.T_cam_model.R, scene_->T_cam_model.R), 5.0);
 }
 
+// refine.max_hypotheses: only that many hypotheses are refined, each exactly
+// as in the run that refines all of them (its own random stream: ICP on a
+// seeded subset of model points), and here the best is among them, so the
+// answer is the same pose bit for bit.
+TEST_F(Pipeline, MaxHypothesesRefinesTheMostPromisingExactlyAsBefore) {
+  pb::RecognitionSettings s = small_settings("fpfh");
+  s.refine.icp_sample_points = 150;
+  const auto model = pb::test::train(*mesh_, s);
+  const pb::RecognitionResult all = pb::recognize(scene_->depth, scene_->K, *model, s);
+  ASSERT_EQ(all.status, "ok") << all.message;
+  ASSERT_GT(all.hypotheses.size(), 3u);
+  s.refine.max_hypotheses = 3;
+  const pb::RecognitionResult few = pb::recognize(scene_->depth, scene_->K, *model, s);
+  ASSERT_EQ(few.status, "ok") << few.message;
+  ASSERT_EQ(few.hypotheses.size(), 3u);
+  for (const pb::Hypothesis& h : few.hypotheses) {
+    bool found = false;
+    for (const pb::Hypothesis& g : all.hypotheses) found = found || same_bits(h.T_cam_model, g.T_cam_model);
+    EXPECT_TRUE(found) << "a kept hypothesis is refined as in the full run";
+  }
+  EXPECT_TRUE(same_bits(few.T_cam_model, all.T_cam_model));
+  EXPECT_EQ(few.inliers, all.inliers);
+  EXPECT_LT((few.T_cam_model.t - scene_->T_cam_model.t).norm(), 10.0);
+}
+
 // Registration alone (Table 4.9): from a slightly perturbed ground truth the
 // pose is found ("ok", inliers); from a pose 1 m away from the object no
 // model point has a scene point within the inlier threshold, and that is

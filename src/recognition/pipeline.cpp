@@ -1,6 +1,7 @@
 // The recognition pipeline (THESIS.md "The system"), online part:
 // recognize() preprocesses the scene, lets the descriptor method
-// hypothesize, refines every hypothesis, counts its inliers and keeps the one
+// hypothesize, refines every hypothesis (or the refine.max_hypotheses most
+// promising ones), counts its inliers and keeps the one
 // with the most; refine_from() is registration alone (Table 4.9, Figure
 // 4.12). Training and the method registry: training.cpp, registry.cpp.
 #include "recognition/pipeline.h"
@@ -55,9 +56,11 @@ PointSet prepare_scene(const DepthImage& depth, const Intrinsics& K, const Recog
 
 // Refines every hypothesis independently (one random stream each, one
 // output slot each), in parallel over OpenMP threads: the result does not
-// depend on the thread count.
-void refine_all(std::vector<Hypothesis>& hyps, const TrainedModel& model, const PointSet& scene,
-                const RecognitionSettings& s) {
+// depend on the thread count. stream[i]: hypothesis i's position in the
+// method's list (its random stream, the same whether or not others were
+// dropped before refinement).
+void refine_all(std::vector<Hypothesis>& hyps, const std::vector<uint64_t>& stream, const TrainedModel& model,
+                const PointSet& scene, const RecognitionSettings& s) {
   for (const auto& h : hyps) model.model_cloud(h.view);  // throws for a view index out of range
   const long nh = static_cast<long>(hyps.size());
   std::vector<std::exception_ptr> errors(hyps.size());
@@ -66,7 +69,7 @@ void refine_all(std::vector<Hypothesis>& hyps, const TrainedModel& model, const 
     try {
       Hypothesis& h = hyps[static_cast<size_t>(i)];
       const RefineResult r = refine_pose(s.refinement, model.model_cloud(h.view), scene, h.T_cam_model, s.refine,
-                                         derive_seed(s.seed, {kStreamRefine, static_cast<uint64_t>(i)}));
+                                         derive_seed(s.seed, {kStreamRefine, stream[static_cast<size_t>(i)]}));
       if (finite_pose(r.T_cam_model)) {
         h.T_cam_model = r.T_cam_model;
         h.fitness = r.fitness;
@@ -80,17 +83,53 @@ void refine_all(std::vector<Hypothesis>& hyps, const TrainedModel& model, const 
     if (e) std::rethrow_exception(e);  // the first failing hypothesis, whatever the thread count
 }
 
-// Counts inliers and ranks: most inliers first; ties by score, then view
-// index, then the method's order.
-std::vector<Hypothesis> verify_and_rank(std::vector<Hypothesis> hyps, const TrainedModel& model,
-                                        const PointSet& scene, const VerifySettings& v) {
-  const PointIndex index(scene.points);
+// Counts every hypothesis's inliers within `threshold_mm` (in parallel; one
+// slot each).
+void count_all(std::vector<Hypothesis>& hyps, const TrainedModel& model, const PointIndex& index,
+               const VerifySettings& v, double threshold_mm) {
   const long nh = static_cast<long>(hyps.size());
 #pragma omp parallel for schedule(dynamic, 1)
   for (long i = 0; i < nh; ++i) {
     Hypothesis& h = hyps[static_cast<size_t>(i)];
-    h.inliers = count_inliers(model.verify_cloud(h.view, v).points, h.T_cam_model, index, v.inlier_threshold_mm);
+    h.inliers = count_inliers(model.verify_cloud(h.view, v).points, h.T_cam_model, index, threshold_mm);
   }
+}
+
+// RefineSettings::max_hypotheses: keeps the hypotheses with the most inliers
+// within max_correspondence_mm at their initial pose (ties: score, then the
+// method's order), in the method's order. Returns the kept hypotheses'
+// positions in the method's list.
+std::vector<uint64_t> keep_most_promising(std::vector<Hypothesis>& hyps, const TrainedModel& model,
+                                          const PointIndex& index, const RecognitionSettings& s) {
+  const size_t keep = static_cast<size_t>(s.refine.max_hypotheses);
+  std::vector<uint64_t> kept_at(hyps.size());
+  for (size_t i = 0; i < kept_at.size(); ++i) kept_at[i] = i;
+  if (keep == 0 || hyps.size() <= keep) return kept_at;
+  count_all(hyps, model, index, s.verify, s.refine.max_correspondence_mm);
+  std::vector<size_t> order(hyps.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  auto score_of = [](const Hypothesis& h) { return std::isnan(h.score) ? -HUGE_VAL : h.score; };
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    if (hyps[a].inliers != hyps[b].inliers) return hyps[a].inliers > hyps[b].inliers;
+    return score_of(hyps[a]) > score_of(hyps[b]);
+  });
+  order.resize(keep);
+  std::sort(order.begin(), order.end());
+  std::vector<Hypothesis> kept;
+  kept_at.clear();
+  for (size_t i : order) {
+    kept.push_back(hyps[i]);
+    kept_at.push_back(i);
+  }
+  hyps = std::move(kept);
+  return kept_at;
+}
+
+// Counts inliers and ranks: most inliers first; ties by score, then view
+// index, then the method's order.
+std::vector<Hypothesis> verify_and_rank(std::vector<Hypothesis> hyps, const TrainedModel& model,
+                                        const PointIndex& index, const VerifySettings& v) {
+  count_all(hyps, model, index, v, v.inlier_threshold_mm);
   std::vector<size_t> order(hyps.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   auto score_of = [](const Hypothesis& h) { return std::isnan(h.score) ? -HUGE_VAL : h.score; };
@@ -150,11 +189,15 @@ int nearest_view(const TrainedModel& model, const Pose& init) {
 void refine_verify_accept(std::vector<Hypothesis> hyps, const TrainedModel& model, const PointSet& scene,
                           const RecognitionSettings& s, RecognitionResult& res) {
   Timer timer;
-  refine_all(hyps, model, scene, s);
+  const PointIndex index(scene.points);
+  res.times.verify = timer.seconds();
+  timer.reset();
+  const std::vector<uint64_t> stream = keep_most_promising(hyps, model, index, s);
+  refine_all(hyps, stream, model, scene, s);
   res.times.refine = timer.seconds();
   timer.reset();
-  res.hypotheses = verify_and_rank(std::move(hyps), model, scene, s.verify);
-  res.times.verify = timer.seconds();
+  res.hypotheses = verify_and_rank(std::move(hyps), model, index, s.verify);
+  res.times.verify += timer.seconds();
   accept_best(model, s.verify, res);
 }
 

@@ -47,6 +47,11 @@ struct RefineSettings {
                                            // initial model centre are registered (< 0: use
                                            // max_correspondence_mm)
   int normal_neighbours = 10;              // k for PCA normals when a cloud has none (icp_plane, gicp)
+  int max_hypotheses = 0;                  // refine only this many hypotheses: those with the most
+                                           // model points within max_correspondence_mm of a scene
+                                           // point at their initial pose (ties: the method's score,
+                                           // then its order); the others are dropped before
+                                           // refinement. 0 = refine every hypothesis (thesis)
 
   template <class S, class F>
   static void fields(S& s, F& f) {
@@ -66,6 +71,7 @@ struct RefineSettings {
     f("gicp_covariances_from_normals", s.gicp_covariances_from_normals);
     f("crop_margin_mm", s.crop_margin_mm);
     f("normal_neighbours", s.normal_neighbours, fields::at_least(3));
+    f("max_hypotheses", s.max_hypotheses, fields::at_least(0));
   }
   void validate(const YamlNode& node) const {
     if (ndt_outlier_ratio >= 1) node["ndt_outlier_ratio"].fail("must be below 1");
