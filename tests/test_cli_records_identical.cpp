@@ -13,7 +13,10 @@
 // moved by at most 1.7 mm, the same 8 of 10 correct), and when the
 // project's own FPFH replaced PCL's (float rounding in the descriptors: ci
 // 4 FPFH estimates changed, demo 1 by 0.13 mm; the same correctness in every
-// record, FPFH 8 of 10 in ci, 3 in demo). A change that alters
+// record, FPFH 8 of 10 in ci, 3 in demo), and when the project's own SHOT
+// replaced PCL's (float rounding in the descriptors: ci 4 SHOT estimates
+// changed, the two correct ones by at most 0.21 mm, demo 2; the same
+// correctness in every record, SHOT 6 of 10 in ci, 2 in demo). A change that alters
 // results on purpose updates those files and says why in its commit.
 #include <gtest/gtest.h>
 

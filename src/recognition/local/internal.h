@@ -3,7 +3,7 @@
 // file, so the PCL compile cost is spread over several small units:
 //   keypoints.cpp  keypoints (the shared voxel grid, PCL-free)
 //   fpfh.cpp       FPFH (our own, on KdTree3; fpfh_pcl.cpp: PCL's, the reference)
-//   shot.cpp       SHOT (pcl::SHOTEstimationOMP)
+//   shot.cpp       SHOT (our own, on KdTree3; shot_pcl.cpp: PCL's, the reference)
 //   match.cpp      exact descriptor search (FLANN kd-tree for FPFH, a
 //                  projected lower bound for SHOT)
 //   hough.cpp      BOARD reference frames + pcl::Hough3DGrouping
@@ -39,6 +39,9 @@ std::vector<float> compute_shot(const PointSet& cloud, const std::vector<int>& k
 // PCL's FPFHEstimationOMP with the same inputs: the reference of our FPFH
 // (tests and the stock-PCL benchmark only).
 std::vector<float> compute_fpfh_pcl(const PointSet& cloud, const std::vector<int>& keypoints,
+                                    double radius_mm, int threads);
+// PCL's SHOTEstimationOMP with the same inputs: the reference of our SHOT.
+std::vector<float> compute_shot_pcl(const PointSet& cloud, const std::vector<int>& keypoints,
                                     double radius_mm, int threads);
 
 // OpenMP threads for a `threads` setting: 0 = OMP_NUM_THREADS (as `run`

@@ -29,11 +29,15 @@ inline uint64_t mix(const K& k) {
   return h;
 }
 
-// Points grouped by cell: cell_of[i] (or -1), cells in output order, the
-// first point of each cell and its count.
+// Points grouped by cell: cell_of[i] (or -1), cells numbered in order of
+// first appearance, the first point of each cell and its count; `order`
+// lists the cells in output (key) order. The points keep first-appearance
+// cell ids (no renumbering pass over every point): only the output is
+// written in key order.
 struct Cells {
   std::vector<int> cell_of;
   std::vector<int> first, count;
+  std::vector<int> order;
   size_t size() const { return first.size(); }
 };
 
@@ -123,24 +127,7 @@ Cells group_by(size_t n, KeyOf key_of, Skip skip, std::vector<K>& keys) {
   return c;
 }
 
-// Renumbers the cells of c in the order `order` (cell ids, output order).
-Cells renumber(Cells c, const std::vector<int>& order) {
-  std::vector<int> rank(order.size());
-  for (size_t r = 0; r < order.size(); ++r) rank[static_cast<size_t>(order[r])] = static_cast<int>(r);
-  Cells out;
-  out.first.resize(order.size());
-  out.count.resize(order.size());
-  for (size_t r = 0; r < order.size(); ++r) {
-    out.first[r] = c.first[static_cast<size_t>(order[r])];
-    out.count[r] = c.count[static_cast<size_t>(order[r])];
-  }
-  out.cell_of = std::move(c.cell_of);
-  for (int& k : out.cell_of)
-    if (k >= 0) k = rank[static_cast<size_t>(k)];
-  return out;
-}
-
-// Groups the points by cell, cells in key order (PCL's: z, then y, then x
+// Groups the points by cell, with the key order of the cells (PCL's: z, then y, then x
 // for kZYX). When every axis spans fewer than 2^21 cells (always, for images
 // at sensor range and millimetre-scale leaves) the key is one integer, 21
 // bits per axis above the minimum cell, in priority order: hashing,
@@ -157,17 +144,16 @@ Cells group(const std::vector<Vec3f>& pts, const VoxelGridOptions& opt) {
   Eigen::AlignedBox3f box;
   for (size_t i = 0; i < n; ++i)
     if (!skip(i)) box.extend(pts[i]);
-  if (box.isEmpty()) return Cells{std::vector<int>(n, -1), {}, {}};
+  if (box.isEmpty()) return Cells{std::vector<int>(n, -1), {}, {}, {}};
   int64_t lo[3], span = 0;
   for (int d = 0; d < 3; ++d) {
     lo[d] = cell(box.min()[ax[d]]);  // the cell index is monotonic in the coordinate
     span = std::max(span, cell(box.max()[ax[d]]) - lo[d]);
   }
-  std::vector<int> order;
-  auto sorted_order = [&order](auto& keyed) {
+  auto sorted_order = [](auto& keyed, Cells& c) {
     std::sort(keyed.begin(), keyed.end());
-    order.resize(keyed.size());
-    for (size_t k = 0; k < keyed.size(); ++k) order[k] = keyed[k].second;
+    c.order.resize(keyed.size());
+    for (size_t k = 0; k < keyed.size(); ++k) c.order[k] = keyed[k].second;
   };
   if (span < (int64_t(1) << 21)) {
     std::vector<uint64_t> keys;
@@ -181,16 +167,16 @@ Cells group(const std::vector<Vec3f>& pts, const VoxelGridOptions& opt) {
         skip, keys);
     std::vector<std::pair<uint64_t, int>> keyed(keys.size());
     for (size_t k = 0; k < keys.size(); ++k) keyed[k] = {keys[k], static_cast<int>(k)};
-    sorted_order(keyed);
-    return renumber(std::move(c), order);
+    sorted_order(keyed, c);
+    return c;
   }
   std::vector<Key> keys;
   Cells c = group_by<Key>(
       n, [&](size_t i) { return Key{cell(pts[i][ax[0]]), cell(pts[i][ax[1]]), cell(pts[i][ax[2]])}; }, skip, keys);
   std::vector<std::pair<Key, int>> keyed(keys.size());
   for (size_t k = 0; k < keys.size(); ++k) keyed[k] = {keys[k], static_cast<int>(k)};
-  sorted_order(keyed);
-  return renumber(std::move(c), order);
+  sorted_order(keyed, c);
+  return c;
 }
 
 // Centroids accumulated in input order (double).
@@ -232,7 +218,8 @@ PointSet voxel_downsample(const PointSet& in, const VoxelGridOptions& opt) {
   out.source_width = in.source_width;
   out.source_height = in.source_height;
   out.points.reserve(c.size());
-  for (size_t k = 0; k < c.size(); ++k) {
+  for (const int cell : c.order) {
+    const size_t k = static_cast<size_t>(cell);
     if (has_n) {
       const double l = nsum[k].norm();
       if (opt.drop_cancelled_normals > 0 && !(l > opt.drop_cancelled_normals * c.count[k])) continue;
@@ -261,7 +248,9 @@ std::vector<int> voxel_nearest_points(const PointSet& in, const VoxelGridOptions
       out[static_cast<size_t>(k)] = static_cast<int>(i);
     }
   }
-  return out;
+  std::vector<int> sorted(c.size());
+  for (size_t r = 0; r < c.order.size(); ++r) sorted[r] = out[static_cast<size_t>(c.order[r])];
+  return sorted;
 }
 
 PointSet voxel_downsample_to(const PointSet& in, int target, const VoxelGridOptions& base) {
