@@ -24,8 +24,9 @@ constexpr char kMagic[8] = {'P', 'B', 'T', 'R', 'A', 'I', 'N', '\0'};
 // one binary format for every method. 3: the project's own normals (PCA in a
 // radius on its kd-tree) replace PCL's in preprocessing: models trained by
 // version 2 are retrained. 4: the project's own FPFH. 5: the project's own
-// SHOT (descriptors equal to PCL's at rounding level).
-constexpr uint32_t kVersion = 5;
+// SHOT (descriptors equal to PCL's at rounding level). 6: the project's own
+// BOARD frames (deterministic start axis of the hole search).
+constexpr uint32_t kVersion = 6;
 
 std::string sanitize(const std::string& name) {
   std::string o;

@@ -1,10 +1,9 @@
-// Correspondence grouping of the local pipeline: BOARD local reference frames
-// (pcl::BOARDLocalReferenceFrameEstimation) and 3D Hough voting
-// (pcl::Hough3DGrouping, Tombari & Di Stefano 2010). Hough3DGrouping filters
+// Correspondence grouping of the local pipeline: 3D Hough voting
+// (pcl::Hough3DGrouping, Tombari & Di Stefano 2010) over the BOARD frames of
+// board.cpp. Hough3DGrouping filters
 // each cluster with PCL's RANSAC correspondence rejector (fixed seed 12345,
 // single-threaded), so its output is deterministic.
 #include <pcl/correspondence.h>
-#include <pcl/features/board.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 #include <pcl/recognition/cg/hough_3d.h>
@@ -18,32 +17,6 @@
 #include "recognition/local/pcl_features.h"
 
 namespace pb::local {
-
-std::vector<float> compute_board_lrf(const PointSet& cloud, const std::vector<int>& keypoints,
-                                     double radius_mm) {
-  std::vector<float> out(keypoints.size() * kLrfDim, std::numeric_limits<float>::quiet_NaN());
-  if (keypoints.empty() || !cloud.has_normals()) return out;
-
-  pcl::BOARDLocalReferenceFrameEstimation<pcl::PointXYZ, pcl::Normal, pcl::ReferenceFrame> est;
-  est.setFindHoles(true);
-  pcl::PointCloud<pcl::ReferenceFrame> rf;
-  if (!estimate_at_keypoints(est, cloud, keypoints, radius_mm, rf)) return out;
-  for (size_t i = 0; i < rf.size(); ++i) {
-    float row[kLrfDim];
-    for (int d = 0; d < 3; ++d) {
-      row[d] = rf[i].x_axis[d];
-      row[3 + d] = rf[i].y_axis[d];
-      row[6 + d] = rf[i].z_axis[d];
-    }
-    // A frame is usable only if finite and (close to) orthonormal.
-    if (!finite_row(row, kLrfDim)) continue;
-    Eigen::Matrix3f R;
-    R << row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7], row[8];
-    if (!((R * R.transpose() - Eigen::Matrix3f::Identity()).cwiseAbs().maxCoeff() < 1e-3f)) continue;
-    std::copy(row, row + kLrfDim, out.begin() + static_cast<long>(i) * kLrfDim);
-  }
-  return out;
-}
 
 namespace {
 

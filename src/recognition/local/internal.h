@@ -6,7 +6,8 @@
 //   shot.cpp       SHOT (our own, on KdTree3; shot_pcl.cpp: PCL's, the reference)
 //   match.cpp      exact descriptor search (FLANN kd-tree for FPFH, a
 //                  projected lower bound for SHOT)
-//   hough.cpp      BOARD reference frames + pcl::Hough3DGrouping
+//   board.cpp      BOARD reference frames (our own; board_pcl.cpp: PCL's, the reference)
+//   hough.cpp      pcl::Hough3DGrouping
 //   method.cpp     the Method (train, save/load, hypothesize)
 #pragma once
 
@@ -48,11 +49,25 @@ std::vector<float> compute_shot_pcl(const PointSet& cloud, const std::vector<int
 // gives its workers), 1 without OpenMP.
 int omp_threads(int threads);
 
-// BOARD local reference frames (pcl::BOARDLocalReferenceFrameEstimation,
-// holes filled) at `keypoints`, cloud as surface; row-major
-// keypoints.size() x 9 (x, y, z axes); NaN rows for invalid frames.
-std::vector<float> compute_board_lrf(const PointSet& cloud, const std::vector<int>& keypoints,
-                                     double radius_mm);
+// Where BOARD's hole search starts counting its 24 angular sectors (the
+// frame it finds depends on this axis only through the sector borders).
+enum class BoardStartAxis {
+  kFixed,  // z x the coordinate axis least aligned with z: deterministic (the pipeline)
+  kCRand,  // drawn with std::rand() as PCL draws it (tests, after std::srand)
+};
+// BOARD local reference frames (Petrelli & Di Stefano 2011, as
+// pcl::BOARDLocalReferenceFrameEstimation with holes filled; board.cpp) at
+// `keypoints`, cloud as surface; row-major keypoints.size() x 9 (x, y, z
+// axes); NaN rows for invalid frames (no frame, not orthonormal).
+std::vector<float> compute_board_lrf(const PointSet& cloud, const std::vector<int>& keypoints, double radius_mm,
+                                     BoardStartAxis start = BoardStartAxis::kFixed);
+// PCL's estimator with the same inputs (board_pcl.cpp): the reference of
+// ours (tests and benchmarks only).
+std::vector<float> compute_board_lrf_pcl(const PointSet& cloud, const std::vector<int>& keypoints,
+                                         double radius_mm);
+// A frame row (x, y, z axes) the voting can use: finite and orthonormal
+// within 1e-3.
+bool usable_frame(const float* row);
 
 // True if the row holds no NaN / inf.
 bool finite_row(const float* row, int dim);

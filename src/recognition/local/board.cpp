@@ -1,0 +1,224 @@
+// Our BOARD local reference frames (Petrelli & Di Stefano 2011), PCL-free, as
+// pcl::BOARDLocalReferenceFrameEstimation computes them with holes filled and
+// its default tangent radius (0: every neighbour but the keypoint itself is
+// a "margin" point), the set-up of PCL's correspondence grouping tutorial
+// (board_pcl.cpp keeps PCL's as the reference):
+//   - neighbourhood: every cloud point with squared distance below r^2, in
+//     order of distance (KdTree3); fewer than 6: no frame;
+//   - z: the normal of the least-squares plane through the neighbours,
+//     pointing along the mean of their normals;
+//   - x: toward the margin point whose normal deviates most from z
+//     (projected on the tangent plane), unless the margin has a hole: the
+//     margin points' directions around z fall into 24 sectors counted from
+//     a start axis; the widest run of empty sectors that is wider than 20%
+//     of the circle and whose bordering normals are steep enough (> 0.1)
+//     turns x into the hole, between its borders weighted by their normals;
+//   - y = z x x.
+// Differences from PCL: the plane normal comes from the 3x3 covariance (an
+// eigenvector, in double) instead of an SVD of the centred points (the same
+// vector up to rounding and sign, and the sign is then set by the normals);
+// the start axis is deterministic (PCL draws it with std::rand(), so its
+// frames depend on every earlier call in the process) unless
+// BoardStartAxis::kCRand asks for PCL's draw.
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+
+#include "recognition/kdtree.h"
+#include "recognition/local/internal.h"
+
+namespace pb::local {
+
+namespace {
+
+constexpr int kSectors = 24;            // PCL's check_margin_array_size
+constexpr float kHoleFraction = 0.2f;   // PCL's hole_size_prob_thresh
+constexpr float kSteep = 0.1f;          // PCL's steep_thresh
+constexpr float kTwoPi = 2 * static_cast<float>(M_PI);
+
+using Neighbours = std::vector<std::pair<float, int>>;
+
+// The unit direction from `origin` to `p` projected on the plane with unit
+// normal `axis` through origin.
+Vec3f tangent_direction(const Vec3f& axis, const Vec3f& origin, const Vec3f& p) {
+  const Vec3f projected = p - axis.dot(p - origin) * axis;
+  return (projected - origin).normalized();
+}
+
+// The angle from unit vector a to unit vector b about `axis`, in [0, 2 pi).
+float angle_about(const Vec3f& a, const Vec3f& b, const Vec3f& axis) {
+  const float angle = std::acos(std::clamp(a.dot(b), -1.0f, 1.0f));
+  return a.cross(b).dot(axis) < 0.f ? kTwoPi - angle : angle;
+}
+
+// A unit axis orthogonal to z: deterministic, or std::rand()'s as PCL draws
+// it (two coordinates uniform in [-1, 1], the third solved for).
+Vec3f start_axis(const Vec3f& z, BoardStartAxis how) {
+  if (how == BoardStartAxis::kFixed) {
+    int least = 0;
+    z.cwiseAbs().minCoeff(&least);
+    return z.cross(Vec3f::Unit(least)).normalized();
+  }
+  auto draw = [] { return (static_cast<float>(std::rand()) / static_cast<float>(RAND_MAX)) * 2.0f - 1.0f; };
+  Vec3f a = Vec3f::Zero();
+  for (int solve : {2, 1, 0}) {  // the first coordinate of z (from z) that is not zero is solved for
+    if (std::abs(z[solve]) < 1e-8f) continue;
+    const int u = solve == 0 ? 1 : 0, v = solve == 2 ? 1 : 2;
+    a[u] = draw();
+    a[v] = draw();
+    a[solve] = -(z[u] * a[u] + z[v] * a[v]) / z[solve];
+    break;
+  }
+  return a.normalized();
+}
+
+// Per sector: whether a margin point falls in it, and the smallest and
+// largest angle there with the normal cosine of the point at each.
+struct Sectors {
+  std::array<bool, kSectors> hit{};
+  std::array<float, kSectors> min_angle, max_angle, min_cos, max_cos;
+  Sectors() {
+    min_angle.fill(std::numeric_limits<float>::max());
+    max_angle.fill(-std::numeric_limits<float>::max());
+    min_cos.fill(-1.0f);
+    max_cos.fill(-1.0f);
+  }
+  void add(float angle, float normal_cos) {
+    const int s = std::min(static_cast<int>(std::floor(angle / (kTwoPi / kSectors))), kSectors - 1);
+    hit[static_cast<size_t>(s)] = true;
+    if (angle < min_angle[static_cast<size_t>(s)]) {
+      min_angle[static_cast<size_t>(s)] = angle;
+      min_cos[static_cast<size_t>(s)] = normal_cos;
+    }
+    if (angle > max_angle[static_cast<size_t>(s)]) {
+      max_angle[static_cast<size_t>(s)] = angle;
+      max_cos[static_cast<size_t>(s)] = normal_cos;
+    }
+  }
+};
+
+// The angle (from the start axis) of the widest qualifying hole, or false
+// when there is none. Runs of empty sectors are scanned from the first
+// sector after a hit (a run across sector 0 is one run).
+bool widest_hole(const Sectors& s, float min_cos, float* angle) {
+  const bool any_empty = std::find(s.hit.begin(), s.hit.end(), false) != s.hit.end();
+  if (!any_empty) return false;
+  const int start = s.hit[kSectors - 1] ? 0 : static_cast<int>(std::find(s.hit.begin(), s.hit.end(), true) - s.hit.begin());
+  float best = -std::numeric_limits<float>::max();
+  for (int ch = start; ch < kSectors; ++ch) {
+    if (s.hit[static_cast<size_t>(ch)]) continue;
+    int end = ch + 1;
+    while (!s.hit[static_cast<size_t>(end % kSectors)]) ++end;
+    const size_t before = static_cast<size_t>((ch - 1 + kSectors) % kSectors), after = static_cast<size_t>(end % kSectors);
+    const float nb = 1.0f - (s.max_cos[before] - min_cos) / (1.0f - min_cos);
+    const float ne = 1.0f - (s.min_cos[after] - min_cos) / (1.0f - min_cos);
+    const float width = after < before ? s.min_angle[after] + kTwoPi - s.max_angle[before]
+                                       : s.min_angle[after] - s.max_angle[before];
+    const float fraction = width / kTwoPi;
+    if (fraction > kHoleFraction && (ne + nb) / 2.0f > kSteep && fraction > best) {
+      best = fraction;
+      *angle = s.max_angle[before] + width * (((ne - nb) + 1.0f) / 2.0f);
+    }
+    if (end >= kSectors) break;
+    ch = end - 1;
+  }
+  return best > -std::numeric_limits<float>::max();
+}
+
+// The frame of keypoint q (rows x, y, z into row[9]); false when it has none.
+bool board_frame(const Vec3f& q, const PointSet& cloud, const Neighbours& nn, BoardStartAxis how, float* row) {
+  if (nn.size() < 6) return false;
+  // z: the plane through the neighbours, oriented by their normals.
+  Vec3f centroid = Vec3f::Zero();
+  for (const auto& e : nn) centroid += cloud.points[static_cast<size_t>(e.second)];
+  centroid /= static_cast<float>(nn.size());
+  Mat3 cov = Mat3::Zero();
+  Vec3f normal_sum = Vec3f::Zero();
+  for (const auto& e : nn) {
+    const Vec3 d = (cloud.points[static_cast<size_t>(e.second)] - centroid).cast<double>();
+    cov.noalias() += d * d.transpose();
+    normal_sum += cloud.normals[static_cast<size_t>(e.second)];
+  }
+  Vec3f z = Eigen::SelfAdjointEigenSolver<Mat3>(cov).eigenvectors().col(0).cast<float>();
+  if (z.dot(normal_sum.normalized()) < 0) z = -z;
+  // x: the steepest margin point, or the widest hole in the margin.
+  const Vec3f x0 = start_axis(z, how);
+  float min_cos = std::numeric_limits<float>::max();
+  int steepest = -1;
+  Sectors sectors;
+  for (const auto& [d2, i] : nn) {
+    if (d2 <= 0.0f) continue;  // the keypoint itself (margin distance 0: every other point)
+    const float c = z.dot(cloud.normals[static_cast<size_t>(i)]);
+    if (c < min_cos) {
+      min_cos = c;
+      steepest = i;
+    }
+    sectors.add(angle_about(x0, tangent_direction(z, q, cloud.points[static_cast<size_t>(i)]), z), c);
+  }
+  Vec3f x;
+  float hole = 0;
+  if (steepest >= 0 && widest_hole(sectors, min_cos, &hole)) {
+    x = Eigen::AngleAxisf(hole, z) * x0;
+  } else {
+    if (steepest < 0) {  // every neighbour coincides with q: the steepest of them
+      for (const auto& e : nn) {
+        const float c = z.dot(cloud.normals[static_cast<size_t>(e.second)]);
+        if (c < min_cos) {
+          min_cos = c;
+          steepest = e.second;
+        }
+      }
+      if (steepest < 0) return false;
+    }
+    x = tangent_direction(z, q, cloud.points[static_cast<size_t>(steepest)]);
+  }
+  const Vec3f y = z.cross(x);
+  for (int d = 0; d < 3; ++d) {
+    row[d] = x[d];
+    row[3 + d] = y[d];
+    row[6 + d] = z[d];
+  }
+  return true;
+}
+
+}  // namespace
+
+bool usable_frame(const float* row) {
+  if (!finite_row(row, kLrfDim)) return false;
+  Eigen::Matrix3f R;
+  R << row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7], row[8];
+  return (R * R.transpose() - Eigen::Matrix3f::Identity()).cwiseAbs().maxCoeff() < 1e-3f;
+}
+
+std::vector<float> compute_board_lrf(const PointSet& cloud, const std::vector<int>& keypoints, double radius_mm,
+                                     BoardStartAxis start) {
+  std::vector<float> out(keypoints.size() * kLrfDim, std::numeric_limits<float>::quiet_NaN());
+  if (keypoints.empty() || !cloud.has_normals() || !(radius_mm > 0)) return out;
+  std::vector<int> finite;
+  std::vector<Vec3f> fpts;
+  for (size_t i = 0; i < cloud.points.size(); ++i)
+    if (cloud.points[i].allFinite()) {
+      finite.push_back(static_cast<int>(i));
+      fpts.push_back(cloud.points[i]);
+    }
+  const KdTree3 tree(fpts);
+  const float r2 = static_cast<float>(radius_mm * radius_mm);
+  Neighbours nn;
+  float row[kLrfDim];
+  for (size_t k = 0; k < keypoints.size(); ++k) {
+    const int p = keypoints[k];
+    if (p < 0 || static_cast<size_t>(p) >= cloud.points.size() || !cloud.points[static_cast<size_t>(p)].allFinite())
+      continue;
+    const Vec3f& q = cloud.points[static_cast<size_t>(p)];
+    tree.within(q, r2, nn);
+    for (auto& e : nn) e.second = finite[static_cast<size_t>(e.second)];
+    if (board_frame(q, cloud, nn, start, row) && usable_frame(row))
+      std::copy(row, row + kLrfDim, out.begin() + static_cast<long>(k) * kLrfDim);
+  }
+  return out;
+}
+
+}  // namespace pb::local
