@@ -127,25 +127,30 @@ void BM_Keypoints(benchmark::State& state) {
   state.counters["keypoints"] = static_cast<double>(n);
 }
 
-// Descriptors at the scene keypoints; threads as the argument.
-void BM_Fpfh(benchmark::State& state) {
+// Descriptors at the scene keypoints; threads as the argument. Each stage
+// of ours has PCL's beside it (the *Pcl benchmarks: the reference
+// implementations kept for the tests), on the same keypoints and cloud.
+using Describe = std::vector<float> (*)(const PointSet&, const std::vector<int>&, double, int);
+void describe_bench(benchmark::State& state, Describe fn) {
   const Fixture& f = fixture();
   const int threads = static_cast<int>(state.range(0));
-  for (auto _ : state)
-    benchmark::DoNotOptimize(local::compute_fpfh(f.scene, f.scene_kp, f.s.local.descriptor_radius_mm, threads).data());
+  for (auto _ : state) benchmark::DoNotOptimize(fn(f.scene, f.scene_kp, f.s.local.descriptor_radius_mm, threads).data());
   state.counters["keypoints"] = static_cast<double>(f.scene_kp.size());
 }
-void BM_Shot(benchmark::State& state) {
-  const Fixture& f = fixture();
-  const int threads = static_cast<int>(state.range(0));
-  for (auto _ : state)
-    benchmark::DoNotOptimize(local::compute_shot(f.scene, f.scene_kp, f.s.local.descriptor_radius_mm, threads).data());
-  state.counters["keypoints"] = static_cast<double>(f.scene_kp.size());
-}
+void BM_Fpfh(benchmark::State& state) { describe_bench(state, local::compute_fpfh); }
+void BM_FpfhPcl(benchmark::State& state) { describe_bench(state, local::compute_fpfh_pcl); }
+void BM_Shot(benchmark::State& state) { describe_bench(state, local::compute_shot); }
+void BM_ShotPcl(benchmark::State& state) { describe_bench(state, local::compute_shot_pcl); }
 void BM_BoardLrf(benchmark::State& state) {
   const Fixture& f = fixture();
   for (auto _ : state)
     benchmark::DoNotOptimize(local::compute_board_lrf(f.scene, f.scene_kp, f.s.local.lrf_radius_mm).data());
+  state.counters["keypoints"] = static_cast<double>(f.scene_kp.size());
+}
+void BM_BoardLrfPcl(benchmark::State& state) {
+  const Fixture& f = fixture();
+  for (auto _ : state)
+    benchmark::DoNotOptimize(local::compute_board_lrf_pcl(f.scene, f.scene_kp, f.s.local.lrf_radius_mm).data());
   state.counters["keypoints"] = static_cast<double>(f.scene_kp.size());
 }
 
@@ -252,8 +257,11 @@ void BM_Online(benchmark::State& state, int d) {
 
 BENCHMARK(BM_Keypoints)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Fpfh)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FpfhPcl)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Shot)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ShotPcl)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_BoardLrf)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_BoardLrfPcl)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Match, fpfh, 0)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Match, shot, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Hough, fpfh, 0)->Unit(benchmark::kMillisecond)->UseRealTime();
