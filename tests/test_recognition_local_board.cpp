@@ -15,31 +15,13 @@
 #include "core/random.h"
 #include "core/rotation.h"
 #include "recognition/local/internal.h"
+#include "test_recognition_local_util.h"
 
 namespace pb {
 namespace {
 
-PointSet noisy_surface(uint64_t seed) {
-  Rng rng(seed);
-  PointSet c;
-  for (double y = -60; y <= 60; y += 4)
-    for (double x = -60; x <= 60; x += 4) {
-      const double px = x + rng.uniform(-1, 1), py = y + rng.uniform(-1, 1);
-      const double g = 25 * std::exp(-((px - 10) * (px - 10) + (py + 5) * (py + 5)) / (2 * 20.0 * 20.0));
-      const double h = 600 + 0.1 * px - g;
-      const double hx = 0.1 + g * (px - 10) / 400.0, hy = g * (py + 5) / 400.0;
-      const Vec3 n = (Vec3(hx, hy, -1).normalized() + Vec3(rng.normal(0, 0.02), rng.normal(0, 0.02), 0)).normalized();
-      c.points.emplace_back(float(px), float(py), float(h + rng.normal(0, 0.3)));
-      c.normals.push_back(n.cast<float>());
-    }
-  return c;
-}
-
-std::vector<int> every_nth(size_t n, size_t step) {
-  std::vector<int> k;
-  for (size_t i = 0; i < n; i += step) k.push_back(static_cast<int>(i));
-  return k;
-}
+using localtest::every_nth;
+using localtest::noisy_surface;
 
 double axis_difference(const std::vector<float>& a, const std::vector<float>& b, size_t r, int axis) {
   double d = 0;
@@ -108,7 +90,7 @@ TEST(LocalBoard, DeterministicStartAxisIsRepeatableAndMovesWithTheSurface) {
   size_t moved_with = 0, interior = 0;
   for (size_t r = 0; r < kp.size(); ++r) {
     const Vec3f p = cloud.points[static_cast<size_t>(kp[r])];
-    if (std::abs(p.x()) > 40 || std::abs(p.y()) > 40) continue;  // border: holes
+    if (std::abs(p.x()) > 60 || std::abs(p.y()) > 60) continue;  // border: holes
     ++interior;
     Eigen::Matrix3f A, B;
     for (int a = 0; a < 3; ++a)

@@ -27,7 +27,6 @@
 #include <cstdlib>
 #include <limits>
 
-#include "recognition/kdtree.h"
 #include "recognition/local/internal.h"
 
 namespace pb::local {
@@ -197,14 +196,7 @@ std::vector<float> compute_board_lrf(const PointSet& cloud, const std::vector<in
                                      BoardStartAxis start) {
   std::vector<float> out(keypoints.size() * kLrfDim, std::numeric_limits<float>::quiet_NaN());
   if (keypoints.empty() || !cloud.has_normals() || !(radius_mm > 0)) return out;
-  std::vector<int> finite;
-  std::vector<Vec3f> fpts;
-  for (size_t i = 0; i < cloud.points.size(); ++i)
-    if (cloud.points[i].allFinite()) {
-      finite.push_back(static_cast<int>(i));
-      fpts.push_back(cloud.points[i]);
-    }
-  const KdTree3 tree(fpts);
+  const CloudNeighbours tree(cloud.points);
   const float r2 = static_cast<float>(radius_mm * radius_mm);
   Neighbours nn;
   float row[kLrfDim];
@@ -214,7 +206,6 @@ std::vector<float> compute_board_lrf(const PointSet& cloud, const std::vector<in
       continue;
     const Vec3f& q = cloud.points[static_cast<size_t>(p)];
     tree.within(q, r2, nn);
-    for (auto& e : nn) e.second = finite[static_cast<size_t>(e.second)];
     if (board_frame(q, cloud, nn, start, row) && usable_frame(row))
       std::copy(row, row + kLrfDim, out.begin() + static_cast<long>(k) * kLrfDim);
   }

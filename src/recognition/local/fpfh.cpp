@@ -28,7 +28,6 @@
 #include <cstdint>
 #include <limits>
 
-#include "recognition/kdtree.h"
 #include "recognition/local/internal.h"
 
 namespace pb::local {
@@ -95,19 +94,10 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
   if (keypoints.empty() || !cloud.has_normals() || !(radius_mm > 0)) return out;
   const std::vector<Vec3f>& pts = cloud.points;
   const int n = static_cast<int>(pts.size());
-  // The tree holds the finite points (search results are cloud indices).
-  std::vector<int> finite;
-  std::vector<Vec3f> fpts;
-  for (int i = 0; i < n; ++i)
-    if (pts[i].allFinite()) {
-      finite.push_back(i);
-      fpts.push_back(pts[i]);
-    }
-  const KdTree3 tree(fpts);
+  const CloudNeighbours tree(pts);
   const float r2 = static_cast<float>(radius_mm * radius_mm);
   const auto neighbours = [&](int p, std::vector<std::pair<float, int>>& nn, bool sorted) {
     tree.within(pts[p], r2, nn, sorted);
-    for (auto& e : nn) e.second = finite[static_cast<size_t>(e.second)];
   };
   const int nthreads = omp_threads(threads);
 

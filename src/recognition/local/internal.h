@@ -16,6 +16,7 @@
 
 #include "core/types.h"
 #include "recognition/cloud.h"
+#include "recognition/kdtree.h"
 
 namespace pb::local {
 
@@ -71,6 +72,21 @@ bool usable_frame(const float* row);
 
 // True if the row holds no NaN / inf.
 bool finite_row(const float* row, int dim);
+
+// The finite points of a cloud in a kd-tree, searched by cloud index: the
+// neighbourhoods of FPFH, SHOT and the BOARD frames (keypoints.cpp).
+class CloudNeighbours {
+ public:
+  explicit CloudNeighbours(const std::vector<Vec3f>& points);
+  // Every finite point with squared distance below r2 (FLANN's strict
+  // radius) as (squared distance, cloud index), sorted by distance then
+  // index unless `sorted` is false (then in tree order).
+  void within(const Vec3f& q, float r2, std::vector<std::pair<float, int>>& out, bool sorted = true) const;
+
+ private:
+  std::vector<int> cloud_index_;  // tree input index -> cloud index
+  KdTree3 tree_;
+};
 
 // Exact nearest neighbour search over descriptors (squared L2 distances),
 // FLANN single kd-tree index. Queries are const and thread-safe.

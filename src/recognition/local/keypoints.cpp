@@ -21,4 +21,23 @@ bool finite_row(const float* row, int dim) {
   return true;
 }
 
+namespace {
+std::vector<Vec3f> finite_points(const std::vector<Vec3f>& points, std::vector<int>& index) {
+  std::vector<Vec3f> out;
+  for (size_t i = 0; i < points.size(); ++i)
+    if (points[i].allFinite()) {
+      index.push_back(static_cast<int>(i));
+      out.push_back(points[i]);
+    }
+  return out;
+}
+}  // namespace
+
+CloudNeighbours::CloudNeighbours(const std::vector<Vec3f>& points) : tree_(finite_points(points, cloud_index_)) {}
+
+void CloudNeighbours::within(const Vec3f& q, float r2, std::vector<std::pair<float, int>>& out, bool sorted) const {
+  tree_.within(q, r2, out, sorted);
+  for (auto& e : out) e.second = cloud_index_[static_cast<size_t>(e.second)];
+}
+
 }  // namespace pb::local

@@ -29,7 +29,6 @@
 #include <cmath>
 #include <limits>
 
-#include "recognition/kdtree.h"
 #include "recognition/local/internal.h"
 
 namespace pb::local {
@@ -209,14 +208,7 @@ std::vector<float> compute_shot(const PointSet& cloud, const std::vector<int>& k
   std::vector<float> out(keypoints.size() * kShotDim, std::numeric_limits<float>::quiet_NaN());
   if (keypoints.empty() || !cloud.has_normals() || !(radius_mm > 0)) return out;
   const std::vector<Vec3f>& pts = cloud.points;
-  std::vector<int> finite;
-  std::vector<Vec3f> fpts;
-  for (size_t i = 0; i < pts.size(); ++i)
-    if (pts[i].allFinite()) {
-      finite.push_back(static_cast<int>(i));
-      fpts.push_back(pts[i]);
-    }
-  const KdTree3 tree(fpts);
+  const CloudNeighbours tree(cloud.points);
   const float r2 = static_cast<float>(radius_mm * radius_mm);
   const long nk = static_cast<long>(keypoints.size());
 #pragma omp parallel num_threads(omp_threads(threads)) if (nk > 16)
@@ -229,7 +221,6 @@ std::vector<float> compute_shot(const PointSet& cloud, const std::vector<int>& k
       if (p < 0 || static_cast<size_t>(p) >= pts.size() || !pts[static_cast<size_t>(p)].allFinite()) continue;
       const Vec3f& q = pts[static_cast<size_t>(p)];
       tree.within(q, r2, nn);
-      for (auto& e : nn) e.second = finite[static_cast<size_t>(e.second)];
       Frame f;
       float* row = out.data() + static_cast<size_t>(k) * kShotDim;
       if (!reference_frame(q, pts, nn, radius_mm, &f, off) || !describe(q, f, cloud, nn, radius_mm, row))
