@@ -31,9 +31,10 @@ constexpr int kLrfDim = 9;     // x, y, z axes (rows of R_local_cam)
 std::vector<int> voxel_keypoints(const PointSet& cloud, double voxel_mm);
 
 // Descriptors at `keypoints` (indices into `cloud`) with the whole cloud as
-// search surface and its normals; row-major, keypoints.size() x dim. Rows
-// PCL could not compute (no neighbours, invalid SHOT reference frame) are NaN.
-// threads: OpenMP threads (0 = all cores). The result does not depend on it.
+// search surface and its normals (fpfh.cpp, shot.cpp: PCL's definitions,
+// our code); row-major, keypoints.size() x dim. Rows that have no
+// descriptor (no neighbours, no SHOT reference frame) are NaN.
+// threads: OpenMP threads (0 = OMP_NUM_THREADS). The result does not depend on it.
 std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& keypoints,
                                 double radius_mm, int threads);
 std::vector<float> compute_shot(const PointSet& cloud, const std::vector<int>& keypoints,
