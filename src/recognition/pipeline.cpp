@@ -83,6 +83,9 @@ void refine_all(std::vector<Hypothesis>& hyps, const std::vector<uint64_t>& stre
     if (e) std::rethrow_exception(e);  // the first failing hypothesis, whatever the thread count
 }
 
+// A hypothesis's score for ranking: NaN (no score) ranks last.
+double score_of(const Hypothesis& h) { return std::isnan(h.score) ? -HUGE_VAL : h.score; }
+
 // Counts every hypothesis's inliers within `threshold_mm` (in parallel; one
 // slot each).
 void count_all(std::vector<Hypothesis>& hyps, const TrainedModel& model, const PointIndex& index,
@@ -108,7 +111,6 @@ std::vector<uint64_t> keep_most_promising(std::vector<Hypothesis>& hyps, const T
   count_all(hyps, model, index, s.verify, s.refine.max_correspondence_mm);
   std::vector<size_t> order(hyps.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  auto score_of = [](const Hypothesis& h) { return std::isnan(h.score) ? -HUGE_VAL : h.score; };
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
     if (hyps[a].inliers != hyps[b].inliers) return hyps[a].inliers > hyps[b].inliers;
     return score_of(hyps[a]) > score_of(hyps[b]);
@@ -132,7 +134,6 @@ std::vector<Hypothesis> verify_and_rank(std::vector<Hypothesis> hyps, const Trai
   count_all(hyps, model, index, v, v.inlier_threshold_mm);
   std::vector<size_t> order(hyps.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  auto score_of = [](const Hypothesis& h) { return std::isnan(h.score) ? -HUGE_VAL : h.score; };
   std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
     const Hypothesis &x = hyps[a], &y = hyps[b];
     if (x.inliers != y.inliers) return x.inliers > y.inliers;
