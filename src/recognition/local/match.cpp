@@ -163,14 +163,22 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
     // smallest of them; their exact distances cap the k-th best (tau0), so
     // only rows with a bound up to tau0 remain candidates.
     float* lbs = G.row(i).data();
+    const float* psq = m.proj_sq.data();
+    for (size_t r = 0; r < m.rows; ++r) lbs[r] = zn + psq[r] - 2.f * lbs[r];  // branch-free: vectorized
     cand.clear();
-    for (size_t r = 0; r < m.rows; ++r) {
-      const float lb = zn + m.proj_sq[r] - 2.f * lbs[r];
-      lbs[r] = lb;
-      if (cand.size() == kk && !(lb < cand.back().first)) continue;
-      if (cand.size() == kk) cand.pop_back();
-      cand.insert(std::upper_bound(cand.begin(), cand.end(), std::make_pair(lb, static_cast<int>(r))),
-                  {lb, static_cast<int>(r)});
+    if (kk == 1) {  // the smallest bound, the lowest row among equal ones
+      size_t arg = 0;
+      for (size_t r = 1; r < m.rows; ++r)
+        if (lbs[r] < lbs[arg]) arg = r;
+      cand.emplace_back(lbs[arg], static_cast<int>(arg));
+    } else {
+      for (size_t r = 0; r < m.rows; ++r) {
+        const float lb = lbs[r];
+        if (cand.size() == kk && !(lb < cand.back().first)) continue;
+        if (cand.size() == kk) cand.pop_back();
+        cand.insert(std::upper_bound(cand.begin(), cand.end(), std::make_pair(lb, static_cast<int>(r))),
+                    {lb, static_cast<int>(r)});
+      }
     }
     float tau0 = 0;
     for (const auto& c : cand)
