@@ -3,6 +3,7 @@
 // clouds.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <limits>
 
 #include "core/random.h"
@@ -105,6 +106,29 @@ TEST(KdTree3, WithinIsStrictAndSortedByDistanceThenIndex) {
   std::vector<std::pair<float, int>> at_bound;
   tree.within(Vec3f(0, 0, 0), 25.f, at_bound);
   for (const auto& e : at_bound) EXPECT_NE(e.second, static_cast<int>(pts.size()) - 1) << "25 is not below 25";
+}
+
+// Long neighbourhoods (thousands of points: the radix-sorted path) come in
+// the same order as short ones: by distance, equal distances by index.
+TEST(KdTree3, LongNeighbourhoodsAreSortedByDistanceThenIndex) {
+  std::vector<Vec3f> pts = random_cloud(6000, 21, 50.f);
+  for (int i = 0; i < 300; ++i) pts.push_back(pts[static_cast<size_t>(i) * 11]);  // equal distances
+  for (int i = 0; i < 200; ++i) pts.emplace_back(0.f, 0.f, static_cast<float>(i % 7));  // more ties
+  const pb::KdTree3 tree(pts);
+  for (const Vec3f& q : {Vec3f(0, 0, 0), Vec3f(10, -5, 3), pts[17]}) {
+    for (float max2 : {2500.f, 1e6f}) {
+      std::vector<std::pair<float, int>> want;
+      for (size_t i = 0; i < pts.size(); ++i) {
+        const float d = (pts[i] - q).squaredNorm();
+        if (d < max2) want.emplace_back(d, static_cast<int>(i));
+      }
+      std::sort(want.begin(), want.end());
+      ASSERT_GT(want.size(), 512u);  // long enough for the radix sort
+      std::vector<std::pair<float, int>> got;
+      tree.within(q, max2, got);
+      EXPECT_EQ(got, want);
+    }
+  }
 }
 
 }  // namespace

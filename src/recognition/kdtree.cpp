@@ -116,6 +116,47 @@ void KdTree3::radius(const Vec3f& q, float r, std::vector<int>& out) const {
   for (const auto& f : found) out.push_back(f.second);
 }
 
+namespace {
+
+// Sorts 64-bit keys ascending: std::sort for short lists, an LSD radix sort
+// (11-bit digits, skipping digits every key shares) for long ones (the
+// neighbourhoods of thousands of points in noisy, dense clouds). The same
+// order either way: the keys are distinct.
+void sort_keys(std::vector<uint64_t>& keys) {
+  constexpr size_t kRadixFrom = 512;
+  if (keys.size() < kRadixFrom) {
+    std::sort(keys.begin(), keys.end());
+    return;
+  }
+  thread_local std::vector<uint64_t> tmp;
+  tmp.resize(keys.size());
+  uint64_t all_or = 0, all_and = ~uint64_t(0);
+  for (uint64_t k : keys) {
+    all_or |= k;
+    all_and &= k;
+  }
+  const uint64_t varying = all_or ^ all_and;  // bits that differ between keys
+  constexpr int kBits = 11;
+  constexpr size_t kBuckets = size_t(1) << kBits;
+  uint32_t count[kBuckets];
+  for (int shift = 0; shift < 64; shift += kBits) {
+    const uint64_t mask = (kBuckets - 1);
+    if (((varying >> shift) & mask) == 0) continue;  // every key has the same digit here
+    std::fill(count, count + kBuckets, 0u);
+    for (uint64_t k : keys) ++count[(k >> shift) & mask];
+    uint32_t sum = 0;
+    for (size_t b = 0; b < kBuckets; ++b) {
+      const uint32_t c = count[b];
+      count[b] = sum;
+      sum += c;
+    }
+    for (uint64_t k : keys) tmp[count[(k >> shift) & mask]++] = k;
+    keys.swap(tmp);
+  }
+}
+
+}  // namespace
+
 void KdTree3::within(const Vec3f& q, float max_sq_dist, std::vector<std::pair<float, int>>& out, bool sorted) const {
   out.clear();
   if (nodes_.empty() || !q.allFinite() || !(max_sq_dist > 0)) return;
@@ -139,7 +180,7 @@ void KdTree3::within(const Vec3f& q, float max_sq_dist, std::vector<std::pair<fl
     }
   };
   visit_radius(0, q, max_sq_dist, add);
-  std::sort(keys.begin(), keys.end());
+  sort_keys(keys);
   out.reserve(keys.size());
   for (uint64_t k : keys) {
     const uint32_t bits = static_cast<uint32_t>(k >> 32);
