@@ -104,7 +104,8 @@ struct Sectors {
 // sector after a hit (a run across sector 0 is one run).
 bool widest_hole(const Sectors& s, float min_cos, float* angle) {
   const bool any_empty = std::find(s.hit.begin(), s.hit.end(), false) != s.hit.end();
-  if (!any_empty) return false;
+  const bool any_hit = std::find(s.hit.begin(), s.hit.end(), true) != s.hit.end();
+  if (!any_empty || !any_hit) return false;  // no hole, or no margin point to bound one
   const int start = s.hit[kSectors - 1] ? 0 : static_cast<int>(std::find(s.hit.begin(), s.hit.end(), true) - s.hit.begin());
   float best = -std::numeric_limits<float>::max();
   for (int ch = start; ch < kSectors; ++ch) {

@@ -98,9 +98,7 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
         if (!std::isfinite(alpha)) continue;
         if (alpha < -M_PI) alpha += static_cast<float>(2 * M_PI);
         else if (alpha > M_PI) alpha -= static_cast<float>(2 * M_PI);
-        // alpha + pi is not below -1 ulp here, so truncation is floor
-        // wherever the clamp does not decide (and no libm floor call).
-        int bin = static_cast<int>((alpha + M_PI) / m.angle_step);
+        int bin = static_cast<int>(std::floor((alpha + M_PI) / m.angle_step));
         bin = std::max(0, std::min(n_alpha - 1, bin));
         const uint32_t cell = it.ref * static_cast<uint32_t>(n_alpha) + static_cast<uint32_t>(bin);
         if (acc[cell]++ == 0) touched.push_back(cell);
