@@ -20,7 +20,14 @@
 // project's own BOARD frames replaced PCL's (plane normal from the covariance,
 // a deterministic hole-search start axis instead of std::rand(): ci 3 FPFH
 // and 3 SHOT estimates moved, the correct ones by at most 0.63 mm (demo: 0.74), demo 1
-// FPFH and 2 SHOT; the same correctness in every record). A change that alters
+// FPFH and 2 SHOT; the same correctness in every record), and when the
+// default lengths became relative to the object's diameter (issue 9: the
+// configs pin voxel, keypoint voxel and Hough bin in mm, Table 4.2; every
+// other length is now a fraction of the LS5's 179.6 mm diameter instead of
+// the mm value meant for 200 mm, about 10% shorter; every estimate moved;
+// ci correct per method before -> after: cesf 2 -> 7, cvfh 4 -> 3, esf 6 ->
+// 6, fpfh 8 -> 7, ourcvfh 4 -> 5, ppf 8 -> 7, shot 6 -> 7 of 10; demo: cesf
+// 1 -> 3, cvfh 1 -> 1, fpfh 3 -> 2, shot 2 -> 3 of 4). A change that alters
 // results on purpose updates those files and says why in its commit.
 #include <gtest/gtest.h>
 

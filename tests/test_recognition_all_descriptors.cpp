@@ -79,6 +79,11 @@ const std::map<std::string, int> kMinCorrect = {
 // the 30 images of seed 34: 21, 24, 27 of 30). So ESF is not at the thesis's
 // 0% even with 12 views on this object, and more views do help: with 80
 // views it must do strictly better than with 12. Margin: 2 images.
+// These counts are at the stage headers' mm values (voxel 10 mm, ...). At
+// the relative default profile (the bunny's diameter is 191 mm: voxel 9.6
+// mm, inlier threshold 9.6 mm, cluster tolerance 19 mm, ...) the same set
+// gave 7, 8, 7 of 8 (measured once): 12 views already find 7, so on these
+// 8 images the comparison would say nothing.
 const std::map<int, int> kEsfMinCorrect = {{12, 3}, {40, 5}, {80, 5}};
 
 struct SceneSet {
@@ -208,6 +213,7 @@ TEST_F(AllDescriptors, EsfWithMoreTrainingViews) {
   std::map<int, Outcome> outcomes;
   for (const auto& [views, min_correct] : kEsfMinCorrect) {
     RecognitionSettings s;
+    s.relative.clear();  // the thesis's mm values these counts were measured with (see kEsfMinCorrect)
     s.descriptor = "esf";
     s.refinement = "icp";
     s.views.views = views;

@@ -26,6 +26,7 @@ pb::RecognitionSettings small_settings(const std::string& descriptor, const std:
   s.refinement = refinement;
   s.views.views = 8;
   s.views.resolution = 128;
+  s.relative.clear();  // the stage headers' mm values (the L block is about as large as the thesis's objects)
   return s;
 }
 

@@ -114,9 +114,9 @@ std::set<std::string> allowed_keys(const std::string& section) {
 TEST(Settings, JsonHasEveryFieldEveryParserAccepts) {
   const auto j = nlohmann::json::parse(pb::settings_to_json(pb::RecognitionSettings{}));
   for (const char* top : {"descriptor", "refinement", "views", "preprocess", "local", "global", "ppf", "refine",
-                          "verify", "seed"})
+                          "verify", "scale", "seed"})
     EXPECT_TRUE(j.contains(top)) << top;
-  for (const char* sec : {"views", "preprocess", "local", "global", "ppf", "refine", "verify"}) {
+  for (const char* sec : {"views", "preprocess", "local", "global", "ppf", "refine", "verify", "scale"}) {
     std::set<std::string> in_json;
     for (auto it = j[sec].begin(); it != j[sec].end(); ++it) in_json.insert(it.key());
     EXPECT_EQ(in_json, allowed_keys(sec)) << "section " << sec
@@ -143,6 +143,89 @@ TEST(Settings, JsonRoundTripsThroughTheParsers) {
   const auto s = parse(j.dump());
   EXPECT_EQ(nlohmann::json::parse(pb::settings_to_json(s)), j);
   EXPECT_NE(pb::settings_to_json(s), pb::settings_to_json(pb::RecognitionSettings{}));
+}
+
+// Lengths relative to the object's diameter (issue 9): "0.05d" in YAML, the
+// default profile, resolution with the sensor's floor.
+TEST(RelativeLengths, TheDefaultProfileGivesTheHeaderValuesAt200mm) {
+  const pb::RecognitionSettings d;
+  EXPECT_EQ(d.relative.at("preprocess.voxel_mm"), 0.05);
+  const pb::RecognitionSettings r = pb::resolve_lengths(d, 200);
+  EXPECT_TRUE(r.relative.empty());
+  pb::RecognitionSettings header = d;
+  header.relative.clear();
+  EXPECT_EQ(pb::settings_to_json(r), pb::settings_to_json(header));
+  // ... and scales with the object: 30x smaller, 30x shorter.
+  const pb::RecognitionSettings small = pb::resolve_lengths(d, 50);
+  EXPECT_DOUBLE_EQ(small.preprocess.voxel_mm, 2.5);
+  EXPECT_DOUBLE_EQ(small.local.descriptor_radius_mm, 15);
+  EXPECT_DOUBLE_EQ(small.verify.inlier_threshold_mm, 2.5);
+  const pb::RecognitionSettings large = pb::resolve_lengths(d, 1500);
+  EXPECT_DOUBLE_EQ(large.local.hough_bin_mm, 375);
+  EXPECT_DOUBLE_EQ(large.refine.max_correspondence_mm, 150);
+  // Counts, angles and ranges are not lengths of the object.
+  EXPECT_EQ(large.ppf.model_points, d.ppf.model_points);
+  EXPECT_EQ(large.preprocess.max_range_mm, d.preprocess.max_range_mm);
+}
+
+TEST(RelativeLengths, YamlGivesEitherMmOrAFractionOfTheDiameter) {
+  const auto s = parse("preprocess: {voxel_mm: 12}\nlocal: {hough_bin_mm: 0.4d}\nscale: {diameter_mm: 300}\n");
+  EXPECT_EQ(s.relative.count("preprocess.voxel_mm"), 0u);
+  EXPECT_EQ(s.relative.at("local.hough_bin_mm"), 0.4);
+  const auto r = pb::resolve_lengths(s, 99);  // scale.diameter_mm wins over the model's
+  EXPECT_EQ(r.preprocess.voxel_mm, 12);
+  EXPECT_DOUBLE_EQ(r.local.hough_bin_mm, 120);
+  EXPECT_DOUBLE_EQ(r.local.descriptor_radius_mm, 90);  // default 0.3d
+  // The JSON writes relative fields back as they were given, and parses back.
+  const auto j = nlohmann::json::parse(pb::settings_to_json(s));
+  EXPECT_EQ(j["local"]["hough_bin_mm"], "0.4d");
+  EXPECT_EQ(j["preprocess"]["voxel_mm"], 12);
+  EXPECT_EQ(pb::settings_to_json(parse(j.dump())), pb::settings_to_json(s));
+  // A base's mm value under a later "0.05d" becomes relative again.
+  const auto again = parse("preprocess: {voxel_mm: 0.05d}\n", s);
+  EXPECT_DOUBLE_EQ(pb::resolve_lengths(again, 0).preprocess.voxel_mm, 15);
+}
+
+TEST(RelativeLengths, TheSensorsFloorAndTheCasesThatCannotResolve) {
+  pb::RecognitionSettings s;
+  s.scale.min_length_mm = 4;
+  const auto r = pb::resolve_lengths(s, 50);  // a 5 cm part: voxel 2.5 mm -> the 4 mm floor
+  EXPECT_EQ(r.preprocess.voxel_mm, 4);
+  EXPECT_DOUBLE_EQ(r.local.descriptor_radius_mm, 15);  // above the floor
+  // The floor from an image: 2 px at the median depth 1000 mm with fx 500.
+  pb::Intrinsics K;
+  K.fx = K.fy = 500;
+  K.width = 4;
+  K.height = 1;
+  pb::DepthImage im;
+  im.width = 4;
+  im.height = 1;
+  im.z = {900, 1000, 0, 1100};
+  EXPECT_DOUBLE_EQ(pb::sensor_length_floor_mm(s.scale, im, K), 4.0);
+  const auto f = pb::resolve_lengths_for_sensor(pb::RecognitionSettings{}, 50, im, K);
+  EXPECT_DOUBLE_EQ(f.scale.min_length_mm, 4.0);
+  EXPECT_DOUBLE_EQ(f.preprocess.voxel_mm, 4.0);
+  // No diameter: an input error naming scale.diameter_mm.
+  try {
+    pb::resolve_lengths(pb::RecognitionSettings{}, 0);
+    ADD_FAILURE() << "resolved without a diameter";
+  } catch (const pb::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("scale.diameter_mm"), std::string::npos) << e.what();
+  }
+  // A number set in code on a field that is still relative is not ignored.
+  pb::RecognitionSettings code;
+  code.preprocess.voxel_mm = 8;
+  EXPECT_THROW(pb::resolve_lengths(code, 200), std::logic_error);
+  code.relative.erase("preprocess.voxel_mm");
+  EXPECT_EQ(pb::resolve_lengths(code, 200).preprocess.voxel_mm, 8);
+}
+
+TEST(RelativeLengths, BadFractionsNameTheKey) {
+  expect_input_error("preprocess: {voxel_mm: -0.05d}\n", "preprocess.voxel_mm", "positive fraction");
+  expect_input_error("preprocess: {voxel_mm: 0d}\n", "preprocess.voxel_mm", "positive fraction");
+  expect_input_error("local: {hough_bin_mm: 0.1dd}\n", "local.hough_bin_mm", "malformed");
+  // Not a length: a fraction is malformed there.
+  expect_input_error("local: {hough_min_votes: 0.1d}\n", "local.hough_min_votes", "malformed");
 }
 
 TEST(Settings, NamesAreTheIssuesList) {

@@ -252,9 +252,11 @@ static pb::cli::Command recognize_cmd(
       pb::TrainOptions topt;
       topt.cache_dir = o.cache;
       bool from_cache = false;
-      const auto model = pb::train_model(obj.cloud.empty() ? pb::training_views(mesh, s.views, model_name)
-                                                           : pb::cloud_training_views(obj.cloud, model_name),
-                                         s, topt, &from_cache);
+      const pb::TrainingViews views = obj.cloud.empty() ? pb::training_views(mesh, s.views, model_name)
+                                                        : pb::cloud_training_views(obj.cloud, model_name);
+      // Relative lengths in mm: the model's diameter, the sensor's floor at this image.
+      if (!views.views.empty()) s = pb::resolve_lengths_for_sensor(s, pb::training_views_diameter(views), depth, im.K);
+      const auto model = pb::train_model(views, s, topt, &from_cache);
       const double train_s = train_timer.seconds();
       const pb::RecognitionResult res = pb::recognize(depth, im.K, *model, s);
       const Evaluation ev = evaluate(res, im, obj_id, info, thr);

@@ -1,5 +1,7 @@
 #include "core/settings_fields.h"
 
+#include <cmath>
+#include <cstdlib>
 #include <sstream>
 
 namespace pb::fields {
@@ -34,6 +36,22 @@ void check(const YamlNode& node, double v, const Rule& r) {
   }
   if (r.max > 0 && v > r.max) node.fail("must be at most " + num(r.max) + r.unit + ", got " + num(v));
 }
+
+bool parse_relative(const YamlNode& node, const std::string& text, double* fraction) {
+  if (text.size() < 2 || text.back() != 'd') return false;
+  const std::string number = text.substr(0, text.size() - 1);
+  char* end = nullptr;
+  const double f = std::strtod(number.c_str(), &end);
+  if (end != number.c_str() + number.size() || number.find_first_of(" \t") != std::string::npos)
+    return false;
+  if (!(f > 0) || !std::isfinite(f))
+    node.fail("a length relative to the object's diameter must be a positive fraction followed by d (e.g. "
+              "0.05d), got '" + text + "'");
+  *fraction = f;
+  return true;
+}
+
+std::string relative_text(double fraction) { return nlohmann::json(fraction).dump() + "d"; }
 
 void check(const YamlNode& node, const std::string& v, const Rule& r) {
   if (r.kind != Rule::kOneOf) return;

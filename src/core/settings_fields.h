@@ -16,10 +16,18 @@
 // The rules give the messages the project's parsers always gave ("must be
 // positive, got -3", "must be in [0, 1]", ...), with file, line and key
 // through YamlNode::fail.
+//
+// A length field (rule wrapped in fields::length) may also be given as a
+// fraction of the object's diameter, `voxel_mm: 0.05d`, when the caller
+// passes a `relative` map: the fraction is kept there under "PREFIX.key" and
+// the field's number is left as it is until the caller resolves it (see
+// recognition/settings.h, resolve_lengths); a number given in mm removes the
+// entry. The JSON form writes such a field back as "0.05d".
 #pragma once
 
 #include <nlohmann/json.hpp>
 
+#include <map>
 #include <set>
 #include <string>
 #include <type_traits>
@@ -36,6 +44,7 @@ struct Rule {
   std::vector<std::string> names;  // kOneOf
   double max = 0;                  // > 0: also "must be at most max" (kPositive, kNonnegative)
   std::string unit;                // appended to "at most" messages, e.g. " degrees"
+  bool length = false;             // a length: may be a fraction of the diameter ("0.05d")
 };
 
 inline Rule any() { return {}; }
@@ -46,6 +55,17 @@ inline Rule nonnegative(double max = 0, std::string unit = "") {
 inline Rule at_least(double lo, double max = 0) { return {Rule::kAtLeast, lo, 0, {}, max, ""}; }
 inline Rule in_range(double lo, double hi) { return {Rule::kRange, lo, hi, {}, 0, ""}; }
 inline Rule one_of(std::vector<std::string> names) { return {Rule::kOneOf, 0, 0, std::move(names), 0, ""}; }
+// A length in mm that may also be written as a fraction of the diameter.
+inline Rule length(Rule r) {
+  r.length = true;
+  return r;
+}
+
+// "0.05d" -> 0.05; false when `text` is not of that form. A form with a
+// fraction that is not a positive finite number fails at `node`.
+bool parse_relative(const YamlNode& node, const std::string& text, double* fraction);
+// 0.05 -> "0.05d" (shortest round-trip form).
+std::string relative_text(double fraction);
 
 // Checks a read value; fails at `node` (the field's node).
 void check(const YamlNode& node, double v, const Rule& r);
@@ -61,10 +81,24 @@ struct KeyLister {
 
 struct Reader {
   const YamlNode& node;
+  std::map<std::string, double>* relative = nullptr;  // "PREFIX.key" -> fraction (length fields)
+  std::string prefix;
+  std::set<std::string>* given_relative = nullptr;    // the keys this section gave as fractions
   template <typename T>
   void operator()(const char* key, T& v, const Rule& r = {}) {
     if (!node.has(key)) return;
     const YamlNode n = node[key];
+    if constexpr (std::is_floating_point_v<T>) {
+      if (r.length && relative) {
+        double fraction = 0;
+        if (parse_relative(n, n.as<std::string>(), &fraction)) {
+          (*relative)[prefix + key] = fraction;
+          if (given_relative) given_relative->insert(prefix + key);
+          return;
+        }
+        relative->erase(prefix + key);
+      }
+    }
     if constexpr (std::is_same_v<T, bool>) {
       v = n.as<bool>();
     } else if constexpr (std::is_same_v<T, std::string>) {
@@ -82,8 +116,17 @@ struct Reader {
 
 struct JsonWriter {
   nlohmann::ordered_json j = nlohmann::ordered_json::object();
+  const std::map<std::string, double>* relative = nullptr;
+  std::string prefix;
   template <typename T>
   void operator()(const char* key, const T& v, const Rule& = {}) {
+    if (relative) {
+      const auto it = relative->find(prefix + key);
+      if (it != relative->end()) {
+        j[key] = relative_text(it->second);
+        return;
+      }
+    }
     j[key] = v;
   }
 };
@@ -97,21 +140,28 @@ struct has_validate<S, std::void_t<decltype(std::declval<const S&>().validate(st
 }  // namespace fields
 
 // Reads a YAML section over `s` (fields not given keep their values).
+// `relative` (optional): where length fields given as "0.05d" go, under
+// "PREFIX.key" (see fields::length).
+// `given_relative` (optional) collects the keys given as fractions here.
 template <typename S>
-void parse_section(const YamlNode& node, S& s) {
+void parse_section(const YamlNode& node, S& s, std::map<std::string, double>* relative = nullptr,
+                   const std::string& prefix = "", std::set<std::string>* given_relative = nullptr) {
   if (!node.defined()) return;
   fields::KeyLister keys;
   S::fields(s, keys);
   node.check_keys(keys.keys);
-  fields::Reader reader{node};
+  fields::Reader reader{node, relative, prefix, given_relative};
   S::fields(s, reader);
   if constexpr (fields::has_validate<S>::value) s.validate(node);
 }
 
-// Every field, in declaration order.
+// Every field, in declaration order; fields in `relative` as "0.05d".
 template <typename S>
-nlohmann::ordered_json section_json(const S& s) {
+nlohmann::ordered_json section_json(const S& s, const std::map<std::string, double>* relative = nullptr,
+                                    const std::string& prefix = "") {
   fields::JsonWriter w;
+  w.relative = relative;
+  w.prefix = prefix;
   S::fields(s, w);
   return std::move(w.j);
 }

@@ -54,6 +54,9 @@ struct TrainingViews {
   std::string model_name;            // for messages and cache file names
   std::vector<TrainingView> views;
   std::string empty_reason;          // set when views is empty
+  double diameter_mm = 0;            // the model's diameter (mm), what relative lengths ("0.05d")
+                                     // refer to; 0 = unknown (train_model then takes the
+                                     // bounding-box diagonal of the views in the model frame)
 };
 
 }  // namespace pb

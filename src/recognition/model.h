@@ -17,7 +17,8 @@ class TrainedModel {
  public:
   std::string model_name;
   std::string descriptor;
-  RecognitionSettings settings;          // the settings it was trained with
+  RecognitionSettings settings;          // the settings it was trained with (lengths in mm)
+  double diameter_mm = 0;                // what its relative lengths were resolved with
   std::unique_ptr<Method> method;        // null when there is nothing to recognize
   std::string empty_reason;              // why method is null
   std::vector<ViewData> views;           // preprocessed training views (view camera frame)

@@ -205,13 +205,14 @@ void refine_verify_accept(std::vector<Hypothesis> hyps, const TrainedModel& mode
 }  // namespace
 
 RecognitionResult recognize(const DepthImage& depth, const Intrinsics& K, const TrainedModel& model,
-                            const RecognitionSettings& s) {
+                            const RecognitionSettings& settings) {
   RecognitionResult res;
-  check_call(depth, K, model, s);
+  check_call(depth, K, model, settings);
   if (!model.method) {
     res.message = "empty model: " + model.empty_reason;
     return res;
   }
+  const RecognitionSettings s = resolve_lengths(settings, model.diameter_mm);
   const PointSet scene = prepare_scene(depth, K, s, res);
   if (scene.empty()) return res;
 
@@ -229,13 +230,14 @@ RecognitionResult recognize(const DepthImage& depth, const Intrinsics& K, const 
 }
 
 RecognitionResult refine_from(const DepthImage& depth, const Intrinsics& K, const TrainedModel& model,
-                              const RecognitionSettings& s, const Pose& init) {
+                              const RecognitionSettings& settings, const Pose& init) {
   RecognitionResult res;
-  check_call(depth, K, model, s);
+  check_call(depth, K, model, settings);
   if (model.views.empty()) {
     res.message = "empty model: " + model.empty_reason;
     return res;
   }
+  const RecognitionSettings s = resolve_lengths(settings, model.diameter_mm);
   const PointSet scene = prepare_scene(depth, K, s, res);
   if (scene.empty()) return res;
   std::vector<Hypothesis> hyps(1);

@@ -27,6 +27,12 @@ struct TrainOptions {
   std::string cache_dir;   // "" = no cache; else DIR/<model>-<descriptor>-<key>.bin, key = FNV-1a of the
                            // training views (as data) and the settings training reads
 };
+// The diameter relative lengths ("0.05d") refer to: views.diameter_mm (the
+// mesh's), else the diagonal of the bounding box of every view point in the
+// model frame (a model given as a point cloud).
+double training_views_diameter(const TrainingViews& views);
+
+// Resolves relative lengths for the model (training_views_diameter) first.
 // Never throws for empty input: a model without views is empty (recognize
 // then answers no_hypothesis with the reason).
 std::shared_ptr<const TrainedModel> train_model(const TrainingViews& views, const RecognitionSettings& s,

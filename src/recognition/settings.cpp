@@ -2,12 +2,19 @@
 // parsed and serialized from its own field list.
 #include "recognition/settings.h"
 
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <type_traits>
+
+#include "core/error.h"
 #include "recognition/registry.h"
 
 namespace pb {
 
 const std::vector<std::string>& recognition_sections() {
-  static const std::vector<std::string> v{"views", "preprocess", "local", "global", "ppf", "refine", "verify"};
+  static const std::vector<std::string> v{"views", "preprocess", "local",  "global",
+                                          "ppf",   "refine",     "verify", "scale"};
   return v;
 }
 
@@ -22,6 +29,78 @@ void for_each_section(RecognitionSettings& s, F&& f) {
   f("ppf", s.ppf);
   f("refine", s.refine);
   f("verify", s.verify);
+  f("scale", s.scale);
+}
+
+// Sets every relative field of a section to fraction x d (at least floor).
+struct Resolver {
+  const std::map<std::string, double>& relative;
+  std::string prefix;
+  double d = 0, floor = 0;
+  template <typename T>
+  void operator()(const char* key, T& v, const fields::Rule& = {}) {
+    if constexpr (std::is_floating_point_v<T>) {
+      const auto it = relative.find(prefix + key);
+      if (it != relative.end()) v = std::max(it->second * d, floor);
+    }
+  }
+};
+
+
+// Every length field's value in a default-constructed RecognitionSettings
+// ("section.key" -> mm): the placeholder a relative field holds until it is
+// resolved.
+struct LengthCollector {
+  std::map<std::string, double>& out;
+  std::string prefix;
+  template <typename T>
+  void operator()(const char* key, const T& v, const fields::Rule& r = {}) {
+    if constexpr (std::is_floating_point_v<T>)
+      if (r.length) out[prefix + key] = v;
+  }
+};
+const std::map<std::string, double>& placeholders() {
+  static const std::map<std::string, double> m = [] {
+    std::map<std::string, double> out;
+    RecognitionSettings d;
+    for_each_section(d, [&](const char* name, auto& section) {
+      LengthCollector c{out, std::string(name) + "."};
+      std::decay_t<decltype(section)>::fields(section, c);
+    });
+    return out;
+  }();
+  return m;
+}
+
+// Sets the fields of `keys` to their placeholders, or (with `check`)
+// compares every relative field with its placeholder.
+struct PlaceholderVisitor {
+  const std::map<std::string, double>& relative;
+  const std::set<std::string>& keys;
+  std::string prefix;
+  bool check = false;
+  template <typename T>
+  void operator()(const char* key, T& v, const fields::Rule& = {}) {
+    if constexpr (std::is_floating_point_v<T>) {
+      const std::string k = prefix + key;
+      if (!(check ? relative.count(k) : keys.count(k))) return;
+      const double p = placeholders().at(k);
+      if (!check) {
+        v = p;
+      } else if (v != p) {
+        throw std::logic_error("settings: " + k + " was set to " + std::to_string(v) + " mm in code but is still "
+                               "relative (" + fields::relative_text(relative.at(k)) + "); erase \"" + k +
+                               "\" from RecognitionSettings::relative to use mm");
+      }
+    }
+  }
+};
+
+void visit_placeholders(RecognitionSettings& s, const std::set<std::string>& keys, bool check) {
+  for_each_section(s, [&](const char* name, auto& section) {
+    PlaceholderVisitor v{s.relative, keys, std::string(name) + ".", check};
+    std::decay_t<decltype(section)>::fields(section, v);
+  });
 }
 
 }  // namespace
@@ -35,13 +114,17 @@ RecognitionSettings parse_recognition_settings(const YamlNode& node, Recognition
   node.check_keys(keys);
   if (node.has("descriptor")) s.descriptor = check_name(node["descriptor"], descriptor_names());
   if (node.has("refinement")) s.refinement = check_name(node["refinement"], refinement_names());
-  for_each_section(s, [&](const char* name, auto& section) { parse_section(node[name], section); });
+  std::set<std::string> given_relative;
+  for_each_section(s, [&](const char* name, auto& section) {
+    parse_section(node[name], section, &s.relative, std::string(name) + ".", &given_relative);
+  });
   if (node.has("seed")) {
     const YamlNode n = node["seed"];
     const std::string text = n.as<std::string>();
     if (text.empty() || text[0] == '-') n.fail("must be a non-negative integer");
     s.seed = n.as<unsigned long long>();
   }
+  visit_placeholders(s, given_relative, false);  // a base's mm value under a later "0.05d" is no number set in code
   return s;
 }
 
@@ -50,9 +133,65 @@ nlohmann::ordered_json recognition_settings_json(const RecognitionSettings& sett
   nlohmann::ordered_json j;
   j["descriptor"] = s.descriptor;
   j["refinement"] = s.refinement;
-  for_each_section(s, [&](const char* name, const auto& section) { j[name] = section_json(section); });
+  for_each_section(s, [&](const char* name, const auto& section) {
+    j[name] = section_json(section, &s.relative, std::string(name) + ".");
+  });
   j["seed"] = s.seed;
   return j;
+}
+
+const std::map<std::string, double>& default_relative_lengths() {
+  static const std::map<std::string, double> m{
+      {"preprocess.voxel_mm", 0.05},           {"preprocess.plane_threshold_mm", 0.05},
+      {"preprocess.normal_radius_mm", 0.10},   {"local.keypoint_voxel_mm", 0.075},
+      {"local.descriptor_radius_mm", 0.30},    {"local.lrf_radius_mm", 0.20},
+      {"local.hough_bin_mm", 0.25},            {"global.cluster_tolerance_mm", 0.10},
+      {"global.cvfh_cluster_tolerance_mm", 0.075}, {"global.cvfh_normal_radius_mm", 0.10},
+      {"ppf.position_cluster_mm", 0.15},       {"refine.max_correspondence_mm", 0.10},
+      {"refine.ndt_resolution_mm", 0.15},      {"refine.ndt_step_size_mm", 0.40},
+      {"verify.inlier_threshold_mm", 0.05},
+  };
+  return m;
+}
+
+RecognitionSettings resolve_lengths(const RecognitionSettings& in, double model_diameter_mm) {
+  RecognitionSettings s = in;
+  if (s.relative.empty()) return s;
+  visit_placeholders(s, {}, true);
+  const double d = s.scale.diameter_mm > 0 ? s.scale.diameter_mm : model_diameter_mm;
+  if (!(d > 0) || !std::isfinite(d))
+    throw InputError("settings", "scale.diameter_mm",
+                     "'" + s.relative.begin()->first + "' is relative to the object's diameter, which is unknown "
+                     "here: give scale.diameter_mm or the length in mm");
+  for_each_section(s, [&](const char* name, auto& section) {
+    Resolver r{s.relative, std::string(name) + ".", d, s.scale.min_length_mm};
+    std::decay_t<decltype(section)>::fields(section, r);
+  });
+  s.relative.clear();
+  return s;
+}
+
+double sensor_length_floor_mm(const ScaleSettings& scale, const DepthImage& image, const Intrinsics& K) {
+  if (!(scale.sensor_floor_px > 0) || !(K.fx > 0)) return 0;
+  double z = scale.working_distance_mm;
+  if (!(z > 0)) {
+    std::vector<float> valid;
+    valid.reserve(image.z.size());
+    for (const float v : image.z)
+      if (v > 0 && std::isfinite(v)) valid.push_back(v);
+    if (valid.empty()) return 0;
+    std::nth_element(valid.begin(), valid.begin() + static_cast<std::ptrdiff_t>(valid.size() / 2), valid.end());
+    z = valid[valid.size() / 2];
+  }
+  return scale.sensor_floor_px * z / K.fx;
+}
+
+RecognitionSettings resolve_lengths_for_sensor(const RecognitionSettings& in, double model_diameter_mm,
+                                               const DepthImage& image, const Intrinsics& K) {
+  if (in.relative.empty()) return in;
+  RecognitionSettings s = in;
+  if (!(s.scale.min_length_mm > 0)) s.scale.min_length_mm = sensor_length_floor_mm(s.scale, image, K);
+  return resolve_lengths(s, model_diameter_mm);
 }
 
 std::string settings_to_json(const RecognitionSettings& s) { return recognition_settings_json(s).dump(); }

@@ -1,6 +1,17 @@
 // RecognitionSettings: one struct per stage, each mirrored one to one by a
 // YAML section of the same name (views, preprocess, local, global, ppf,
-// refine, verify), plus the descriptor and refinement names and the seed. Every
+// refine, verify), plus the descriptor and refinement names, the seed and
+// the `scale` section that says what relative lengths refer to.
+//
+// Lengths scale with the object: every length field may be given in mm
+// (`voxel_mm: 10`) or as a fraction of the object's diameter (`voxel_mm:
+// 0.05d`), and the default profile is relative (default_relative_lengths()).
+// train_model, recognize and refine_from resolve them to mm for their model
+// (resolve_lengths) before any stage sees them; records carry the resolved
+// values. In code, a length set in mm must also leave `relative`
+// (`s.relative.erase("preprocess.voxel_mm")`, or `s.relative.clear()` for
+// the stage headers' mm values): resolve_lengths throws std::logic_error for
+// a relative field whose number was changed, rather than ignore it. Every
 // field is declared once in its stage header, with its comment and its
 // `fields` entry, from which parsing, key checks and JSON derive
 // (core/settings_fields.h). PCL-free.
@@ -8,11 +19,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "core/training_views.h"
+#include "core/types.h"
 #include "core/yaml.h"
 #include "recognition/global/global.h"
 #include "recognition/local/local.h"
@@ -22,6 +35,34 @@
 #include "recognition/verify/verify.h"
 
 namespace pb {
+
+// What relative lengths ("0.05d") refer to, and the floor the sensor sets.
+struct ScaleSettings {
+  double diameter_mm = 0;          // the diameter d of "0.05d"; 0 = the model's (its models_info
+                                   // diameter, or the extent of its training views)
+  double min_length_mm = 0;        // no relative length resolves below this (mm); 0 = none, or
+                                   // the sensor's floor when the caller knows the sensor
+                                   // (sensor_floor_px below)
+  double sensor_floor_px = 2.0;    // the sensor's floor: this many pixel footprints at the working
+                                   // distance (the runner and `recognize` set min_length_mm from
+                                   // it when min_length_mm is 0; 0 = no floor)
+  double working_distance_mm = 0;  // where the object is seen (mm); 0 = the median valid depth of
+                                   // the scene's first image
+
+  template <class S, class F>
+  static void fields(S& s, F& f) {
+    f("diameter_mm", s.diameter_mm, fields::nonnegative());
+    f("min_length_mm", s.min_length_mm, fields::nonnegative());
+    f("sensor_floor_px", s.sensor_floor_px, fields::nonnegative());
+    f("working_distance_mm", s.working_distance_mm, fields::nonnegative());
+  }
+};
+
+// The default profile: "section.field" -> fraction of the diameter. At a
+// diameter of 200 mm (the thesis's 10-20 cm objects: the LS5 is 180 mm) it
+// gives the values of the stage headers (voxel 10 mm, descriptor radius 60,
+// Hough bin 50, ...).
+const std::map<std::string, double>& default_relative_lengths();
 
 struct RecognitionSettings {
   std::string descriptor = "fpfh";   // fpfh shot cvfh esf cesf ourcvfh ppf (registry.h)
@@ -34,10 +75,34 @@ struct RecognitionSettings {
   PpfSettings ppf;                   // ppf
   RefineSettings refine;             // every refinement method
   VerifySettings verify;             // inlier counting, acceptance
+  ScaleSettings scale;               // what relative lengths refer to
   uint64_t seed = 1;                 // seeds every random choice of the call
+  // Length fields given relative to the diameter, "section.field" ->
+  // fraction; empty once resolved. Their numbers in the sections are
+  // placeholders until then.
+  std::map<std::string, double> relative = default_relative_lengths();
 };
 
-// The stage sections, in order.
+// Every relative length in mm: fraction x d, d = scale.diameter_mm if > 0
+// else model_diameter_mm, but at least scale.min_length_mm. Returns the
+// settings with `relative` empty. InputError when a relative length remains
+// and d is not positive.
+RecognitionSettings resolve_lengths(const RecognitionSettings& s, double model_diameter_mm);
+
+// The sensor's floor for relative lengths: scale.sensor_floor_px pixel
+// footprints (working distance / fx) at the working distance
+// (scale.working_distance_mm, else the median valid depth of `image`). 0
+// when there is none (no valid depth, sensor_floor_px 0).
+double sensor_length_floor_mm(const ScaleSettings& scale, const DepthImage& image, const Intrinsics& K);
+
+// resolve_lengths with the sensor's floor: when scale.min_length_mm is 0 it
+// becomes sensor_length_floor_mm(scale, image, K) first. The runner passes
+// the first image of the trial's scene, so every image of a scene resolves
+// alike (and shares one trained model).
+RecognitionSettings resolve_lengths_for_sensor(const RecognitionSettings& s, double model_diameter_mm,
+                                               const DepthImage& image, const Intrinsics& K);
+
+// The stage sections, in order (and `scale`).
 const std::vector<std::string>& recognition_sections();
 
 // Reads the YAML keys descriptor, refinement, seed and the stage sections

@@ -53,19 +53,35 @@ TrainedModelInfo trained_model_info(const TrainedModel& m) {
   return i;
 }
 
-std::shared_ptr<const TrainedModel> train_model(const TrainingViews& input, const RecognitionSettings& s,
+double training_views_diameter(const TrainingViews& input) {
+  if (input.diameter_mm > 0) return input.diameter_mm;
+  Eigen::AlignedBox3f box;
+  for (const auto& v : input.views) {
+    const Pose T_model_cam = v.T_cam_model.inverse();
+    const Eigen::Matrix3f R = T_model_cam.R.cast<float>();
+    const Vec3f t = T_model_cam.t.cast<float>();
+    for (const Vec3f& p : v.cloud.points)
+      if (p.allFinite() && p.z() > 0) box.extend(R * p + t);
+  }
+  return box.isEmpty() ? 0.0 : static_cast<double>(box.diagonal().norm());
+}
+
+std::shared_ptr<const TrainedModel> train_model(const TrainingViews& input, const RecognitionSettings& settings,
                                                 const TrainOptions& opt, bool* from_cache) {
   if (from_cache) *from_cache = false;
-  descriptor_entry(s.descriptor);  // InputError for unknown names
+  descriptor_entry(settings.descriptor);  // InputError for unknown names
   auto m = std::make_shared<TrainedModel>();
   m->model_name = input.model_name;
-  m->descriptor = s.descriptor;
-  m->settings = s;
+  m->diameter_mm = training_views_diameter(input);
+  m->descriptor = settings.descriptor;
   if (input.views.empty()) {
+    m->settings = settings;
     m->empty_reason = input.empty_reason.empty() ? "no training views of model '" + input.model_name + "'"
                                                  : input.empty_reason;
     return m;
   }
+  const RecognitionSettings s = resolve_lengths(settings, m->diameter_mm);
+  m->settings = s;
 
   const cache::Key key = cache::training_key(input, s);
   FileLock training_lock;

@@ -137,11 +137,17 @@ void run(TrialRecord& rec, const TrialContext& ctx) {
   rec.obj_id = obj_id;
   const SceneInfo scene = ds.load_scene(rec.split, rec.scene_id);
   const ImageInfo& im = scene.images.at(rec.im_id);
-  DepthImage depth = ds.load_depth(rec.split, rec.scene_id, im);
+  const DepthImage depth_clean = ds.load_depth(rec.split, rec.scene_id, im);
+  DepthImage depth = depth_clean;
   add_noise(depth, rec.added_noise_mm, rec.seed);
 
-  RecognitionSettings s =
-      parse_recognition_settings(YamlNode::load_string(rec.settings.dump(), "trial " + rec.key));
+  // Relative lengths in mm, for the object's diameter and the sensor's floor
+  // at the scene's first image (the same for every image of the scene).
+  const ImageInfo& first = scene.images.begin()->second;
+  RecognitionSettings s = resolve_lengths_for_sensor(
+      parse_recognition_settings(YamlNode::load_string(rec.settings.dump(), "trial " + rec.key)),
+      ds.model_info(obj_id).diameter, first.im_id == im.im_id ? depth_clean : ds.load_depth(rec.split, rec.scene_id, first),
+      first.K);
   RecognitionSettings st = s;  // training keeps the settings' seed
   s.seed = rec.seed;
   rec.settings_resolved = nlohmann::json::parse(settings_to_json(s));

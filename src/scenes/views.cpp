@@ -5,6 +5,7 @@
 #include "core/error.h"
 #include "core/rotation.h"
 #include "io/cloud.h"
+#include "models/registry.h"
 #include "render/renderer.h"
 
 namespace pb {
@@ -82,6 +83,7 @@ TrainingViews training_views(const Mesh& mesh, const ViewSettings& settings, con
     t.empty_reason = "model '" + model_name + "' is degenerate (zero or non-finite extent)";
   } else {
     t.views = render_training_views(mesh, settings);
+    t.diameter_mm = exact_diameter(mesh);
   }
   return t;
 }

@@ -30,19 +30,19 @@ struct GlobalSettings {
 
   template <class S, class F>
   static void fields(S& s, F& f) {
-    f("cluster_tolerance_mm", s.cluster_tolerance_mm, fields::positive());
+    f("cluster_tolerance_mm", s.cluster_tolerance_mm, fields::length(fields::positive()));
     f("cluster_min_points", s.cluster_min_points, fields::at_least(1));
     f("cluster_max_points", s.cluster_max_points, fields::at_least(1));
     f("cvfh_eps_angle_deg", s.cvfh_eps_angle_deg, fields::positive(180, " degrees"));
     f("cvfh_curvature_threshold", s.cvfh_curvature_threshold, fields::positive());
-    f("cvfh_cluster_tolerance_mm", s.cvfh_cluster_tolerance_mm, fields::positive());
+    f("cvfh_cluster_tolerance_mm", s.cvfh_cluster_tolerance_mm, fields::length(fields::positive()));
     f("cvfh_min_region_points", s.cvfh_min_region_points, fields::at_least(3));
     f("esf_samples", s.esf_samples, fields::at_least(1));
     f("top_k", s.top_k, fields::at_least(1));
     f("crh_peak_threshold", s.crh_peak_threshold, fields::in_range(0, 1));
     f("crh_max_peaks", s.crh_max_peaks, fields::at_least(1));
     f("skip_crh", s.skip_crh);
-    f("cvfh_normal_radius_mm", s.cvfh_normal_radius_mm, fields::positive());
+    f("cvfh_normal_radius_mm", s.cvfh_normal_radius_mm, fields::length(fields::positive()));
     f("cvfh_normalize_bins", s.cvfh_normalize_bins);
     f("crh_peak_distance_deg", s.crh_peak_distance_deg, fields::nonnegative(180, " degrees"));
     f("ourcvfh_axis_ratio", s.ourcvfh_axis_ratio, fields::positive(1));

@@ -31,13 +31,13 @@ struct LocalSettings {
 
   template <class S, class F>
   static void fields(S& s, F& f) {
-    f("keypoint_voxel_mm", s.keypoint_voxel_mm, fields::positive());
-    f("descriptor_radius_mm", s.descriptor_radius_mm, fields::positive());
-    f("lrf_radius_mm", s.lrf_radius_mm, fields::positive());
+    f("keypoint_voxel_mm", s.keypoint_voxel_mm, fields::length(fields::positive()));
+    f("descriptor_radius_mm", s.descriptor_radius_mm, fields::length(fields::positive()));
+    f("lrf_radius_mm", s.lrf_radius_mm, fields::length(fields::positive()));
     f("match_threshold", s.match_threshold, fields::positive());
     f("fpfh_match_threshold", s.fpfh_match_threshold, fields::positive());
     f("matches_per_keypoint", s.matches_per_keypoint, fields::at_least(1));
-    f("hough_bin_mm", s.hough_bin_mm, fields::positive());
+    f("hough_bin_mm", s.hough_bin_mm, fields::length(fields::positive()));
     f("hough_min_votes", s.hough_min_votes, fields::at_least(1));
     f("hough_interpolation", s.hough_interpolation);
     f("max_hypotheses", s.max_hypotheses, fields::at_least(1));

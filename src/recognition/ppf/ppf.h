@@ -26,7 +26,7 @@ struct PpfSettings {
     f("distance_step_fraction", s.distance_step_fraction, fields::positive(1));
     f("scene_reference_fraction", s.scene_reference_fraction, fields::positive(1));
     f("scene_sampling_steps", s.scene_sampling_steps, fields::nonnegative());
-    f("position_cluster_mm", s.position_cluster_mm, fields::positive());
+    f("position_cluster_mm", s.position_cluster_mm, fields::length(fields::positive()));
     f("rotation_cluster_deg", s.rotation_cluster_deg, fields::positive());
     f("max_hypotheses", s.max_hypotheses, fields::at_least(1));
   }

@@ -34,15 +34,15 @@ struct PreprocessSettings {
   static void fields(S& s, F& f) {
     f("min_range_mm", s.min_range_mm, fields::nonnegative());
     f("max_range_mm", s.max_range_mm, fields::positive());
-    f("voxel_mm", s.voxel_mm, fields::nonnegative());
+    f("voxel_mm", s.voxel_mm, fields::length(fields::nonnegative()));
     f("remove_plane", s.remove_plane);
-    f("plane_threshold_mm", s.plane_threshold_mm, fields::positive());
+    f("plane_threshold_mm", s.plane_threshold_mm, fields::length(fields::positive()));
     f("plane_iterations", s.plane_iterations, fields::at_least(1));
     f("plane_probability", s.plane_probability, fields::in_range(0, 1));
     f("min_plane_fraction", s.min_plane_fraction, fields::in_range(0, 1));
     f("max_planes", s.max_planes, fields::at_least(0));
     f("plane_sample_points", s.plane_sample_points, fields::at_least(0));
-    f("normal_radius_mm", s.normal_radius_mm, fields::positive());
+    f("normal_radius_mm", s.normal_radius_mm, fields::length(fields::positive()));
   }
   void validate(const YamlNode& node) const;  // max_range_mm > min_range_mm
 };

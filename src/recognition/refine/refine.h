@@ -56,15 +56,15 @@ struct RefineSettings {
   template <class S, class F>
   static void fields(S& s, F& f) {
     f("max_iterations", s.max_iterations, fields::at_least(1));
-    f("max_correspondence_mm", s.max_correspondence_mm, fields::positive());
+    f("max_correspondence_mm", s.max_correspondence_mm, fields::length(fields::positive()));
     f("transformation_epsilon", s.transformation_epsilon, fields::nonnegative());
     f("rotation_epsilon_deg", s.rotation_epsilon_deg, fields::nonnegative());
     f("fitness_epsilon", s.fitness_epsilon, fields::nonnegative());
     f("reciprocal_correspondences", s.reciprocal_correspondences);
     f("icp_sample_points", s.icp_sample_points, fields::at_least(0));
-    f("ndt_resolution_mm", s.ndt_resolution_mm, fields::positive());
+    f("ndt_resolution_mm", s.ndt_resolution_mm, fields::length(fields::positive()));
     f("ndt_resolution_fraction", s.ndt_resolution_fraction, fields::nonnegative());
-    f("ndt_step_size_mm", s.ndt_step_size_mm, fields::positive());
+    f("ndt_step_size_mm", s.ndt_step_size_mm, fields::length(fields::positive()));
     f("ndt_outlier_ratio", s.ndt_outlier_ratio, fields::positive());
     f("ndt_min_points_per_cell", s.ndt_min_points_per_cell, fields::at_least(3));
     f("gicp_correspondence_randomness", s.gicp_correspondence_randomness, fields::at_least(3));

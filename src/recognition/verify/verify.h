@@ -28,7 +28,7 @@ struct VerifySettings {
 
   template <class S, class F>
   static void fields(S& s, F& f) {
-    f("inlier_threshold_mm", s.inlier_threshold_mm, fields::positive());
+    f("inlier_threshold_mm", s.inlier_threshold_mm, fields::length(fields::positive()));
     f("min_inlier_fraction", s.min_inlier_fraction, fields::in_range(0, 1));
     f("inlier_model", s.inlier_model, fields::one_of({"view", "merged"}));
   }
