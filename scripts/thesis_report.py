@@ -56,7 +56,8 @@ RECORD_SCHEMA = _struct(
     ("refinement", STRING, True), ("params", FREE, True), ("added_noise_mm", NUMBER, True), ("settings", FREE, True),
     ("seed", INTEGER, True), ("status", STRING, True), ("correct", BOOLEAN, GT), ("wall_s", NUMBER, OK),
     ("message", STRING, False), ("obj_id", INTEGER, OK), ("settings_resolved", FREE, OK), ("train_s", NUMBER, OK),
-    ("train_from_cache", BOOLEAN, OK), ("times", TIMES, OK), ("hypotheses", INTEGER, OK), ("init", POSE, False),
+    ("train_from_cache", BOOLEAN, OK), ("times", TIMES, OK), ("hypotheses", INTEGER, OK), ("correct_rank", INTEGER, False),
+    ("init", POSE, False),
     ("estimate", POSE, OK), ("score", NUMBER, OK), ("inliers", INTEGER, OK), ("gt", POSE, False),
     ("visib_fract", NUMBER, False), ("errors", ERRORS, GT), ("bop", BOP, GT),
     ("judgements", {"type": "object", "values": JUDGEMENT}, False))

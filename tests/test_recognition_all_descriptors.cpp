@@ -69,6 +69,12 @@ camera: {distance_mm: [600, 1000], elevation_deg: [30, 70]}
 // the point clouds into many small clusters that were less descriptive").
 // CVFH keeps working here because its histogram also describes the whole
 // cluster (the VFH part), not only the region.
+// These fractions are at the stage headers' mm values and the thesis's
+// inlier ranking. At the default profile (lengths relative to the bunny's
+// 191 mm diameter, verify.score visibility) the same 8 images gave (measured
+// once): cesf 0, cvfh 6, esf 6, fpfh 8, ourcvfh 5, ppf 8, shot 8. CESF's 0:
+// only one image of 8 had a correct hypothesis among its 15, ranked 3rd; the
+// hypotheses, not the verification, are what CESF lacks here (see above).
 const std::map<std::string, int> kMinCorrect = {
     {"fpfh", 6}, {"shot", 6}, {"cvfh", 5}, {"esf", 3}, {"cesf", 1}, {"ourcvfh", 2}, {"ppf", 6},
 };
@@ -198,6 +204,8 @@ TEST_F(AllDescriptors, EveryDescriptorFindsThePoseInTheMeasuredFraction) {
   for (const std::string& name : descriptor_names()) {
     ASSERT_TRUE(kMinCorrect.count(name)) << "no measured fraction for descriptor '" << name << "'";
     RecognitionSettings s;
+    s.relative.clear();          // the mm values and the ranking these fractions were measured with
+    s.verify.score = "inliers";  // (see kMinCorrect)
     s.descriptor = name;
     s.refinement = "icp";
     outcomes[name] = run(s, name + "+icp");
@@ -213,7 +221,8 @@ TEST_F(AllDescriptors, EsfWithMoreTrainingViews) {
   std::map<int, Outcome> outcomes;
   for (const auto& [views, min_correct] : kEsfMinCorrect) {
     RecognitionSettings s;
-    s.relative.clear();  // the thesis's mm values these counts were measured with (see kEsfMinCorrect)
+    s.relative.clear();  // the thesis's mm values and ranking these counts were measured with (see
+    s.verify.score = "inliers";  // kEsfMinCorrect)
     s.descriptor = "esf";
     s.refinement = "icp";
     s.views.views = views;

@@ -94,7 +94,7 @@ TEST_P(PipelineDeterminism, SamePoseBitForBitWithOneAndTwoThreads) {
     EXPECT_GT(a.times.verify, 0.0);
     EXPECT_EQ(a.inliers, a.hypotheses.front().inliers);
     for (size_t i = 1; i < a.hypotheses.size(); ++i)
-      EXPECT_GE(a.hypotheses[i - 1].inliers, a.hypotheses[i].inliers) << "hypotheses ranked by inliers";
+      EXPECT_GE(a.hypotheses[i - 1].verification, a.hypotheses[i].verification) << "hypotheses ranked by verify.score";
   }
 }
 

@@ -101,6 +101,7 @@ void fields(S& r, F& f, TrialRecord*) {
   f("train_from_cache", r.train_from_cache, kWhenOk);
   f("times", r.times, kWhenOk);
   f("hypotheses", r.hypotheses, kWhenOk);
+  f("correct_rank", r.correct_rank, kOptional);
   f("init", r.init, kOptional);
   f("estimate", r.estimate, kWhenOk);
   f("score", r.score, kWhenOk);

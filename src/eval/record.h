@@ -71,6 +71,11 @@ struct TrialRecord {
   std::optional<bool> train_from_cache;
   std::optional<StageTimesRecord> times;
   std::optional<int> hypotheses;
+  // With ground truth and hypotheses: the rank (0 = the chosen one) of the
+  // first ranked hypothesis the thesis's judgement calls correct, -1 if none
+  // is. correct_rank > 0: a correct hypothesis existed, verification chose a
+  // wrong one.
+  std::optional<int> correct_rank;
   std::optional<PoseRecord> init;      // registration_only: the perturbed start
   std::optional<PoseRecord> estimate;  // status ok
   std::optional<double> score;

@@ -127,15 +127,24 @@ std::vector<uint64_t> keep_most_promising(std::vector<Hypothesis>& hyps, const T
   return kept_at;
 }
 
-// Counts inliers and ranks: most inliers first; ties by score, then view
-// index, then the method's order.
+// Counts inliers and ranks by verify.score (inliers, or the depth evidence
+// of visibility) first; ties by inliers, score, then view index, then the
+// method's order.
 std::vector<Hypothesis> verify_and_rank(std::vector<Hypothesis> hyps, const TrainedModel& model,
-                                        const PointIndex& index, const VerifySettings& v) {
+                                        const PointIndex& index, const VerifySettings& v, const DepthImage& depth,
+                                        const Intrinsics& K) {
   count_all(hyps, model, index, v, v.inlier_threshold_mm);
+  const bool visibility = v.score == "visibility";
+  for (Hypothesis& h : hyps)
+    h.verification = visibility ? depth_evidence(model.verify_cloud(h.view, v), h.T_cam_model, depth, K,
+                                                 v.inlier_threshold_mm)
+                                      .score(v.violation_weight)
+                                : h.inliers;
   std::vector<size_t> order(hyps.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
     const Hypothesis &x = hyps[a], &y = hyps[b];
+    if (x.verification != y.verification) return x.verification > y.verification;
     if (x.inliers != y.inliers) return x.inliers > y.inliers;
     if (score_of(x) != score_of(y)) return score_of(x) > score_of(y);
     if (x.view != y.view) return x.view < y.view;
@@ -188,7 +197,8 @@ int nearest_view(const TrainedModel& model, const Pose& init) {
 
 // The common tail of recognize and refine_from: refine, verify, accept.
 void refine_verify_accept(std::vector<Hypothesis> hyps, const TrainedModel& model, const PointSet& scene,
-                          const RecognitionSettings& s, RecognitionResult& res) {
+                          const DepthImage& depth, const Intrinsics& K, const RecognitionSettings& s,
+                          RecognitionResult& res) {
   Timer timer;
   const PointIndex index(scene.points);
   res.times.verify = timer.seconds();
@@ -197,7 +207,7 @@ void refine_verify_accept(std::vector<Hypothesis> hyps, const TrainedModel& mode
   refine_all(hyps, stream, model, scene, s);
   res.times.refine = timer.seconds();
   timer.reset();
-  res.hypotheses = verify_and_rank(std::move(hyps), model, index, s.verify);
+  res.hypotheses = verify_and_rank(std::move(hyps), model, index, s.verify, depth, K);
   res.times.verify += timer.seconds();
   accept_best(model, s.verify, res);
 }
@@ -225,7 +235,7 @@ RecognitionResult recognize(const DepthImage& depth, const Intrinsics& K, const 
                   " scene points)";
     return res;
   }
-  refine_verify_accept(std::move(hyps), model, scene, s, res);
+  refine_verify_accept(std::move(hyps), model, scene, depth, K, s, res);
   return res;
 }
 
@@ -243,7 +253,7 @@ RecognitionResult refine_from(const DepthImage& depth, const Intrinsics& K, cons
   std::vector<Hypothesis> hyps(1);
   hyps[0].T_cam_model = init;
   hyps[0].view = nearest_view(model, init);
-  refine_verify_accept(std::move(hyps), model, scene, s, res);
+  refine_verify_accept(std::move(hyps), model, scene, depth, K, s, res);
   return res;
 }
 

@@ -99,13 +99,17 @@ void record_result(const RecognitionResult& res, TrialRecord& rec) {
   }
 }
 
+// The thesis's thresholds of the trial's scenario.
+ThesisThresholds thresholds_for(const std::string& scenario, const TrialContext& ctx) {
+  return {scenario == "warehouse" ? ctx.thresholds.warehouse_translation_mm : ctx.thresholds.table_translation_mm,
+          ctx.thresholds.rotation_1mpq};
+}
+
 // The thesis's errors (symmetry-aware), the extra judgements and the BOP
 // errors (MSSD, MSPD, VSD with bop19 settings) of an estimate.
 void evaluate(const Pose& est, const GtObject& gt, const BopDataset& ds, const ImageInfo& im, int obj_id,
               const Mesh& mesh, const TrialContext& ctx, TrialRecord& rec) {
-  const ThesisThresholds thr{rec.scenario == "warehouse" ? ctx.thresholds.warehouse_translation_mm
-                                                         : ctx.thresholds.table_translation_mm,
-                             ctx.thresholds.rotation_1mpq};
+  const ThesisThresholds thr = thresholds_for(rec.scenario, ctx);
   const auto syms = symmetry_transformations(ds.model_info(obj_id));
   const ThesisJudgement judged = thesis_judge(est, gt.T_cam_model, syms, thr);
   const ThesisErrors& e = judged.errors;
@@ -129,6 +133,17 @@ void evaluate(const Pose& est, const GtObject& gt, const BopDataset& ds, const I
   const DepthImage clean = ds.load_depth(rec.split, rec.scene_id, im);  // without the trial's added noise
   const BopPoseErrors be = bop_pose_errors(est, gt.T_cam_model, bm, im.K, {}, &clean, renderer.get());
   rec.bop = BopErrorsRecord{be.mssd_mm, be.mspd_px, be.vsd, bm.diameter, im.K.width};
+}
+
+// The rank of the first correct hypothesis (the thesis's judgement with the
+// model's symmetries), -1 if none.
+int first_correct_rank(const std::vector<Hypothesis>& ranked, const GtObject& gt, const BopDataset& ds, int obj_id,
+                       const std::string& scenario, const TrialContext& ctx) {
+  const ThesisThresholds thr = thresholds_for(scenario, ctx);
+  const auto syms = symmetry_transformations(ds.model_info(obj_id));
+  for (size_t i = 0; i < ranked.size(); ++i)
+    if (thesis_judge(ranked[i].T_cam_model, gt.T_cam_model, syms, thr).correct) return static_cast<int>(i);
+  return -1;
 }
 
 void run(TrialRecord& rec, const TrialContext& ctx) {
@@ -175,6 +190,8 @@ void run(TrialRecord& rec, const TrialContext& ctx) {
   record_result(res, rec);
   if (!gt) return;  // nothing to judge against: no `correct` (as the records always had it)
   rec.gt = PoseRecord::from(gt->T_cam_model);
+  if (!res.hypotheses.empty())
+    rec.correct_rank = first_correct_rank(res.hypotheses, *gt, ds, obj_id, rec.scenario, ctx);
   const size_t gi = static_cast<size_t>(gt - &im.gt[0]);
   if (gi < im.gt_info.size() && std::isfinite(im.gt_info[gi].visib_fract))  // NaN: not given
     rec.visib_fract = im.gt_info[gi].visib_fract;

@@ -57,4 +57,30 @@ int count_inliers(const std::vector<Vec3f>& model_points, const Pose& T_cam_mode
   return n;
 }
 
+DepthEvidence depth_evidence(const PointSet& model, const Pose& T_cam_model, const DepthImage& depth,
+                             const Intrinsics& K, double tolerance_mm) {
+  DepthEvidence e;
+  if (depth.width != K.width || depth.height != K.height ||
+      depth.z.size() != static_cast<size_t>(depth.width) * static_cast<size_t>(depth.height))
+    throw std::invalid_argument("depth_evidence: depth image and intrinsics differ in size");
+  const Eigen::Matrix3d R = T_cam_model.R;
+  const Vec3 t = T_cam_model.t;
+  const bool normals = model.has_normals();
+  for (size_t i = 0; i < model.points.size(); ++i) {
+    const Vec3 q = R * model.points[i].cast<double>() + t;
+    if (!(q.z() > 0)) continue;
+    if (normals && (R * model.normals[i].cast<double>()).dot(q) >= 0) continue;  // faces away
+    const double u = K.fx * q.x() / q.z() + K.cx, v = K.fy * q.y() / q.z() + K.cy;
+    const long col = std::lround(u), row = std::lround(v);
+    if (!(col >= 0 && col < depth.width && row >= 0 && row < depth.height)) continue;
+    const float z_obs = depth.z[static_cast<size_t>(row) * static_cast<size_t>(depth.width) + static_cast<size_t>(col)];
+    if (!(z_obs > 0) || !std::isfinite(z_obs)) continue;
+    const double d = static_cast<double>(z_obs) - q.z();
+    if (d > tolerance_mm) ++e.violating;
+    else if (d < -tolerance_mm) ++e.occluded;
+    else ++e.supported;
+  }
+  return e;
+}
+
 }  // namespace pb
