@@ -164,7 +164,7 @@ RecognitionSettings resolve_lengths(const RecognitionSettings& in, double model_
                      "'" + s.relative.begin()->first + "' is relative to the object's diameter, which is unknown "
                      "here: give scale.diameter_mm or the length in mm");
   for_each_section(s, [&](const char* name, auto& section) {
-    Resolver r{s.relative, std::string(name) + ".", d, s.scale.min_length_mm};
+    Resolver r{s.relative, std::string(name) + ".", d * s.scale.length_factor, s.scale.min_length_mm};
     std::decay_t<decltype(section)>::fields(section, r);
   });
   s.relative.clear();

@@ -48,6 +48,8 @@ struct ScaleSettings {
                                    // it when min_length_mm is 0; 0 = no floor)
   double working_distance_mm = 0;  // where the object is seen (mm); 0 = the median valid depth of
                                    // the scene's first image
+  double length_factor = 1.0;      // every relative length x this (one knob for the whole
+                                   // profile; `posebench advise` sweeps it)
 
   template <class S, class F>
   static void fields(S& s, F& f) {
@@ -55,6 +57,7 @@ struct ScaleSettings {
     f("min_length_mm", s.min_length_mm, fields::nonnegative());
     f("sensor_floor_px", s.sensor_floor_px, fields::nonnegative());
     f("working_distance_mm", s.working_distance_mm, fields::nonnegative());
+    f("length_factor", s.length_factor, fields::positive());
   }
 };
 
@@ -83,7 +86,7 @@ struct RecognitionSettings {
   std::map<std::string, double> relative = default_relative_lengths();
 };
 
-// Every relative length in mm: fraction x d, d = scale.diameter_mm if > 0
+// Every relative length in mm: fraction x d x scale.length_factor, d = scale.diameter_mm if > 0
 // else model_diameter_mm, but at least scale.min_length_mm. Returns the
 // settings with `relative` empty. InputError when a relative length remains
 // and d is not positive.
