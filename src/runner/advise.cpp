@@ -8,6 +8,8 @@
 #include <sstream>
 #include <tuple>
 
+#include <nlohmann/json.hpp>
+
 #include "core/error.h"
 #include "core/random.h"
 #include "core/rotation.h"
@@ -41,6 +43,9 @@ std::string list(const std::vector<double>& v) {
   return s + "]";
 }
 
+// A YAML scalar for any text: a JSON string is a YAML double-quoted scalar.
+std::string quoted(const std::string& text) { return nlohmann::json(text).dump(); }
+
 // A registry name from the mesh file's stem (letters, digits, _).
 std::string object_name(const std::string& mesh) {
   std::string n = fs::path(mesh).stem().string();
@@ -61,8 +66,8 @@ std::string registry_yaml(const AdviseOptions& opt, const std::string& name, dou
   std::ostringstream y;
   y << "# Written by `posebench advise`: the user's mesh and generated distractors of its size.\n"
     << "models:\n"
-    << "  " << name << ":\n    obj_id: 1\n    source: " << fs::absolute(opt.mesh).string() << "\n    scale: "
-    << num(opt.mesh_scale) << "\n    up: \"" << opt.up << "\"\n    role: target\n"
+    << "  " << name << ":\n    obj_id: 1\n    source: " << quoted(fs::absolute(opt.mesh).string())
+    << "\n    scale: " << num(opt.mesh_scale) << "\n    up: " << quoted(opt.up) << "\n    role: target\n"
     << "  box:\n    obj_id: 2\n    source: generated:box:120x80x60\n    fit_size: " << num(0.8 * extent)
     << "\n    role: distractor\n"
     << kBoxSymmetries << "  cylinder:\n    obj_id: 3\n    source: generated:cylinder:70x120\n    fit_size: "
