@@ -46,7 +46,6 @@ struct Resolver {
   }
 };
 
-
 // Every length field's value in a default-constructed RecognitionSettings
 // ("section.key" -> mm): the placeholder a relative field holds until it is
 // resolved.

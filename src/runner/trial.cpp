@@ -28,6 +28,7 @@ struct WorkerCache {
   std::map<std::string, std::shared_ptr<const TrainedModel>> models;
   std::map<std::string, std::unique_ptr<Mesh>> meshes;
   std::map<std::string, std::unique_ptr<DepthRenderer>> renderers;  // by intrinsics, for VSD
+  std::map<std::string, DepthImage> first_depths;  // each scene's first image (the sensor's floor)
 };
 WorkerCache& cache() {
   static WorkerCache c;
@@ -159,10 +160,13 @@ void run(TrialRecord& rec, const TrialContext& ctx) {
   // Relative lengths in mm, for the object's diameter and the sensor's floor
   // at the scene's first image (the same for every image of the scene).
   const ImageInfo& first = scene.images.begin()->second;
+  const std::string first_key = ds.root() + "#" + rec.split + "#" + std::to_string(rec.scene_id);
+  if (!cache().first_depths.count(first_key))
+    cache().first_depths[first_key] =
+        first.im_id == im.im_id ? depth_clean : ds.load_depth(rec.split, rec.scene_id, first);
   RecognitionSettings s = resolve_lengths_for_sensor(
       parse_recognition_settings(YamlNode::load_string(rec.settings.dump(), "trial " + rec.key)),
-      ds.model_info(obj_id).diameter, first.im_id == im.im_id ? depth_clean : ds.load_depth(rec.split, rec.scene_id, first),
-      first.K);
+      ds.model_info(obj_id).diameter, cache().first_depths.at(first_key), first.K);
   RecognitionSettings st = s;  // training keeps the settings' seed
   s.seed = rec.seed;
   rec.settings_resolved = nlohmann::json::parse(settings_to_json(s));
