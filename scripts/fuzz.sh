@@ -66,7 +66,9 @@ seed() {  # seed NAME FILE [PREFIX_BYTE]
   if [ -n "${3:-}" ]; then { printf "\\x$(printf %02x "$3")"; cat "$2"; } >"$out"; else cp "$2" "$out"; fi
 }
 scene="$SEEDS/ds/test/000001"
-for f in configs/experiments/*.yaml configs/thesis/*.yaml; do seed fuzz_experiment_yaml "$f"; done
+for f in configs/experiments/*.yaml configs/experiments/scale/*.yaml configs/thesis/*.yaml fuzz/seeds/experiment_relative.yaml; do
+  seed fuzz_experiment_yaml "$f"
+done
 for f in configs/scenes/*.yaml; do seed fuzz_scene_yaml "$f"; done
 seed fuzz_models_yaml models/models.yaml
 seed fuzz_bop_camera "$SEEDS/ds/camera.json"
