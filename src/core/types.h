@@ -62,6 +62,10 @@ struct DepthImage {
   float& at(int u, int v) { return z[static_cast<size_t>(v) * width + u]; }
   float at(int u, int v) const { return z[static_cast<size_t>(v) * width + u]; }
   size_t valid_count() const;
+  // Whether it is an image of K's size with one depth per pixel.
+  bool fits(const Intrinsics& K) const {
+    return width == K.width && height == K.height && z.size() == static_cast<size_t>(width) * static_cast<size_t>(height);
+  }
 };
 
 // A triangle mesh in model coordinates (mm after scaling).

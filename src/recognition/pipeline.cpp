@@ -28,8 +28,7 @@ bool finite_pose(const Pose& p) { return p.R.allFinite() && p.t.allFinite(); }
 
 void check_call(const DepthImage& depth, const Intrinsics& K, const TrainedModel& model,
                 const RecognitionSettings& s) {
-  if (depth.width != K.width || depth.height != K.height ||
-      depth.z.size() != static_cast<size_t>(depth.width) * static_cast<size_t>(depth.height))
+  if (!depth.fits(K))
     throw InputError("", "depth", "image is " + std::to_string(depth.width) + "x" + std::to_string(depth.height) +
                                       " but the intrinsics are for " + std::to_string(K.width) + "x" +
                                       std::to_string(K.height));

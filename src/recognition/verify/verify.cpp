@@ -60,9 +60,7 @@ int count_inliers(const std::vector<Vec3f>& model_points, const Pose& T_cam_mode
 DepthEvidence depth_evidence(const PointSet& model, const Pose& T_cam_model, const DepthImage& depth,
                              const Intrinsics& K, double tolerance_mm) {
   DepthEvidence e;
-  if (depth.width != K.width || depth.height != K.height ||
-      depth.z.size() != static_cast<size_t>(depth.width) * static_cast<size_t>(depth.height))
-    throw std::invalid_argument("depth_evidence: depth image and intrinsics differ in size");
+  if (!depth.fits(K)) throw std::invalid_argument("depth_evidence: depth image and intrinsics differ in size");
   const Eigen::Matrix3d R = T_cam_model.R;
   const Vec3 t = T_cam_model.t;
   const bool normals = model.has_normals();
@@ -70,10 +68,13 @@ DepthEvidence depth_evidence(const PointSet& model, const Pose& T_cam_model, con
     const Vec3 q = R * model.points[i].cast<double>() + t;
     if (!(q.z() > 0)) continue;
     if (normals && (R * model.normals[i].cast<double>()).dot(q) >= 0) continue;  // faces away
-    const double u = K.fx * q.x() / q.z() + K.cx, v = K.fy * q.y() / q.z() + K.cy;
-    const long col = std::lround(u), row = std::lround(v);
-    if (!(col >= 0 && col < depth.width && row >= 0 && row < depth.height)) continue;
-    const float z_obs = depth.z[static_cast<size_t>(row) * static_cast<size_t>(depth.width) + static_cast<size_t>(col)];
+    const Eigen::Vector2d uv = K.project(q);
+    // The nearest pixel centre; checked in floating point first, so that a
+    // point far off the image never reaches an integer conversion.
+    // (lround rounds halves away from zero: -0.5 -> -1, width - 0.5 -> width.)
+    if (!(uv.x() > -0.5 && uv.x() < depth.width - 0.5 && uv.y() > -0.5 && uv.y() < depth.height - 0.5)) continue;
+    const int col = static_cast<int>(std::lround(uv.x())), row = static_cast<int>(std::lround(uv.y()));
+    const float z_obs = depth.at(col, row);
     if (!(z_obs > 0) || !std::isfinite(z_obs)) continue;
     const double d = static_cast<double>(z_obs) - q.z();
     if (d > tolerance_mm) ++e.violating;
