@@ -46,6 +46,8 @@ ERRORS = _struct(("translation_mm", NUMBER, True), ("rotation_1mpq", NUMBER, Tru
 BOP = _struct(("mssd_mm", NUMBER, True), ("mspd_px", NUMBER, True), ("vsd", ARRAY, True), ("diameter", NUMBER, True),
               ("image_width", INTEGER, True))
 JUDGEMENT = _struct(("correct", BOOLEAN, True), ("translation_mm", NUMBER, True), ("rotation_1mpq", NUMBER, True))
+INSTANCE = _struct(("estimate", POSE, True), ("score", NUMBER, True), ("inliers", INTEGER, True),
+                   ("correct", BOOLEAN, False))
 # "required": True = in every record, False = when the trial got that far,
 # "when_ok" = in every record with status ok, "when_gt" = in every record with
 # status ok and a ground truth (`gt`): the judged ones.
@@ -53,12 +55,12 @@ OK, GT = "when_ok", "when_gt"
 RECORD_SCHEMA = _struct(
     ("key", STRING, True), ("scene", STRING, True), ("scenario", STRING, True), ("dataset", STRING, True),
     ("split", STRING, True), ("scene_id", INTEGER, True), ("im_id", INTEGER, True), ("descriptor", STRING, True),
-    ("refinement", STRING, True), ("params", FREE, True), ("added_noise_mm", NUMBER, True), ("settings", FREE, True),
+    ("refinement", STRING, True), ("inst_count", INTEGER, False), ("params", FREE, True), ("added_noise_mm", NUMBER, True), ("settings", FREE, True),
     ("seed", INTEGER, True), ("status", STRING, True), ("correct", BOOLEAN, GT), ("wall_s", NUMBER, OK),
     ("message", STRING, False), ("obj_id", INTEGER, OK), ("settings_resolved", FREE, OK), ("train_s", NUMBER, OK),
     ("train_from_cache", BOOLEAN, OK), ("times", TIMES, OK), ("hypotheses", INTEGER, OK), ("correct_rank", INTEGER, False),
     ("init", POSE, False),
-    ("estimate", POSE, OK), ("score", NUMBER, OK), ("inliers", INTEGER, OK), ("gt", POSE, False),
+    ("estimate", POSE, OK), ("instances", {"type": "array", "items": INSTANCE}, False), ("score", NUMBER, OK), ("inliers", INTEGER, OK), ("gt", POSE, False),
     ("visib_fract", NUMBER, False), ("errors", ERRORS, GT), ("bop", BOP, GT),
     ("judgements", {"type": "object", "values": JUDGEMENT}, False))
 
@@ -114,6 +116,9 @@ def check_value(value, spec, record, path):
     if "values" in spec:
         for k, v in value.items():
             check_value(v, spec["values"], record, path + "." + k)
+    elif "items" in spec:
+        for i, v in enumerate(value):
+            check_value(v, spec["items"], record, "%s[%d]" % (path, i))
     elif "fields" in spec:
         check_fields(value, spec["fields"], record, path)
 

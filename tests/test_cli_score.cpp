@@ -94,3 +94,59 @@ TEST(CliScore, OurOwnCsvScoresAsTheReportDid) {
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("file name"), std::string::npos) << r.err;
 }
+
+// `object: all` over BOP test targets: a trial per target with its
+// inst_count; the report's BOP CSV has a row per instance (at most
+// inst_count per target, ranked by score), one time per image; score reads
+// it (exit 0) and counts every target.
+TEST(CliScore, EveryTargetWithItsInstanceCountGoesIntoTheCsv) {
+  pbcli::TempDir tmp;
+  auto r = pbcli::run_small_experiment(tmp.path, "scoretest", "[ppf]");
+  ASSERT_EQ(r.code, 0) << r.err;
+  nlohmann::json targets = nlohmann::json::array();
+  std::string dataset;
+  std::ifstream in(tmp.path + "/res/records.jsonl");
+  std::string line;
+  while (std::getline(in, line)) {
+    const auto j = nlohmann::json::parse(line);
+    dataset = j["dataset"];
+    targets.push_back({{"scene_id", j["scene_id"]}, {"im_id", j["im_id"]}, {"obj_id", j["obj_id"]}, {"inst_count", 2}});
+  }
+  ASSERT_EQ(targets.size(), 3u);
+  pbcli::write_file(tmp.path + "/targets.json", targets.dump());
+  pbcli::write_file(tmp.path + "/all.yaml", "name: all\nseed: 3\nobject: all\nscenes:\n  - name: t\n    dataset: " +
+                                                dataset + "\n    targets: " + tmp.path +
+                                                "/targets.json\ndescriptors: [ppf]\nrefinements: [icp]\n"
+                                                "settings:\n  views: {views: 4}\n");
+  r = pbcli::run("run all.yaml --out all -q --cache cache", tmp.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream rec(tmp.path + "/all/records.jsonl");
+  int records = 0;
+  size_t instances = 0;
+  while (std::getline(rec, line)) {
+    const auto j = nlohmann::json::parse(line);
+    ++records;
+    EXPECT_EQ(j["inst_count"], 2);
+    EXPECT_EQ(j["settings"]["verify"]["max_instances"], 2);
+    ASSERT_TRUE(j.contains("instances")) << line;
+    ASSERT_GE(j["instances"].size(), 1u);
+    ASSERT_LE(j["instances"].size(), 2u);
+    EXPECT_EQ(j["instances"][0]["estimate"], j["estimate"]);  // the first is the chosen pose
+    instances += j["instances"].size();
+  }
+  EXPECT_EQ(records, 3);
+  r = pbcli::run("report all --format csv", tmp.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::vector<std::string> csvs;
+  for (const auto& e : fs::directory_iterator(tmp.path + "/all/bop")) csvs.push_back(e.path().string());
+  ASSERT_EQ(csvs.size(), 1u);
+  std::ifstream csv(csvs[0]);
+  std::getline(csv, line);  // header
+  size_t rows = 0;
+  while (std::getline(csv, line)) rows += !line.empty();
+  EXPECT_EQ(rows, instances);
+  r = pbcli::run("score '" + csvs[0] + "' --dataset '" + dataset + "' --targets targets.json --no-vsd", tmp.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("| all | 3 |"), std::string::npos) << r.out;
+}
+

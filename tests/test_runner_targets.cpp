@@ -14,11 +14,13 @@
 #include <map>
 #include <set>
 #include <string>
+#include <tuple>
 #include <utility>
 
 #include "core/error.h"
 #include "io/bop.h"
 #include "runner/experiment.h"
+#include "runner/trial.h"
 #include "temp_dir.h"
 
 namespace fs = std::filesystem;
@@ -175,6 +177,39 @@ TEST(TestTargets, TargetsOutsideTheDatasetOrNoneForTheObjectAreInputErrors) {
   fs::remove(file);
   e = error_of(expand);
   EXPECT_EQ(e.file(), file);
+}
+
+// `object: all`: one trial per target (image and object) and method, the
+// object and its inst_count in the trial, verify.max_instances set to it, the
+// object in the key; every scene needs a dataset with targets; an object
+// missing from models_info.json is an InputError naming the entry.
+TEST(TestTargets, ObjectAllRunsEveryTargetWithItsInstanceCount) {
+  Dataset ds;
+  ds.targets(kTargets);
+  const auto trials = pb::expand_trials(pb::load_experiment(ds.experiment("    targets: targets.json\n", "all")));
+  ASSERT_EQ(trials.size(), 8u);  // 4 targets x 2 descriptors
+  std::set<std::tuple<int, int, int, int>> got;
+  for (const auto& t : trials) {
+    got.insert({t.scene_id, t.im_id, t.obj_id, t.inst_count});
+    EXPECT_EQ(t.settings["verify"]["max_instances"], t.inst_count) << t.key;
+    EXPECT_NE(t.key.find("/obj=" + std::to_string(t.obj_id)), std::string::npos) << t.key;
+    const pb::TrialRecord r = pb::trial_record(t);  // what the worker gets
+    EXPECT_EQ(r.obj_id.value_or(0), t.obj_id);
+    EXPECT_EQ(r.inst_count.value_or(0), t.inst_count);
+  }
+  EXPECT_EQ(got, (std::set<std::tuple<int, int, int, int>>{{1, 0, 1, 1}, {1, 2, 1, 2}, {2, 1, 2, 1}, {2, 0, 1, 1}}));
+  // Keys stay unique and seeds differ per object.
+  std::set<std::string> keys;
+  for (const auto& t : trials) keys.insert(t.key);
+  EXPECT_EQ(keys.size(), trials.size());
+
+  // Without targets: exit-2 error naming the scene entry.
+  const pb::InputError no_targets = error_of([&] { pb::load_experiment(ds.experiment("", "all")); });
+  EXPECT_EQ(no_targets.field(), "scenes[0]") << no_targets.what();
+  // An object the dataset has no model of.
+  ds.targets(R"([{"im_id": 0, "inst_count": 1, "obj_id": 7, "scene_id": 1}])");
+  const pb::InputError e = error_of([&] { pb::expand_trials(pb::load_experiment(ds.experiment("    targets: targets.json\n", "all"))); });
+  EXPECT_EQ(e.field(), "[0].obj_id");
 }
 
 }  // namespace

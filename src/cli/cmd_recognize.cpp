@@ -49,6 +49,7 @@ struct Options {
   pbcli::RecognizeSource src;
   std::string method, refine, config, overlay, cache = default_cache_dir(), scenario = "table";
   int views = 0;
+  int instances = -1;  // verify.max_instances (-1: the config's)
   long long seed = -1;
   bool json = false;
 };
@@ -76,6 +77,9 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--views", o.views, "training views (1, 8, 12 or N on a sphere)")->check(CLI::PositiveNumber);
   app.add_option("--config", o.config, "recognition settings YAML (sections descriptor, refinement, views, "
                                        "preprocess, local, global, ppf, refine, verify, seed)");
+  app.add_option("--instances", o.instances, "recognize up to N instances of the object (0 = every one that "
+                                             "verification accepts; default: the config's verify.max_instances, 1)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--seed", o.seed, "seed of every random choice (overrides the config)")->check(CLI::NonNegativeNumber);
   app.add_option("--overlay", o.overlay, "write a PNG: the model at the estimated pose over the colour-mapped depth");
   app.add_option("--cache", o.cache, "training cache folder ('' = no cache; default $POSEBENCH_CACHE or ~/.cache/posebench/train)");
@@ -89,6 +93,7 @@ void settings_from(const Options& o, pb::RecognitionSettings& s) {
   if (!o.method.empty()) s.descriptor = pb::descriptor_entry(o.method, "", "--method").name;
   if (!o.refine.empty()) s.refinement = pb::refinement_entry(o.refine, "", "--refine").name;
   if (o.views > 0) s.views.views = o.views;
+  if (o.instances >= 0) s.verify.max_instances = o.instances;
   if (o.seed >= 0) s.seed = static_cast<uint64_t>(o.seed);
 }
 
@@ -169,6 +174,17 @@ std::string json_output(const Outcome& x) {
   }
   j["score"] = x.res.score;
   j["inliers"] = x.res.inliers;
+  if (x.s.verify.max_instances != 1) {
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const auto& h : x.res.instances) {
+      std::vector<double> R, t;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) R.push_back(h.T_cam_model.R(r, c));
+      for (int r = 0; r < 3; ++r) t.push_back(h.T_cam_model.t[r]);
+      list.push_back({{"R", R}, {"t", t}, {"verification", h.verification}, {"inliers", h.inliers}});
+    }
+    j["instances"] = list;
+  }
   j["hypotheses"] = x.res.hypotheses.size();
   j["times"] = times_json(x.res.times);
   j["train"] = {{"seconds", x.train_s}, {"from_cache", x.from_cache}, {"views", x.train_views}};
@@ -207,6 +223,12 @@ std::string text_output(const Outcome& x, const pb::ThesisThresholds& thr) {
         << "\n";
     o << "inliers: " << res.inliers << "  score: " << res.score << "  hypotheses: " << res.hypotheses.size()
       << "\n";
+    if (x.s.verify.max_instances != 1) {
+      o << "instances: " << res.instances.size() << "\n";
+      for (size_t i = 0; i < res.instances.size(); ++i)
+        o << "  " << i + 1 << ": t = (" << res.instances[i].T_cam_model.t.transpose() << ") mm, verification "
+          << res.instances[i].verification << ", inliers " << res.instances[i].inliers << "\n";
+    }
   }
   o << "times (s): preprocess " << res.times.preprocess << ", describe " << res.times.describe << ", match "
     << res.times.match << ", group " << res.times.group << ", initial pose " << res.times.initial_pose

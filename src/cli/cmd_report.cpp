@@ -88,23 +88,37 @@ static std::string bop_csv_name(const pb::TrialRecord& r) {
 }
 
 // BOP results CSVs in DIR/bop (every estimate), so the BOP toolkit itself
-// can score them.
+// can score them. A multi-instance record (BOP test targets) gives a row per
+// instance, scored by its verification; an image's time is the sum of its
+// trials' totals in that file (BOP times the whole image, all objects).
 static void write_bop_csvs(const std::vector<pb::TrialRecord>& records, const std::string& dir) {
   std::map<std::string, std::vector<pb::BopResultRow>> files;
+  std::map<std::tuple<std::string, int, int>, double> image_time;
   for (const auto& r : records) {
     if (r.status != "ok" || !r.estimate) continue;
+    const std::string name = bop_csv_name(r);
+    double& t = image_time[{name, r.scene_id, r.im_id}];
+    t = r.times && t >= 0 ? t + r.times->total : -1.0;
     pb::BopResultRow row;
     row.scene_id = r.scene_id;
     row.im_id = r.im_id;
     row.obj_id = r.obj_id.value_or(0);
-    row.score = r.score.value_or(1.0);
-    row.T_cam_model = r.estimate->pose();
-    row.time_s = r.times ? r.times->total : -1.0;
-    files[bop_csv_name(r)].push_back(row);
+    if (r.instances) {
+      for (const auto& inst : *r.instances) {
+        row.score = inst.score;
+        row.T_cam_model = inst.estimate.pose();
+        files[name].push_back(row);
+      }
+    } else {
+      row.score = r.score.value_or(1.0);
+      row.T_cam_model = r.estimate->pose();
+      files[name].push_back(row);
+    }
   }
   if (!files.empty()) fs::create_directories(fs::path(dir) / "bop");
   for (auto& [name, rows] : files) {
-    std::sort(rows.begin(), rows.end(), [](const pb::BopResultRow& a, const pb::BopResultRow& b) {
+    for (auto& row : rows) row.time_s = image_time.at({name, row.scene_id, row.im_id});
+    std::stable_sort(rows.begin(), rows.end(), [](const pb::BopResultRow& a, const pb::BopResultRow& b) {
       return std::tie(a.scene_id, a.im_id, a.obj_id) < std::tie(b.scene_id, b.im_id, b.obj_id);
     });
     pb::write_bop_results_csv((fs::path(dir) / "bop" / name).string(), rows);

@@ -77,6 +77,13 @@ void fields(S& r, F& f, JudgementRecord*) {
   f("rotation_1mpq", r.rotation_1mpq, kAlways);
 }
 template <typename S, typename F>
+void fields(S& r, F& f, InstanceRecord*) {
+  f("estimate", r.estimate, kAlways);
+  f("score", r.score, kAlways);
+  f("inliers", r.inliers, kAlways);
+  f("correct", r.correct, kOptional);
+}
+template <typename S, typename F>
 void fields(S& r, F& f, TrialRecord*) {
   f("key", r.key, kAlways);
   f("scene", r.scene, kAlways);
@@ -87,6 +94,7 @@ void fields(S& r, F& f, TrialRecord*) {
   f("im_id", r.im_id, kAlways);
   f("descriptor", r.descriptor, kAlways);
   f("refinement", r.refinement, kAlways);
+  f("inst_count", r.inst_count, kOptional);
   f("params", r.params, kAlways);
   f("added_noise_mm", r.added_noise_mm, kAlways);
   f("settings", r.settings, kAlways);
@@ -104,6 +112,7 @@ void fields(S& r, F& f, TrialRecord*) {
   f("correct_rank", r.correct_rank, kOptional);
   f("init", r.init, kOptional);
   f("estimate", r.estimate, kWhenOk);
+  f("instances", r.instances, kOptional);
   f("score", r.score, kWhenOk);
   f("inliers", r.inliers, kWhenOk);
   f("gt", r.gt, kOptional);
@@ -116,7 +125,12 @@ void fields(S& r, F& f, TrialRecord*) {
 template <typename S>
 constexpr bool is_record_struct = std::is_same_v<S, PoseRecord> || std::is_same_v<S, StageTimesRecord> ||
                                   std::is_same_v<S, ThesisErrorsRecord> || std::is_same_v<S, BopErrorsRecord> ||
-                                  std::is_same_v<S, JudgementRecord> || std::is_same_v<S, TrialRecord>;
+                                  std::is_same_v<S, JudgementRecord> || std::is_same_v<S, InstanceRecord> ||
+                                  std::is_same_v<S, TrialRecord>;
+template <typename T>
+constexpr bool is_struct_vector = false;
+template <typename T>
+constexpr bool is_struct_vector<std::vector<T>> = is_record_struct<T>;
 
 // --- writing ---------------------------------------------------------------
 
@@ -147,6 +161,10 @@ nlohmann::json write_value(const T& v) {
   } else if constexpr (is_map<T>::value) {
     nlohmann::json j = nlohmann::json::object();
     for (const auto& [k, x] : v) j[k] = write_value(x);
+    return j;
+  } else if constexpr (is_struct_vector<T>) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const auto& x : v) j.push_back(write_value(x));
     return j;
   } else {
     return nlohmann::json(v);
@@ -239,6 +257,10 @@ void read_value(const nlohmann::json& j, T& v, const std::string& path, const Wh
   } else if constexpr (std::is_same_v<T, nlohmann::json>) {
     if (!j.is_object()) w.fail(path, "expected a JSON object");
     v = j;
+  } else if constexpr (is_struct_vector<T>) {
+    if (!j.is_array()) w.fail(path, "expected a JSON list");
+    v.resize(j.size());
+    for (size_t i = 0; i < j.size(); ++i) read_value(j[i], v[i], path + "[" + std::to_string(i) + "]", w);
   } else {
     using E = T;
     const bool ok = std::is_same_v<E, bool>          ? j.is_boolean()
@@ -293,6 +315,8 @@ nlohmann::json schema_of() {
     return {{"type", "object"}, {"values", e}};
   } else if constexpr (std::is_same_v<T, nlohmann::json>) {
     return {{"type", "object"}, {"free", true}};
+  } else if constexpr (is_struct_vector<T>) {
+    return {{"type", "array"}, {"items", schema_of<typename T::value_type>()}};
   } else if constexpr (std::is_same_v<T, bool>) {
     return {{"type", "boolean"}};
   } else if constexpr (std::is_same_v<T, std::string>) {
@@ -337,7 +361,7 @@ nlohmann::json record_schema() {
   s["notes"] = {"required: true = in every record; \"when_ok\" = in every record with status ok; \"when_gt\" = "
                 "in every record with status ok and a gt (the judged ones); false = when the trial got that far "
                 "(message, init with registration_only, gt and visib_fract when the image has the object, "
-                "judgements when the experiment declares them)",
+                "judgements when the experiment declares them, inst_count and instances for BOP test targets)",
                 "a trial whose worker crashed, timed out or ran out of memory (status error, timeout or "
                 "out_of_memory) has the always-required "
                 "keys, message and correct = false only",

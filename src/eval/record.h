@@ -47,11 +47,23 @@ struct JudgementRecord {       // the thesis's judgement over an extra symmetry 
   double translation_mm = 0, rotation_1mpq = 0;
 };
 
+struct InstanceRecord {        // one instance of a multi-instance trial (BOP inst_count)
+  PoseRecord estimate;
+  double score = 0;            // what verification ranked it by (Hypothesis::verification)
+  int inliers = 0;
+  // The thesis's judgement against the object's GT instances, each GT
+  // matched at most once, instances in rank order; absent without GT.
+  std::optional<bool> correct;
+};
+
 struct TrialRecord {
   // The trial (runner/experiment.h Trial): always present.
   std::string key, scene, scenario, dataset, split;
   int scene_id = 0, im_id = 0;
   std::string descriptor, refinement;
+  // A test target's instance count (experiment `object: all` with BOP
+  // test targets): recognize up to this many instances. None: one estimate.
+  std::optional<int> inst_count;
   nlohmann::json params = nlohmann::json::object();    // grid point: dotted path -> value
   double added_noise_mm = 0;
   nlohmann::json settings = nlohmann::json::object();  // the trial's settings sections, as configured
@@ -65,7 +77,7 @@ struct TrialRecord {
   std::optional<bool> correct;  // the thesis's judgement: with a GT pose (false without an estimate), or a failed worker
   std::optional<double> wall_s;  // wall time of the whole trial in its worker (s); none when the worker failed
   std::optional<std::string> message;
-  std::optional<int> obj_id;
+  std::optional<int> obj_id;   // set with the trial when the experiment takes objects from test targets
   std::optional<nlohmann::json> settings_resolved;  // every field, after defaults
   std::optional<double> train_s;
   std::optional<bool> train_from_cache;
@@ -78,6 +90,9 @@ struct TrialRecord {
   std::optional<int> correct_rank;
   std::optional<PoseRecord> init;      // registration_only: the perturbed start
   std::optional<PoseRecord> estimate;  // status ok
+  // With inst_count: every instance found, best first (the first is
+  // `estimate`).
+  std::optional<std::vector<InstanceRecord>> instances;
   std::optional<double> score;
   std::optional<int> inliers;
   std::optional<PoseRecord> gt;        // the first instance of the object in the image

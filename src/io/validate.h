@@ -10,10 +10,14 @@
 namespace pb {
 
 // Rotation tolerances: |det R - 1| and max |R^T R - I| (elementwise).
-// Poses (scene_gt.json) carry 8 or more digits in BOP's own files;
-// symmetry transforms in models_info.json are written with about 6
-// significant digits in some datasets, so they get a looser bound.
-constexpr double kPoseRotationTolerance = 1e-6;
+// Poses (scene_gt.json): most BOP datasets carry 8 or more digits, but
+// LM-O's ground truth (from the original Occlusion dataset) deviates from a
+// rotation by up to 0.0137 (measured over its 1445 test poses), so the bound
+// is 0.05: a scaled (mm vs m), mirrored or sheared matrix is still far
+// outside it. Accepted matrices are used as written, as bop_toolkit does.
+// Symmetry transforms in models_info.json are written with about 6
+// significant digits in some datasets.
+constexpr double kPoseRotationTolerance = 0.05;
 constexpr double kSymmetryRotationTolerance = 1e-4;
 
 // R is a rotation: finite, orthonormal and det +1 within `tolerance`.

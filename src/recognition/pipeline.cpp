@@ -173,6 +173,19 @@ void accept_best(const TrainedModel& model, const VerifySettings& v, Recognition
   res.T_cam_model = best.T_cam_model;
   res.score = best.score;
   res.inliers = best.inliers;
+  res.instances.push_back(best);
+  // Further instances (VerifySettings::max_instances), in rank order.
+  for (size_t i = 1; i < res.hypotheses.size(); ++i) {
+    if (v.max_instances > 0 && res.instances.size() >= static_cast<size_t>(v.max_instances)) break;
+    const Hypothesis& h = res.hypotheses[i];
+    const double points = static_cast<double>(model.verify_cloud(h.view, v).size());
+    if (h.inliers < 1 || static_cast<double>(h.inliers) < v.min_inlier_fraction * points) continue;
+    if (!(h.verification >= v.instance_min_ratio * best.verification) || !(h.verification > 0)) continue;
+    bool separate = true;
+    for (const Hypothesis& taken : res.instances)
+      separate = separate && (h.T_cam_model.t - taken.T_cam_model.t).norm() > v.instance_separation_mm;
+    if (separate) res.instances.push_back(h);
+  }
 }
 
 // The training view seen from the direction closest to the one `init`

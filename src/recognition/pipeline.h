@@ -54,6 +54,9 @@ struct RecognitionResult {
   std::string status = "no_hypothesis";  // "ok" | "no_hypothesis"
   std::string message;                   // why no hypothesis, when so
   std::vector<Hypothesis> hypotheses;    // ranked, best first
+  // When ok: the instances found (verify.max_instances), best first; the
+  // first is the chosen pose below.
+  std::vector<Hypothesis> instances;
   Pose T_cam_model;                      // the chosen pose (valid when ok)
   double score = 0;
   int inliers = 0;

@@ -148,7 +148,7 @@ const std::map<std::string, double>& default_relative_lengths() {
       {"global.cvfh_cluster_tolerance_mm", 0.075}, {"global.cvfh_normal_radius_mm", 0.10},
       {"ppf.position_cluster_mm", 0.15},       {"refine.max_correspondence_mm", 0.10},
       {"refine.ndt_resolution_mm", 0.15},      {"refine.ndt_step_size_mm", 0.40},
-      {"verify.inlier_threshold_mm", 0.05},
+      {"verify.inlier_threshold_mm", 0.05},    {"verify.instance_separation_mm", 0.20},
   };
   return m;
 }

@@ -273,6 +273,13 @@ ExperimentConfig load_experiment(const std::string& path) {
   if (!scenes.is_sequence() || scenes.size() == 0) scenes.fail("expected a non-empty list of scenes");
   std::set<std::string> names;
   for (size_t i = 0; i < scenes.size(); ++i) c.scenes.push_back(parse_scene(scenes.at(i), path, names));
+  if (c.object == kEveryTargetObject) {
+    for (size_t i = 0; i < scenes.size(); ++i)
+      if (c.scenes[i].targets.empty() || c.scenes[i].dataset.empty())
+        scenes.at(i).fail("'object: all' takes the objects from the scene's BOP test targets: give 'dataset' "
+                          "and 'targets' (e.g. test_targets_bop19.json)");
+    if (c.registration_only) root["registration_only"].fail("not with 'object: all'");
+  }
   c.judgements = parse_judgements(root["judgements"]);
   c.canonical = canonical(c);
   c.hash = hash_hex(c.canonical.dump());
@@ -281,13 +288,15 @@ ExperimentConfig load_experiment(const std::string& path) {
 
 namespace {
 
-// A scene source's test targets for the experiment's object: the file, and
-// each listed (scene_id, im_id) with the index of its first entry there (for
-// errors). Every scene must be in the split; that every image is in its
+// A scene source's test targets for the experiment's object (every object
+// with `object: all`): the file, and each listed (scene_id, im_id) with the
+// index of its first entry there (for errors) and its targets (obj_id,
+// inst_count). Every scene must be in the split; that every image is in its
 // scene is checked as expand_trials reads the scene (check_target_images).
 struct Targets {
   std::string file;
   std::map<std::pair<int, int>, size_t> entry;
+  std::map<std::pair<int, int>, std::vector<std::pair<int, int>>> objects;
 };
 
 Targets read_targets(const SceneSource& src, const BopDataset& ds, const std::string& object) {
@@ -296,16 +305,21 @@ Targets read_targets(const SceneSource& src, const BopDataset& ds, const std::st
   out.file = fs::path(src.targets).is_absolute() ? src.targets : (fs::path(src.dataset) / src.targets).string();
   if (std::error_code ec; !fs::is_regular_file(out.file, ec))
     throw InputError(out.file, "targets", "test-targets file not found");
-  const int obj = ds.resolve_object(object);
+  const bool every = object == kEveryTargetObject;
+  const int obj = every ? 0 : ds.resolve_object(object);
   const auto targets = read_test_targets(out.file);
   const auto scenes = ds.scene_ids(src.split);
   for (size_t i = 0; i < targets.size(); ++i) {
     const TestTarget& t = targets[i];
-    if (t.obj_id != obj) continue;
+    if (!every && t.obj_id != obj) continue;
     if (std::find(scenes.begin(), scenes.end(), t.scene_id) == scenes.end())
       throw InputError(out.file, "[" + std::to_string(i) + "].scene_id",
                        "scene " + std::to_string(t.scene_id) + " is not in split '" + src.split + "'");
+    if (every && !ds.models().count(t.obj_id))
+      throw InputError(out.file, "[" + std::to_string(i) + "].obj_id",
+                       "object " + std::to_string(t.obj_id) + " is not in the dataset's models_info.json");
     out.entry.emplace(std::make_pair(t.scene_id, t.im_id), i);
+    out.objects[{t.scene_id, t.im_id}].push_back({t.obj_id, t.inst_count});
   }
   if (out.entry.empty())
     throw InputError(out.file, "obj_id", "no target for object '" + object + "' (obj_id " + std::to_string(obj) + ")");
@@ -355,6 +369,11 @@ std::vector<Trial> expand_trials(const ExperimentConfig& cfg) {
         if (src.images > 0 && taken >= src.images) break;
         ++taken;
         const auto& refinements = src.refinements.empty() ? cfg.refinements : src.refinements;
+        // The image's objects: the experiment's, or each test target's
+        // (obj_id, inst_count) with `object: all`.
+        std::vector<std::pair<int, int>> objects{{0, 0}};
+        if (cfg.object == kEveryTargetObject) objects = targets.objects.at({sid, im_id});
+        for (const auto& [obj_id, inst_count] : objects)
         for (const auto& d : cfg.descriptors)
           for (const auto& r : refinements)
             for (const auto& p : points)
@@ -366,6 +385,8 @@ std::vector<Trial> expand_trials(const ExperimentConfig& cfg) {
                 t.split = src.split;
                 t.scene_id = sid;
                 t.im_id = im_id;
+                t.obj_id = obj_id;
+                t.inst_count = inst_count;
                 t.descriptor = d;
                 t.refinement = r;
                 t.params = p;
@@ -375,11 +396,13 @@ std::vector<Trial> expand_trials(const ExperimentConfig& cfg) {
                 for (auto it = p.begin(); it != p.end(); ++it) set_path(s, it.key(), it.value());
                 s["descriptor"] = d == "none" ? "fpfh" : d;
                 s["refinement"] = r;
+                if (inst_count > 0) set_path(s, "verify.max_instances", inst_count);
                 t.settings = s;
                 char buf[64];
                 std::snprintf(buf, sizeof buf, "%d/%d", sid, im_id);
                 t.key = src.name + "/" + buf + "/" + d + "/" + r + "/" + p.dump() + "/noise=" +
                         nlohmann::json(noise).dump();
+                if (obj_id > 0) t.key += "/obj=" + std::to_string(obj_id);
                 // The trial's random stream: stream_id keeps the seeds (and so
                 // every result) of the releases before the one hash.
                 t.seed = derive_seed(cfg.seed, {stream_id(t.key)});

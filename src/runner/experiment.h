@@ -62,11 +62,15 @@ struct Judgement {
   std::vector<ContinuousSymmetry> symmetries_continuous;
 };
 
+// ExperimentConfig::object that takes every object of each scene's BOP test
+// targets (one trial per target, recognizing up to its inst_count).
+inline constexpr const char* kEveryTargetObject = "all";
+
 struct ExperimentConfig {
   std::string file;                 // the YAML it came from
   std::string name;                 // experiment name (default: file stem)
   uint64_t seed = 1;                // seeds every trial (derive_seed with the trial key)
-  std::string object;               // registry name / BOP object name or id
+  std::string object;               // registry name / BOP object name or id; "all": every test target's
   std::vector<SceneSource> scenes;
   std::vector<std::string> descriptors;
   std::vector<std::string> refinements{"icp"};
@@ -101,6 +105,8 @@ struct Trial {
   std::string scenario;   // table | warehouse
   std::string dataset, split;
   int scene_id = 0, im_id = 0;
+  int obj_id = 0;          // `object: all`: the test target's object (0: the experiment's object)
+  int inst_count = 0;      // `object: all`: the target's instance count (0: one estimate)
   std::string descriptor, refinement;
   nlohmann::json params;  // grid point: dotted path -> value
   double added_noise_mm = 0;

@@ -147,9 +147,34 @@ int first_correct_rank(const std::vector<Hypothesis>& ranked, const GtObject& gt
   return -1;
 }
 
+// Every instance of a multi-instance trial (inst_count), judged in rank
+// order against the object's GT instances, each GT taken by at most one.
+void record_instances(const RecognitionResult& res, const ImageInfo& im, const BopDataset& ds, int obj_id,
+                      const TrialContext& ctx, TrialRecord& rec) {
+  rec.instances.emplace();
+  const ThesisThresholds thr = thresholds_for(rec.scenario, ctx);
+  const auto syms = symmetry_transformations(ds.model_info(obj_id));
+  std::vector<bool> taken(im.gt.size(), false);
+  bool any_gt = false;
+  for (const auto& g : im.gt) any_gt = any_gt || g.obj_id == obj_id;
+  for (const Hypothesis& h : res.instances) {
+    InstanceRecord inst;
+    inst.estimate = PoseRecord::from(h.T_cam_model);
+    inst.score = h.verification;
+    inst.inliers = h.inliers;
+    if (any_gt) {
+      inst.correct = false;
+      for (size_t g = 0; g < im.gt.size() && !*inst.correct; ++g)
+        if (im.gt[g].obj_id == obj_id && !taken[g] && thesis_judge(h.T_cam_model, im.gt[g].T_cam_model, syms, thr).correct)
+          taken[g] = true, inst.correct = true;
+    }
+    rec.instances->push_back(inst);
+  }
+}
+
 void run(TrialRecord& rec, const TrialContext& ctx) {
   const BopDataset& ds = dataset(rec.dataset);
-  const int obj_id = ds.resolve_object(ctx.object);
+  const int obj_id = rec.obj_id ? *rec.obj_id : ds.resolve_object(ctx.object);
   rec.obj_id = obj_id;
   const SceneInfo scene = ds.load_scene(rec.split, rec.scene_id);
   const ImageInfo& im = scene.images.at(rec.im_id);
@@ -192,6 +217,7 @@ void run(TrialRecord& rec, const TrialContext& ctx) {
     res = recognize(depth, im.K, *model, s);
   }
   record_result(res, rec);
+  if (rec.inst_count) record_instances(res, im, ds, obj_id, ctx, rec);
   if (!gt) return;  // nothing to judge against: no `correct` (as the records always had it)
   rec.gt = PoseRecord::from(gt->T_cam_model);
   if (!res.hypotheses.empty())
@@ -253,6 +279,8 @@ TrialRecord trial_record(const Trial& t) {
   r.im_id = t.im_id;
   r.descriptor = t.descriptor;
   r.refinement = t.refinement;
+  if (t.obj_id > 0) r.obj_id = t.obj_id;
+  if (t.inst_count > 0) r.inst_count = t.inst_count;
   r.params = t.params;
   r.added_noise_mm = t.added_noise_mm;
   r.settings = t.settings;

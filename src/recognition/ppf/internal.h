@@ -4,6 +4,8 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <tuple>
 #include <vector>
@@ -59,15 +61,24 @@ class KeyIndex {
 
 // The discretized feature (PCL's floor(f / step), in float) packed into 64
 // bits, 16 per component (bin indices are clamped to +-32767).
-inline uint64_t feature_key(float f1, float f2, float f3, float f4, float angle_step, float distance_step) {
-  auto bin = [](float f, float step) {
-    const float b = std::floor(f / step);
-    const float c = std::max(-32767.f, std::min(32767.f, b));
-    return static_cast<uint64_t>(static_cast<int64_t>(c) + 32768) & 0xffffu;
-  };
-  return (bin(f1, angle_step) << 48) | (bin(f2, angle_step) << 32) | (bin(f3, angle_step) << 16) |
-         bin(f4, distance_step);
+inline int64_t feature_bin(float f, float step) {
+  const float b = std::floor(f / step);
+  return static_cast<int64_t>(std::max(-32767.f, std::min(32767.f, b)));
 }
+inline uint64_t pack_key(int64_t b1, int64_t b2, int64_t b3, int64_t b4) {
+  auto u = [](int64_t b) { return static_cast<uint64_t>(std::max<int64_t>(-32767, std::min<int64_t>(32767, b)) + 32768) & 0xffffu; };
+  return (u(b1) << 48) | (u(b2) << 32) | (u(b3) << 16) | u(b4);
+}
+inline uint64_t feature_key(float f1, float f2, float f3, float f4, float angle_step, float distance_step) {
+  return pack_key(feature_bin(f1, angle_step), feature_bin(f2, angle_step), feature_bin(f3, angle_step),
+                  feature_bin(f4, distance_step));
+}
+
+// The keys a scene pair looks up (Vidal et al. 2018): its own bin and, per
+// component whose value lies within `margin` of a bin (a fraction of it)
+// from an edge, also the bin across that edge; every combination (at most
+// 16), own bin first. margin 0: the own bin only.
+int neighbour_keys(const float f[4], const float step[4], float margin, uint64_t out[16]);
 
 // The trained model: downsampled merged views (model frame, mm), the n x n
 // pair features (row = reference point) and the pairs sorted by feature key.
@@ -103,8 +114,15 @@ float pcl_alpha(const Eigen::Affine3f& T, const Vec3f& other);
 // The seeded subset of scene reference points (ascending indices).
 std::vector<int> reference_points(size_t n, double fraction, uint64_t seed);
 
+// How a scene pair votes (PpfSettings::neighbour_margin, vote_once).
+struct VoteOptions {
+  float margin = 0;        // neighbouring feature bins and alpha bins within this fraction of an edge
+  bool vote_once = false;  // one vote per (reference, model key, alpha_s bin)
+};
+
 // One pose per reference point: the best accumulator cell of its votes.
-std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vector<int>& refs);
+std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vector<int>& refs,
+                           const VoteOptions& opt);
 
 // Greedy clustering, most votes first; the best max_hypotheses clusters as
 // hypotheses (mean translation, sign-aligned mean quaternion, summed votes).

@@ -49,6 +49,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/log.h"
 #include "core/random.h"
 #include "core/timer.h"
 #include "recognition/method.h"
@@ -78,21 +79,17 @@ class PpfMethod : public Method {
         merged.normals.push_back((T_model_cam.R * v.cloud.normals[i].cast<double>()).cast<float>());
       }
     }
-    VoxelGridOptions grid;  // the PPF model's grid: cells by x, p / leaf, cancelled normals dropped
-    grid.order = VoxelGridOptions::Order::kXYZ;
-    grid.cell_index = VoxelGridOptions::CellIndex::kDivide;
-    grid.drop_cancelled_normals = 1e-6;
-    const PointSet model = voxel_downsample_to(merged, s_.model_points, grid);
+    const PointSet model = sample_model(merged);
     m_ = ppf::Model();
     m_.points = model.points;
     m_.normals = model.normals;
     m_.angle_step = static_cast<float>(s_.angle_step_deg * M_PI / 180.0);
-    for (size_t i = 0; i < m_.points.size(); ++i)
-      for (size_t j = i + 1; j < m_.points.size(); ++j)
-        m_.diameter = std::max(m_.diameter, (m_.points[i] - m_.points[j]).norm());
+    m_.diameter = max_distance(m_.points);
     m_.distance_step = static_cast<float>(s_.distance_step_fraction) * m_.diameter;
     if (m_.points.size() >= 3 && m_.diameter > 0) compute_features();
     build_search();
+    log_event(LogLevel::debug, "ppf_model",
+              {{"points", m_.points.size()}, {"pairs", m_.table.size()}, {"diameter_mm", m_.diameter}});
   }
 
   void save(BinaryWriter& out) const override {
@@ -131,7 +128,10 @@ class PpfMethod : public Method {
     // reference points.
     Timer timer;
     const double leaf = s_.scene_sampling_steps * m_.distance_step;
-    const PointSet sampled = leaf > 0 ? voxel_downsample(scene, {leaf}) : PointSet();
+    VoxelGridOptions grid;
+    grid.leaf_mm = leaf;
+    grid.normal_cluster_deg = s_.normal_cluster_deg;
+    const PointSet sampled = leaf > 0 ? voxel_downsample(scene, grid) : PointSet();
     const PointSet& paired = leaf > 0 ? sampled : scene;
     if (paired.size() < 2 || !paired.has_normals()) return out;
     const std::vector<int> refs = ppf::reference_points(paired.size(), s_.scene_reference_fraction, seed);
@@ -139,7 +139,10 @@ class PpfMethod : public Method {
 
     // Match: vote per reference point.
     timer.reset();
-    std::vector<ppf::PoseVote> poses = ppf::vote(m_, paired, refs);
+    ppf::VoteOptions vo;
+    vo.margin = static_cast<float>(s_.neighbour_margin);
+    vo.vote_once = s_.vote_once;
+    std::vector<ppf::PoseVote> poses = ppf::vote(m_, paired, refs, vo);
     times.match += timer.seconds();
 
     // Group: greedy pose clustering, most votes first.
@@ -167,6 +170,37 @@ class PpfMethod : public Method {
   }
 
  private:
+  static float max_distance(const std::vector<Vec3f>& pts) {
+    float d = 0;
+    for (size_t i = 0; i < pts.size(); ++i)
+      for (size_t j = i + 1; j < pts.size(); ++j) d = std::max(d, (pts[i] - pts[j]).norm());
+    return d;
+  }
+
+  // The model's points: the merged views voxel-sampled at
+  // model_sampling_steps distance steps of the diameter (estimated on a
+  // 1000-point grid, within a cell of the true one), a voxel's points split by
+  // normal; coarsened to at most model_points. With model_sampling_steps 0:
+  // the grid that leaves about model_points.
+  PointSet sample_model(const PointSet& merged) const {
+    VoxelGridOptions grid;  // the PPF model's grid: cells by x, p / leaf, cancelled normals dropped
+    grid.order = VoxelGridOptions::Order::kXYZ;
+    grid.cell_index = VoxelGridOptions::CellIndex::kDivide;
+    grid.drop_cancelled_normals = 1e-6;
+    grid.normal_cluster_deg = s_.normal_cluster_deg;
+    if (s_.model_sampling_steps > 0 && !merged.points.empty()) {
+      VoxelGridOptions coarse = grid;
+      coarse.normal_cluster_deg = 0;
+      const double d = max_distance(voxel_downsample_to(merged, 1000, coarse).points);
+      grid.leaf_mm = s_.model_sampling_steps * s_.distance_step_fraction * d;
+      if (grid.leaf_mm > 0) {
+        PointSet model = voxel_downsample(merged, grid);
+        if (model.size() <= static_cast<size_t>(s_.model_points)) return model;
+      }
+    }
+    return voxel_downsample_to(merged, s_.model_points, grid);
+  }
+
   void compute_features() {
     const auto cloud = pcl_adapter::point_normals(m_.points, m_.normals);
     pcl::PointCloud<pcl::PPFSignature> f;

@@ -65,7 +65,79 @@ void KeyIndex::build(const std::vector<PairEntry>& table) {
   }
 }
 
-std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vector<int>& refs) {
+int neighbour_keys(const float f[4], const float step[4], float margin, uint64_t out[16]) {
+  int64_t bins[4][2];
+  int n[4];
+  for (int k = 0; k < 4; ++k) {
+    const float b = f[k] / step[k];
+    const float own = std::floor(b);
+    bins[k][0] = feature_bin(f[k], step[k]);
+    n[k] = 1;
+    const float frac = b - own;
+    if (margin > 0 && frac < margin) bins[k][n[k]++] = bins[k][0] - 1;
+    else if (margin > 0 && frac > 1 - margin) bins[k][n[k]++] = bins[k][0] + 1;
+  }
+  int count = 0;
+  for (int a = 0; a < n[0]; ++a)
+    for (int b = 0; b < n[1]; ++b)
+      for (int c = 0; c < n[2]; ++c)
+        for (int d = 0; d < n[3]; ++d) out[count++] = pack_key(bins[0][a], bins[1][b], bins[2][c], bins[3][d]);
+  return count;
+}
+
+namespace {
+
+// Hinterstoisser et al.'s flags for one reference point: per looked-up model
+// key, a bit per alpha_s bin already voted. Open addressing, emptied per
+// reference by a generation count.
+class VoteFlags {
+ public:
+  // True the first time (key, bit) is seen since the last next_reference().
+  bool first(uint64_t key, int bit) {
+    if (2 * (used_ + 1) > slots_.size()) grow();
+    size_t i = slot(key);
+    Slot& s = slots_[i];
+    if (s.gen != gen_) {
+      s = {key, 0, gen_};
+      ++used_;
+    }
+    const uint64_t m = uint64_t(1) << (bit & 63);
+    if (s.mask & m) return false;
+    s.mask |= m;
+    return true;
+  }
+  void next_reference() {
+    ++gen_;
+    used_ = 0;
+  }
+
+ private:
+  struct Slot {
+    uint64_t key = 0, mask = 0;
+    uint32_t gen = 0;
+  };
+  size_t slot(uint64_t key) const {
+    uint64_t h = key * 0x9e3779b97f4a7c15ull;
+    size_t i = static_cast<size_t>(h >> 20) & (slots_.size() - 1);
+    while (slots_[i].gen == gen_ && slots_[i].key != key) i = (i + 1) & (slots_.size() - 1);
+    return i;
+  }
+  void grow() {
+    std::vector<Slot> old;
+    old.swap(slots_);
+    slots_.assign(std::max<size_t>(1024, 2 * old.size()), Slot{});
+    for (const Slot& s : old)
+      if (s.gen == gen_) slots_[slot(s.key)] = s;
+  }
+  std::vector<Slot> slots_;
+  uint32_t gen_ = 1;
+  size_t used_ = 0;
+};
+
+}  // namespace
+
+std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vector<int>& refs,
+                           const VoteOptions& opt) {
   const KdTree3 tree(scene.points);
   const size_t n_model = m.points.size();
   const int n_alpha = std::max(1, static_cast<int>(std::floor(2 * M_PI / m.angle_step)));
@@ -73,7 +145,14 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
   std::vector<uint32_t> touched;  // accumulator cells voted for by the current reference point
   std::vector<PoseVote> poses;
   std::vector<int> nn;
+  VoteFlags flags;
+  const float step[4] = {m.angle_step, m.angle_step, m.angle_step, m.distance_step};
+  uint64_t keys[16];
   auto v4 = [](const Vec3f& v) { return Eigen::Vector4f(v.x(), v.y(), v.z(), 0.f); };
+  auto add = [&](uint32_t ref, int bin) {
+    const uint32_t cell = ref * static_cast<uint32_t>(n_alpha) + static_cast<uint32_t>(bin);
+    if (acc[cell]++ == 0) touched.push_back(cell);
+  };
   for (int r : refs) {
     const Vec3f sr = scene.points[r], nr = scene.normals[r];
     if (!sr.allFinite() || !nr.allFinite()) continue;
@@ -81,27 +160,39 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
     tree.radius_unsorted(sr, m.diameter, nn);  // votes add up: the neighbour order does not matter
     for (uint32_t c : touched) acc[c] = 0;
     touched.clear();
+    flags.next_reference();
     const Eigen::Vector4f pr = v4(sr), npr = v4(nr);
     for (int i : nn) {
       if (i == r) continue;
-      float f1, f2, f3, f4;
+      float f[4];
       if (!pcl::computePairFeatures(pr, npr, v4(scene.points[static_cast<size_t>(i)]),
-                                    v4(scene.normals[static_cast<size_t>(i)]), f1, f2, f3, f4))
+                                    v4(scene.normals[static_cast<size_t>(i)]), f[0], f[1], f[2], f[3]))
         continue;
-      if (!std::isfinite(f1) || !std::isfinite(f2) || !std::isfinite(f3) || !std::isfinite(f4)) continue;
-      const auto [begin, end] = m.index.find(feature_key(f1, f2, f3, f4, m.angle_step, m.distance_step));
-      if (begin == end) continue;
+      if (!std::isfinite(f[0]) || !std::isfinite(f[1]) || !std::isfinite(f[2]) || !std::isfinite(f[3])) continue;
+      const int n_keys = neighbour_keys(f, step, opt.margin, keys);
       const float alpha_s = pcl_alpha(T_sg, scene.points[static_cast<size_t>(i)]);
-      for (uint32_t e = begin; e < end; ++e) {
-        const PairEntry& it = m.table[e];
-        float alpha = it.alpha_m - alpha_s;
-        if (!std::isfinite(alpha)) continue;
-        if (alpha < -M_PI) alpha += static_cast<float>(2 * M_PI);
-        else if (alpha > M_PI) alpha -= static_cast<float>(2 * M_PI);
-        int bin = static_cast<int>(std::floor((alpha + M_PI) / m.angle_step));
-        bin = std::max(0, std::min(n_alpha - 1, bin));
-        const uint32_t cell = it.ref * static_cast<uint32_t>(n_alpha) + static_cast<uint32_t>(bin);
-        if (acc[cell]++ == 0) touched.push_back(cell);
+      if (!std::isfinite(alpha_s)) continue;
+      const int alpha_s_bin = static_cast<int>(std::floor((alpha_s + M_PI) / m.angle_step));
+      for (int k = 0; k < n_keys; ++k) {
+        const auto [begin, end] = m.index.find(keys[k]);
+        if (begin == end) continue;
+        if (opt.vote_once && !flags.first(keys[k], alpha_s_bin)) continue;
+        for (uint32_t e = begin; e < end; ++e) {
+          const PairEntry& it = m.table[e];
+          float alpha = it.alpha_m - alpha_s;
+          if (!std::isfinite(alpha)) continue;
+          if (alpha < -M_PI) alpha += static_cast<float>(2 * M_PI);
+          else if (alpha > M_PI) alpha -= static_cast<float>(2 * M_PI);
+          const float b = static_cast<float>((alpha + M_PI) / m.angle_step);
+          int bin = static_cast<int>(std::floor(b));
+          bin = std::max(0, std::min(n_alpha - 1, bin));
+          add(it.ref, bin);
+          if (opt.margin > 0) {  // the neighbouring alpha bin (alpha wraps around)
+            const float frac = b - std::floor(b);
+            if (frac < opt.margin) add(it.ref, (bin + n_alpha - 1) % n_alpha);
+            else if (frac > 1 - opt.margin) add(it.ref, (bin + 1) % n_alpha);
+          }
+        }
       }
     }
     if (touched.empty()) continue;

@@ -188,13 +188,46 @@ std::vector<Vec3> centroids(const std::vector<Vec3f>& pts, const Cells& c) {
   return sum;
 }
 
+// Splits each cell into clusters of similar normal (VoxelGridOptions::
+// normal_cluster_deg): the returned Cells have one entry per cluster, in
+// cell order and, within a cell, creation order.
+Cells split_by_normal(const Cells& c, const std::vector<Vec3f>& normals, double max_deg) {
+  const float min_cos = static_cast<float>(std::cos(max_deg * M_PI / 180.0));
+  std::vector<std::vector<int>> clusters_of(c.size());  // cell -> its clusters
+  Cells out;
+  out.cell_of.assign(c.cell_of.size(), -1);
+  for (size_t i = 0; i < c.cell_of.size(); ++i) {
+    const int k = c.cell_of[i];
+    if (k < 0) continue;
+    int home = -1;
+    for (int cl : clusters_of[static_cast<size_t>(k)])
+      if (normals[static_cast<size_t>(out.first[static_cast<size_t>(cl)])].dot(normals[i]) >= min_cos) {
+        home = cl;
+        break;
+      }
+    if (home < 0) {
+      home = static_cast<int>(out.first.size());
+      clusters_of[static_cast<size_t>(k)].push_back(home);
+      out.first.push_back(static_cast<int>(i));
+      out.count.push_back(0);
+    }
+    out.cell_of[i] = home;
+    ++out.count[static_cast<size_t>(home)];
+  }
+  for (int k : c.order)
+    for (int cl : clusters_of[static_cast<size_t>(k)]) out.order.push_back(cl);
+  return out;
+}
+
 }  // namespace
 
 PointSet voxel_downsample(const PointSet& in, const VoxelGridOptions& opt) {
   if (!(opt.leaf_mm > 0) || in.points.empty()) return in;
   const size_t n = in.points.size();
   const bool has_n = in.normals.size() == n, has_c = in.curvature.size() == n, has_px = in.pixel.size() == n;
-  const Cells c = group(in.points, opt);
+  const Cells c = has_n && opt.normal_cluster_deg > 0
+                      ? split_by_normal(group(in.points, opt), in.normals, opt.normal_cluster_deg)
+                      : group(in.points, opt);
   const std::vector<Vec3> centroid = centroids(in.points, c);
   std::vector<Vec3> nsum(has_n ? c.size() : 0, Vec3::Zero());
   std::vector<double> csum(has_c ? c.size() : 0, 0.0);

@@ -27,6 +27,13 @@ struct VoxelGridOptions {
   // not longer than this x its point count is dropped (normals cancel out);
   // if 0, such a cell (sum exactly 0) keeps the normal of its first point.
   double drop_cancelled_normals = 0;
+  // voxel_downsample with normals: if > 0, a cell's points are clustered by
+  // normal (Vidal et al. 2018's sampling for PPF): a point joins the first
+  // cluster of its cell (input order) whose first normal is within this
+  // angle, else starts one; each cluster becomes one output point (its
+  // centroid and mean normal), the cell's clusters in creation order. Keeps
+  // both sides of an edge that a plain grid would average away. 0 = off.
+  double normal_cluster_deg = 0;
 };
 
 // Centroid per occupied cell. leaf <= 0 or an empty cloud: the input as is.

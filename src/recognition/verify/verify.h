@@ -42,6 +42,16 @@ struct VerifySettings {
   // 66 (configs/experiments/verification.yaml, results/verification).
   std::string score = "visibility";
   double violation_weight = 1.0;  // visibility: what one free-space violation costs, in supported points
+  // Several instances (BOP's inst_count): after the best, the next ranked
+  // hypotheses are further instances while they are accepted like the best
+  // (an inlier, min_inlier_fraction), score at least instance_min_ratio of
+  // the best's verification and lie farther than instance_separation_mm
+  // (model origin to model origin) from every instance taken. The ranked
+  // hypotheses of a method that forms one per instance (PPF's pose
+  // clusters, the local methods' Hough peaks) carry the instances.
+  int max_instances = 1;                // at most this many; 0 = every one that passes
+  double instance_min_ratio = 0.5;      // a further instance's verification / the best's
+  double instance_separation_mm = 40.0; // closer than this to a taken instance: the same one
 
   template <class S, class F>
   static void fields(S& s, F& f) {
@@ -50,6 +60,9 @@ struct VerifySettings {
     f("inlier_model", s.inlier_model, fields::one_of({"view", "merged"}));
     f("score", s.score, fields::one_of({"inliers", "visibility"}));
     f("violation_weight", s.violation_weight, fields::nonnegative());
+    f("max_instances", s.max_instances, fields::nonnegative());
+    f("instance_min_ratio", s.instance_min_ratio, fields::in_range(0, 1));
+    f("instance_separation_mm", s.instance_separation_mm, fields::length(fields::nonnegative()));
   }
 };
 
