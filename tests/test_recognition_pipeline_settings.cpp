@@ -3,11 +3,14 @@
 // one to one (every key the parsers accept is serialized, and every
 // serialized value parses back to itself).
 #include <gtest/gtest.h>
+
+#include "core/random.h"
 #include <nlohmann/json.hpp>
 
 #include <set>
 #include <sstream>
 
+#include "core/random.h"
 #include "recognition/pipeline.h"
 #include "recognition/registry.h"
 
@@ -218,6 +221,43 @@ TEST(RelativeLengths, TheSensorsFloorAndTheCasesThatCannotResolve) {
   EXPECT_THROW(pb::resolve_lengths(code, 200), std::logic_error);
   code.relative.erase("preprocess.voxel_mm");
   EXPECT_EQ(pb::resolve_lengths(code, 200).preprocess.voxel_mm, 8);
+}
+
+// The depth noise estimate: a tilted plane (perspective, no noise) gives
+// almost none; the same plane with Gaussian noise of 2 mm gives 2 mm within
+// 5%; the floor is then the larger of 2 px and 2 sigma.
+TEST(RelativeLengths, TheSensorsNoiseRaisesTheFloor) {
+  pb::Intrinsics K;
+  K.fx = K.fy = 500;
+  K.cx = 160;
+  K.cy = 120;
+  K.width = 320;
+  K.height = 240;
+  pb::DepthImage plane(320, 240);
+  for (int v = 0; v < 240; ++v)
+    for (int u = 0; u < 320; ++u) {  // the plane z = 1000 + 0.8 x (45 degrees-ish), along the ray
+      const double rx = (u - K.cx) / K.fx;
+      plane.z[static_cast<size_t>(v * 320 + u)] = static_cast<float>(1000.0 / (1.0 - 0.8 * rx));
+    }
+  EXPECT_LT(pb::depth_noise_sigma_mm(plane), 0.05);
+  pb::DepthImage noisy = plane;
+  pb::Rng rng(5);
+  for (float& z : noisy.z) z += static_cast<float>(rng.normal(0.0, 2.0));
+  EXPECT_NEAR(pb::depth_noise_sigma_mm(noisy), 2.0, 0.1);
+  pb::ScaleSettings scale;  // 2 px at the median depth (about 1000 mm): 4 mm; 2 sigma: 4 mm
+  scale.sensor_floor_sigmas = 3;
+  EXPECT_NEAR(pb::sensor_length_floor_mm(scale, noisy, K), 6.0, 0.3);
+  scale.sensor_floor_sigmas = 0;
+  EXPECT_NEAR(pb::sensor_length_floor_mm(scale, noisy, K), 4.0, 0.2);
+  scale.sensor_floor_px = 0;
+  scale.sensor_floor_sigmas = 2;
+  EXPECT_NEAR(pb::sensor_length_floor_mm(scale, noisy, K), 4.0, 0.2);
+  // A malformed image (fewer values than its size) gives no estimate, no read past its end.
+  pb::DepthImage short_image;
+  short_image.width = 10;
+  short_image.height = 10;
+  short_image.z.assign(5, 1000.f);
+  EXPECT_EQ(pb::depth_noise_sigma_mm(short_image), 0.0);
 }
 
 TEST(RelativeLengths, BadFractionsNameTheKey) {

@@ -170,19 +170,40 @@ RecognitionSettings resolve_lengths(const RecognitionSettings& in, double model_
   return s;
 }
 
+double depth_noise_sigma_mm(const DepthImage& image) {
+  double sum = 0;
+  size_t n = 0;
+  const auto valid = [](float z) { return z > 0 && std::isfinite(z); };
+  if (image.width < 3 || image.height < 1 ||
+      image.z.size() < static_cast<size_t>(image.width) * static_cast<size_t>(image.height))
+    return 0;
+  for (int v = 0; v < image.height; ++v) {
+    const float* row = image.z.data() + static_cast<size_t>(v) * static_cast<size_t>(image.width);
+    for (int u = 1; u + 1 < image.width; ++u) {
+      if (!valid(row[u - 1]) || !valid(row[u]) || !valid(row[u + 1])) continue;
+      const double d = static_cast<double>(row[u - 1]) - 2.0 * row[u] + row[u + 1];
+      if (std::abs(d) > 0.02 * row[u]) continue;
+      sum += d * d;
+      ++n;
+    }
+  }
+  return n > 0 ? std::sqrt(sum / static_cast<double>(n) / 6.0) : 0.0;
+}
+
 double sensor_length_floor_mm(const ScaleSettings& scale, const DepthImage& image, const Intrinsics& K) {
-  if (!(scale.sensor_floor_px > 0) || !(K.fx > 0)) return 0;
+  const double noise = scale.sensor_floor_sigmas > 0 ? scale.sensor_floor_sigmas * depth_noise_sigma_mm(image) : 0;
+  if (!(scale.sensor_floor_px > 0) || !(K.fx > 0)) return noise;
   double z = scale.working_distance_mm;
   if (!(z > 0)) {
     std::vector<float> valid;
     valid.reserve(image.z.size());
     for (const float v : image.z)
       if (v > 0 && std::isfinite(v)) valid.push_back(v);
-    if (valid.empty()) return 0;
+    if (valid.empty()) return noise;
     std::nth_element(valid.begin(), valid.begin() + static_cast<std::ptrdiff_t>(valid.size() / 2), valid.end());
     z = valid[valid.size() / 2];
   }
-  return scale.sensor_floor_px * z / K.fx;
+  return std::max(noise, scale.sensor_floor_px * z / K.fx);
 }
 
 RecognitionSettings resolve_lengths_for_sensor(const RecognitionSettings& in, double model_diameter_mm,

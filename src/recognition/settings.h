@@ -46,6 +46,9 @@ struct ScaleSettings {
   double sensor_floor_px = 2.0;    // the sensor's floor: this many pixel footprints at the working
                                    // distance (the runner and `recognize` set min_length_mm from
                                    // it when min_length_mm is 0; 0 = no floor)
+  double sensor_floor_sigmas = 2.0; // and this many standard deviations of the depth noise,
+                                   // estimated from the image (depth_noise_sigma_mm): the floor
+                                   // is the larger of the two; 0 = the pixels alone
   double working_distance_mm = 0;  // where the object is seen (mm); 0 = the median valid depth of
                                    // the scene's first image
   double length_factor = 1.0;      // every relative length x this (one knob for the whole
@@ -56,6 +59,7 @@ struct ScaleSettings {
     f("diameter_mm", s.diameter_mm, fields::nonnegative());
     f("min_length_mm", s.min_length_mm, fields::nonnegative());
     f("sensor_floor_px", s.sensor_floor_px, fields::nonnegative());
+    f("sensor_floor_sigmas", s.sensor_floor_sigmas, fields::nonnegative());
     f("working_distance_mm", s.working_distance_mm, fields::nonnegative());
     f("length_factor", s.length_factor, fields::positive());
   }
@@ -92,11 +96,22 @@ struct RecognitionSettings {
 // and d is not positive.
 RecognitionSettings resolve_lengths(const RecognitionSettings& s, double model_diameter_mm);
 
-// The sensor's floor for relative lengths: scale.sensor_floor_px pixel
-// footprints (working distance / fx) at the working distance
-// (scale.working_distance_mm, else the median valid depth of `image`). 0
-// when there is none (no valid depth, sensor_floor_px 0).
+// The sensor's floor for relative lengths: the larger of
+// scale.sensor_floor_px pixel footprints (working distance / fx) at the
+// working distance (scale.working_distance_mm, else the median valid depth
+// of `image`) and scale.sensor_floor_sigmas x the image's depth noise
+// (depth_noise_sigma_mm). 0 when there is none (no valid depth, both
+// factors 0).
 double sensor_length_floor_mm(const ScaleSettings& scale, const DepthImage& image, const Intrinsics& K);
+
+// The depth noise of an image (mm, one standard deviation), estimated from
+// the image alone: along each row, the second difference
+// z[u-1] - 2 z[u] + z[u+1] of three valid pixels cancels a locally linear
+// surface and leaves noise of variance 6 sigma^2; differences above 2% of
+// the depth (edges, steep surfaces) are left out; sigma = sqrt(mean(d^2) /
+// 6). Catches a real sensor's noise and its depth quantization; 0 without
+// three valid neighbours in a row.
+double depth_noise_sigma_mm(const DepthImage& image);
 
 // resolve_lengths with the sensor's floor: when scale.min_length_mm is 0 it
 // becomes sensor_length_floor_mm(scale, image, K) first. The runner passes
