@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "eval/record.h"
+#include "report/lengths.h"
 
 namespace pb {
 
@@ -51,6 +52,7 @@ struct Report {
   std::vector<ReportPlot> plots;
   size_t records = 0;
   std::map<std::string, size_t> status_counts;
+  std::vector<ResolvedLengths> lengths;  // the lengths the trials resolved, per scene set and object
 };
 
 struct ReportOptions {

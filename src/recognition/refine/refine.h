@@ -45,7 +45,8 @@ struct RefineSettings {
                                                // own k-neighbour covariances
   double crop_margin_mm = -1;              // scene crop: points within model radius + this of the
                                            // initial model centre are registered (< 0: use
-                                           // max_correspondence_mm)
+                                           // max_correspondence_mm, which is relative by default; a
+                                           // fraction "0.05d" is allowed)
   int normal_neighbours = 10;              // k for PCA normals when a cloud has none (icp_plane, gicp)
   int max_hypotheses = 0;                  // refine only this many hypotheses: those with the most
                                            // model points within max_correspondence_mm of a scene
@@ -69,7 +70,7 @@ struct RefineSettings {
     f("ndt_min_points_per_cell", s.ndt_min_points_per_cell, fields::at_least(3));
     f("gicp_correspondence_randomness", s.gicp_correspondence_randomness, fields::at_least(3));
     f("gicp_covariances_from_normals", s.gicp_covariances_from_normals);
-    f("crop_margin_mm", s.crop_margin_mm);
+    f("crop_margin_mm", s.crop_margin_mm, fields::length({}));  // a length ("0.05d"); < 0: the sentinel
     f("normal_neighbours", s.normal_neighbours, fields::at_least(3));
     f("max_hypotheses", s.max_hypotheses, fields::at_least(0));
   }
