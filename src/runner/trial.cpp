@@ -165,8 +165,11 @@ void record_instances(const RecognitionResult& res, const ImageInfo& im, const B
     if (any_gt) {
       inst.correct = false;
       for (size_t g = 0; g < im.gt.size() && !*inst.correct; ++g)
-        if (im.gt[g].obj_id == obj_id && !taken[g] && thesis_judge(h.T_cam_model, im.gt[g].T_cam_model, syms, thr).correct)
-          taken[g] = true, inst.correct = true;
+        if (im.gt[g].obj_id == obj_id && !taken[g] &&
+            thesis_judge(h.T_cam_model, im.gt[g].T_cam_model, syms, thr).correct) {
+          taken[g] = true;
+          inst.correct = true;
+        }
     }
     rec.instances->push_back(inst);
   }
