@@ -66,7 +66,7 @@ seed() {  # seed NAME FILE [PREFIX_BYTE]
   if [ -n "${3:-}" ]; then { printf "\\x$(printf %02x "$3")"; cat "$2"; } >"$out"; else cp "$2" "$out"; fi
 }
 scene="$SEEDS/ds/test/000001"
-for f in configs/experiments/*.yaml configs/experiments/scale/*.yaml configs/thesis/*.yaml fuzz/seeds/experiment_relative.yaml; do
+for f in configs/experiments/*.yaml configs/experiments/scale/*.yaml configs/thesis/*.yaml fuzz/seeds/experiment_relative.yaml fuzz/seeds/experiment_all.yaml; do
   seed fuzz_experiment_yaml "$f"
 done
 for f in configs/scenes/*.yaml; do seed fuzz_scene_yaml "$f"; done
@@ -92,7 +92,7 @@ for f in "$SEEDS"/cache/*.bin; do
   case "$d" in cesf) i=0 ;; cvfh) i=1 ;; esf) i=2 ;; fpfh) i=3 ;; ourcvfh) i=4 ;; ppf) i=5 ;; shot) i=6 ;; *) continue ;; esac
   seed fuzz_training_cache "$f" "$i"
 done
-for f in tests/data/expected_records/*.jsonl; do seed fuzz_records_jsonl "$f"; done
+for f in tests/data/expected_records/*.jsonl fuzz/seeds/records_instances.jsonl; do seed fuzz_records_jsonl "$f"; done
 
 export ASAN_OPTIONS="detect_leaks=1:allocator_may_return_null=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
