@@ -154,38 +154,46 @@ std::vector<Hypothesis> verify_and_rank(std::vector<Hypothesis> hyps, const Trai
   return ranked;
 }
 
-// The acceptance rule (VerifySettings): the best hypothesis needs an inlier
-// and at least min_inlier_fraction of its model points as inliers.
-void accept_best(const TrainedModel& model, const VerifySettings& v, RecognitionResult& res) {
-  const Hypothesis& best = res.hypotheses.front();
-  const size_t model_points = model.verify_cloud(best.view, v).size();
-  if (best.inliers < 1) {
-    res.message = "no hypothesis has an inlier within " + std::to_string(v.inlier_threshold_mm) + " mm";
-    return;
-  }
-  if (static_cast<double>(best.inliers) < v.min_inlier_fraction * static_cast<double>(model_points)) {
-    res.message = "the best hypothesis has " + std::to_string(best.inliers) + " inliers of " +
-                  std::to_string(model_points) + " model points, below min_inlier_fraction " +
-                  std::to_string(v.min_inlier_fraction);
-    return;
-  }
-  res.status = "ok";
-  res.T_cam_model = best.T_cam_model;
-  res.score = best.score;
-  res.inliers = best.inliers;
-  res.instances.push_back(best);
-  // Further instances (VerifySettings::max_instances), in rank order.
+// The acceptance rule (VerifySettings): a hypothesis needs an inlier and at
+// least min_inlier_fraction of its model points as inliers. Returns why the
+// ranked-first hypothesis `h` fails it, "" when it passes.
+std::string rejection(const Hypothesis& h, const TrainedModel& model, const VerifySettings& v) {
+  if (h.inliers < 1) return "no hypothesis has an inlier within " + std::to_string(v.inlier_threshold_mm) + " mm";
+  const size_t model_points = model.verify_cloud(h.view, v).size();
+  if (static_cast<double>(h.inliers) < v.min_inlier_fraction * static_cast<double>(model_points))
+    return "the best hypothesis has " + std::to_string(h.inliers) + " inliers of " + std::to_string(model_points) +
+           " model points, below min_inlier_fraction " + std::to_string(v.min_inlier_fraction);
+  return "";
+}
+
+// Further instances (VerifySettings::max_instances) after the accepted best,
+// in rank order: accepted by the same rule, at least instance_min_ratio of
+// the best's verification, farther than instance_separation_mm from every
+// instance taken.
+void collect_instances(const TrainedModel& model, const VerifySettings& v, RecognitionResult& res) {
+  const Hypothesis& best = res.instances.front();
   for (size_t i = 1; i < res.hypotheses.size(); ++i) {
     if (v.max_instances > 0 && res.instances.size() >= static_cast<size_t>(v.max_instances)) break;
     const Hypothesis& h = res.hypotheses[i];
-    const double points = static_cast<double>(model.verify_cloud(h.view, v).size());
-    if (h.inliers < 1 || static_cast<double>(h.inliers) < v.min_inlier_fraction * points) continue;
-    if (!(h.verification >= v.instance_min_ratio * best.verification) || !(h.verification > 0)) continue;
+    if (!(h.verification > 0) || !(h.verification >= v.instance_min_ratio * best.verification)) continue;
+    if (!rejection(h, model, v).empty()) continue;
     bool separate = true;
     for (const Hypothesis& taken : res.instances)
       separate = separate && (h.T_cam_model.t - taken.T_cam_model.t).norm() > v.instance_separation_mm;
     if (separate) res.instances.push_back(h);
   }
+}
+
+void accept_best(const TrainedModel& model, const VerifySettings& v, RecognitionResult& res) {
+  const Hypothesis& best = res.hypotheses.front();
+  res.message = rejection(best, model, v);
+  if (!res.message.empty()) return;
+  res.status = "ok";
+  res.T_cam_model = best.T_cam_model;
+  res.score = best.score;
+  res.inliers = best.inliers;
+  res.instances.push_back(best);
+  collect_instances(model, v, res);
 }
 
 // The training view seen from the direction closest to the one `init`

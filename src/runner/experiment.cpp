@@ -289,14 +289,17 @@ ExperimentConfig load_experiment(const std::string& path) {
 namespace {
 
 // A scene source's test targets for the experiment's object (every object
-// with `object: all`): the file, and each listed (scene_id, im_id) with the
-// index of its first entry there (for errors) and its targets (obj_id,
+// with `object: all`): the file, and per listed (scene_id, im_id) the index
+// of its first entry there (for errors) and its targets (obj_id,
 // inst_count). Every scene must be in the split; that every image is in its
 // scene is checked as expand_trials reads the scene (check_target_images).
+struct ImageTargets {
+  size_t first_entry = 0;
+  std::vector<std::pair<int, int>> objects;  // (obj_id, inst_count)
+};
 struct Targets {
   std::string file;
-  std::map<std::pair<int, int>, size_t> entry;
-  std::map<std::pair<int, int>, std::vector<std::pair<int, int>>> objects;
+  std::map<std::pair<int, int>, ImageTargets> images;
 };
 
 Targets read_targets(const SceneSource& src, const BopDataset& ds, const std::string& object) {
@@ -318,20 +321,58 @@ Targets read_targets(const SceneSource& src, const BopDataset& ds, const std::st
     if (every && !ds.models().count(t.obj_id))
       throw InputError(out.file, "[" + std::to_string(i) + "].obj_id",
                        "object " + std::to_string(t.obj_id) + " is not in the dataset's models_info.json");
-    out.entry.emplace(std::make_pair(t.scene_id, t.im_id), i);
-    out.objects[{t.scene_id, t.im_id}].push_back({t.obj_id, t.inst_count});
+    auto [it, fresh] = out.images.try_emplace({t.scene_id, t.im_id});
+    if (fresh) it->second.first_entry = i;
+    it->second.objects.push_back({t.obj_id, t.inst_count});
   }
-  if (out.entry.empty())
+  if (out.images.empty())
     throw InputError(out.file, "obj_id", "no target for object '" + object + "' (obj_id " + std::to_string(obj) + ")");
   return out;
 }
 
 void check_target_images(const Targets& targets, const SceneInfo& scene) {
-  for (auto it = targets.entry.lower_bound({scene.scene_id, INT_MIN});
-       it != targets.entry.end() && it->first.first == scene.scene_id; ++it)
+  for (auto it = targets.images.lower_bound({scene.scene_id, INT_MIN});
+       it != targets.images.end() && it->first.first == scene.scene_id; ++it)
     if (!scene.images.count(it->first.second))
-      throw InputError(targets.file, "[" + std::to_string(it->second) + "].im_id",
+      throw InputError(targets.file, "[" + std::to_string(it->second.first_entry) + "].im_id",
                        "image " + std::to_string(it->first.second) + " is not in scene " + std::to_string(scene.scene_id));
+}
+
+// One trial: the scene source's image, object (obj_id 0: the experiment's;
+// with an inst_count, verify.max_instances is set to it), method, grid
+// point and noise, its settings, key and seed.
+Trial make_trial(const ExperimentConfig& cfg, const SceneSource& src, int sid, int im_id,
+                 std::pair<int, int> target, const std::string& d, const std::string& r,
+                 const nlohmann::json& p, double noise) {
+  const auto [obj_id, inst_count] = target;
+  Trial t;
+  t.scene_name = src.name;
+  t.scenario = src.scenario;
+  t.dataset = src.dataset;
+  t.split = src.split;
+  t.scene_id = sid;
+  t.im_id = im_id;
+  t.obj_id = obj_id;
+  t.inst_count = inst_count;
+  t.descriptor = d;
+  t.refinement = r;
+  t.params = p;
+  t.added_noise_mm = noise;
+  nlohmann::json s = cfg.settings;
+  merge(s, src.settings);
+  for (auto it = p.begin(); it != p.end(); ++it) set_path(s, it.key(), it.value());
+  s["descriptor"] = d == "none" ? "fpfh" : d;
+  s["refinement"] = r;
+  if (inst_count > 0) set_path(s, "verify.max_instances", inst_count);
+  t.settings = s;
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%d/%d", sid, im_id);
+  t.key = src.name + "/" + buf + "/" + d + "/" + r + "/" + p.dump() + "/noise=" + nlohmann::json(noise).dump();
+  if (obj_id > 0) t.key += "/obj=" + std::to_string(obj_id);
+  // The trial's random stream: stream_id keeps the seeds (and so every
+  // result) of the releases before the one hash.
+  t.seed = derive_seed(cfg.seed, {stream_id(t.key)});
+  return t;
 }
 
 }  // namespace
@@ -357,7 +398,7 @@ std::vector<Trial> expand_trials(const ExperimentConfig& cfg) {
     const Targets targets = read_targets(src, ds, cfg.object);
     if (!src.targets.empty() && src.scene_ids.empty()) {
       sids.clear();
-      for (const auto& [key, i] : targets.entry)
+      for (const auto& [key, image] : targets.images)
         if (sids.empty() || sids.back() != key.first) sids.push_back(key.first);
     }
     for (int sid : sids) {
@@ -365,49 +406,20 @@ std::vector<Trial> expand_trials(const ExperimentConfig& cfg) {
       check_target_images(targets, scene);
       int taken = 0;
       for (const auto& [im_id, im] : scene.images) {
-        if (!src.targets.empty() && targets.entry.count({sid, im_id}) == 0) continue;
+        if (!src.targets.empty() && targets.images.count({sid, im_id}) == 0) continue;
         if (src.images > 0 && taken >= src.images) break;
         ++taken;
         const auto& refinements = src.refinements.empty() ? cfg.refinements : src.refinements;
         // The image's objects: the experiment's, or each test target's
         // (obj_id, inst_count) with `object: all`.
         std::vector<std::pair<int, int>> objects{{0, 0}};
-        if (cfg.object == kEveryTargetObject) objects = targets.objects.at({sid, im_id});
-        for (const auto& [obj_id, inst_count] : objects)
-        for (const auto& d : cfg.descriptors)
-          for (const auto& r : refinements)
-            for (const auto& p : points)
-              for (double noise : cfg.added_noise_mm) {
-                Trial t;
-                t.scene_name = src.name;
-                t.scenario = src.scenario;
-                t.dataset = src.dataset;
-                t.split = src.split;
-                t.scene_id = sid;
-                t.im_id = im_id;
-                t.obj_id = obj_id;
-                t.inst_count = inst_count;
-                t.descriptor = d;
-                t.refinement = r;
-                t.params = p;
-                t.added_noise_mm = noise;
-                nlohmann::json s = cfg.settings;
-                merge(s, src.settings);
-                for (auto it = p.begin(); it != p.end(); ++it) set_path(s, it.key(), it.value());
-                s["descriptor"] = d == "none" ? "fpfh" : d;
-                s["refinement"] = r;
-                if (inst_count > 0) set_path(s, "verify.max_instances", inst_count);
-                t.settings = s;
-                char buf[64];
-                std::snprintf(buf, sizeof buf, "%d/%d", sid, im_id);
-                t.key = src.name + "/" + buf + "/" + d + "/" + r + "/" + p.dump() + "/noise=" +
-                        nlohmann::json(noise).dump();
-                if (obj_id > 0) t.key += "/obj=" + std::to_string(obj_id);
-                // The trial's random stream: stream_id keeps the seeds (and so
-                // every result) of the releases before the one hash.
-                t.seed = derive_seed(cfg.seed, {stream_id(t.key)});
-                trials.push_back(std::move(t));
-              }
+        if (cfg.object == kEveryTargetObject) objects = targets.images.at({sid, im_id}).objects;
+        for (const auto& target : objects)
+          for (const auto& d : cfg.descriptors)
+            for (const auto& r : refinements)
+              for (const auto& p : points)
+                for (double noise : cfg.added_noise_mm)
+                  trials.push_back(make_trial(cfg, src, sid, im_id, target, d, r, p, noise));
       }
     }
   }

@@ -61,10 +61,10 @@ class KeyIndex {
 
 // The discretized feature (PCL's floor(f / step), in float) packed into 64
 // bits, 16 per component (bin indices are clamped to +-32767).
-inline int64_t feature_bin(float f, float step) {
-  const float b = std::floor(f / step);
-  return static_cast<int64_t>(std::max(-32767.f, std::min(32767.f, b)));
+inline int64_t clamped_bin(float floored) {
+  return static_cast<int64_t>(std::max(-32767.f, std::min(32767.f, floored)));
 }
+inline int64_t feature_bin(float f, float step) { return clamped_bin(std::floor(f / step)); }
 inline uint64_t pack_key(int64_t b1, int64_t b2, int64_t b3, int64_t b4) {
   auto u = [](int64_t b) { return static_cast<uint64_t>(std::max<int64_t>(-32767, std::min<int64_t>(32767, b)) + 32768) & 0xffffu; };
   return (u(b1) << 48) | (u(b2) << 32) | (u(b3) << 16) | u(b4);

@@ -71,11 +71,13 @@ int neighbour_keys(const float f[4], const float step[4], float margin, uint64_t
   for (int k = 0; k < 4; ++k) {
     const float b = f[k] / step[k];
     const float own = std::floor(b);
-    bins[k][0] = feature_bin(f[k], step[k]);
+    bins[k][0] = clamped_bin(own);  // feature_bin(f[k], step[k]), from the one division
     n[k] = 1;
-    const float frac = b - own;
-    if (margin > 0 && frac < margin) bins[k][n[k]++] = bins[k][0] - 1;
-    else if (margin > 0 && frac > 1 - margin) bins[k][n[k]++] = bins[k][0] + 1;
+    if (margin > 0) {
+      const float frac = b - own;
+      if (frac < margin) bins[k][n[k]++] = bins[k][0] - 1;
+      else if (frac > 1 - margin) bins[k][n[k]++] = bins[k][0] + 1;
+    }
   }
   int count = 0;
   for (int a = 0; a < n[0]; ++a)
@@ -184,11 +186,11 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
           if (alpha < -M_PI) alpha += static_cast<float>(2 * M_PI);
           else if (alpha > M_PI) alpha -= static_cast<float>(2 * M_PI);
           const float b = static_cast<float>((alpha + M_PI) / m.angle_step);
-          int bin = static_cast<int>(std::floor(b));
-          bin = std::max(0, std::min(n_alpha - 1, bin));
+          const float floored = std::floor(b);
+          const int bin = std::max(0, std::min(n_alpha - 1, static_cast<int>(floored)));
           add(it.ref, bin);
           if (opt.margin > 0) {  // the neighbouring alpha bin (alpha wraps around)
-            const float frac = b - std::floor(b);
+            const float frac = b - floored;
             if (frac < opt.margin) add(it.ref, (bin + n_alpha - 1) % n_alpha);
             else if (frac > 1 - opt.margin) add(it.ref, (bin + 1) % n_alpha);
           }
