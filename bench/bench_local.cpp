@@ -35,8 +35,8 @@ struct Described {
 Described describe(const PointSet& c, bool fpfh, const LocalSettings& s) {
   const int dim = fpfh ? local::kFpfhDim : local::kShotDim;
   const std::vector<int> idx = local::voxel_keypoints(c, s.keypoint_voxel_mm);
-  const std::vector<float> d = fpfh ? local::compute_fpfh(c, idx, s.descriptor_radius_mm, s.threads)
-                                    : local::compute_shot(c, idx, s.descriptor_radius_mm, s.threads);
+  const std::vector<float> d = fpfh ? local::compute_fpfh(c, idx, s.descriptor_radius_mm, s.threads, s.max_support_points)
+                                    : local::compute_shot(c, idx, s.descriptor_radius_mm, s.threads, s.max_support_points);
   const std::vector<float> l = local::compute_board_lrf(c, idx, s.lrf_radius_mm);
   Described out;
   for (size_t i = 0; i < idx.size(); ++i) {
@@ -137,9 +137,17 @@ void describe_bench(benchmark::State& state, Describe fn) {
   for (auto _ : state) benchmark::DoNotOptimize(fn(f.scene, f.scene_kp, f.s.local.descriptor_radius_mm, threads).data());
   state.counters["keypoints"] = static_cast<double>(f.scene_kp.size());
 }
-void BM_Fpfh(benchmark::State& state) { describe_bench(state, local::compute_fpfh); }
+void BM_Fpfh(benchmark::State& state) {
+  describe_bench(state, [](const PointSet& c, const std::vector<int>& k, double r, int t) {
+    return local::compute_fpfh(c, k, r, t, fixture().s.local.max_support_points);
+  });
+}
 void BM_FpfhPcl(benchmark::State& state) { describe_bench(state, local::compute_fpfh_pcl); }
-void BM_Shot(benchmark::State& state) { describe_bench(state, local::compute_shot); }
+void BM_Shot(benchmark::State& state) {
+  describe_bench(state, [](const PointSet& c, const std::vector<int>& k, double r, int t) {
+    return local::compute_shot(c, k, r, t, fixture().s.local.max_support_points);
+  });
+}
 void BM_ShotPcl(benchmark::State& state) { describe_bench(state, local::compute_shot_pcl); }
 void BM_BoardLrf(benchmark::State& state) {
   const Fixture& f = fixture();

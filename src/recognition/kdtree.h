@@ -54,4 +54,17 @@ class KdTree3 {
   std::vector<Node> nodes_;
 };
 
+// Thins a neighbour list to at most `max_points` entries evenly spaced in
+// its order (entry floor(i * n / max_points) for i < max_points): in order
+// of distance a sample even in rank, in tree order a spatially stratified
+// one. No random draw, so the same list gives the same sample. 0 keeps all.
+template <class T>
+void keep_evenly(std::vector<T>& v, int max_points) {
+  const size_t n = v.size();
+  if (max_points <= 0 || n <= static_cast<size_t>(max_points)) return;
+  const size_t m = static_cast<size_t>(max_points);
+  for (size_t i = 0; i < m; ++i) v[i] = v[i * n / m];  // i * n / m >= i: reads ahead of writes
+  v.resize(m);
+}
+
 }  // namespace pb

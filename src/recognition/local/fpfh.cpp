@@ -86,44 +86,44 @@ inline void count_pair(float f1, float f2, float f3, uint32_t* c) {
   ++c[2 * kBins + bin_of(kBins * ((f3 + 1.0) * 0.5))];
 }
 
-}  // namespace
-
-std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& keypoints, double radius_mm,
-                                int threads) {
-  std::vector<float> out(keypoints.size() * kFpfhDim, std::numeric_limits<float>::quiet_NaN());
-  if (keypoints.empty() || !cloud.has_normals() || !(radius_mm > 0)) return out;
+// SPFH histograms of the `needed` points (row_of: cloud index -> row, or -1).
+// A point with more than max_support neighbours is "thinned": its SPFH is
+// taken over an even sample (in tree order) of them, computed by itself
+// alone. Among the other needed points each pair is computed once, by the
+// lower index, and counted for both when symmetric (pair_features), else each
+// point computes its own. Counts are integers, so their sum over threads does
+// not depend on the order; every addition to a bin of point p adds the same
+// 100 / (pairs of p), so the float histogram is that value added count
+// times, as PCL's loop adds it.
+std::vector<Hist> spfh_histograms(const PointSet& cloud, const CloudNeighbours& tree, float r2,
+                                  const std::vector<int>& needed, const std::vector<int>& row_of, int max_support,
+                                  int nthreads) {
   const std::vector<Vec3f>& pts = cloud.points;
-  const int n = static_cast<int>(pts.size());
-  const CloudNeighbours tree(pts);
-  const float r2 = static_cast<float>(radius_mm * radius_mm);
-  const auto neighbours = [&](int p, std::vector<std::pair<float, int>>& nn, bool sorted) {
-    tree.within(pts[p], r2, nn, sorted);
+  const size_t rows = needed.size();
+  std::vector<int> pairs_of(rows, 0);  // neighbours other than the point itself
+  std::vector<char> thinned(rows, 0);
+  // The neighbours (the point itself left out) of needed point i, thinned;
+  // true when there were more than max_support.
+  const auto spfh_neighbours = [&](size_t i, std::vector<std::pair<float, int>>& nn, std::vector<int>& list) {
+    const int p = needed[i];
+    const size_t found = tree.within(pts[p], r2, nn, false, max_support);
+    list.clear();
+    for (const auto& e : nn)
+      if (e.second != p) list.push_back(e.second);
+    return max_support > 0 && found > static_cast<size_t>(max_support);
   };
-  const int nthreads = omp_threads(threads);
-
-  // Which points need an SPFH: every neighbour of a (finite) keypoint.
-  std::vector<int> row_of(static_cast<size_t>(n), -1);
-  std::vector<int> needed;
-  {
-    std::vector<std::pair<float, int>> nn;
-    for (int k : keypoints) {
-      if (k < 0 || k >= n || !pts[k].allFinite()) continue;
-      neighbours(k, nn, false);
-      for (const auto& e : nn)
-        if (row_of[static_cast<size_t>(e.second)] < 0) {
-          row_of[static_cast<size_t>(e.second)] = static_cast<int>(needed.size());
-          needed.push_back(e.second);
-        }
+  // With a cap, which rows are thinned must be known before any pair is
+  // shared: the lists (at most max_support each) are found first and kept.
+  std::vector<std::vector<int>> kept(max_support > 0 ? rows : 0);
+  if (max_support > 0) {
+#pragma omp parallel num_threads(nthreads) if (rows > 256)
+    {
+      std::vector<std::pair<float, int>> nn;
+#pragma omp for schedule(dynamic, 64)
+      for (long i = 0; i < static_cast<long>(rows); ++i)
+        thinned[static_cast<size_t>(i)] = spfh_neighbours(static_cast<size_t>(i), nn, kept[static_cast<size_t>(i)]);
     }
   }
-  // SPFH bin counts. Each pair of needed points is computed once, by the
-  // lower index, and counted for both when symmetric (pair_features), else
-  // each point computes its own. Counts are integers, so their sum over threads does
-  // not depend on the order; every addition to a bin of point p adds the same
-  // 100 / (neighbours - 1), so the float histogram is that value added
-  // count times, as PCL's loop adds it.
-  const size_t rows = needed.size();
-  std::vector<int> nn_size(rows, 0);
   std::vector<std::vector<Counts>> counts(static_cast<size_t>(nthreads));
 #pragma omp parallel num_threads(nthreads) if (rows > 256)
   {
@@ -134,19 +134,23 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
 #endif
     mine.assign(rows, Counts{});
     std::vector<std::pair<float, int>> nn;
+    std::vector<int> searched;
 #pragma omp for schedule(dynamic, 64)
     for (long i = 0; i < static_cast<long>(rows); ++i) {
-      const int p = needed[static_cast<size_t>(i)];
-      neighbours(p, nn, false);
-      nn_size[static_cast<size_t>(i)] = static_cast<int>(nn.size());
-      for (const auto& e : nn) {
-        const int q = e.second;
-        const int qrow = row_of[static_cast<size_t>(q)];
-        if (q == p || (qrow >= 0 && q < p)) continue;  // itself, or counted from q
+      const size_t r = static_cast<size_t>(i);
+      const int p = needed[r];
+      if (max_support <= 0) spfh_neighbours(r, nn, searched);
+      const std::vector<int>& list = max_support > 0 ? kept[r] : searched;
+      pairs_of[r] = static_cast<int>(list.size());
+      const bool alone = thinned[r];
+      for (const int q : list) {
+        int qrow = row_of[static_cast<size_t>(q)];
+        if (alone || (qrow >= 0 && thinned[static_cast<size_t>(qrow)])) qrow = -1;  // q counts its own
+        if (qrow >= 0 && q < p) continue;  // counted from q
         float f1, f2, f3;
         bool symmetric = false;
         if (pair_features(pts[p], cloud.normals[p], pts[q], cloud.normals[q], f1, f2, f3, &symmetric)) {
-          count_pair(f1, f2, f3, mine[static_cast<size_t>(i)].data());
+          count_pair(f1, f2, f3, mine[r].data());
           if (qrow >= 0 && symmetric) count_pair(f1, f2, f3, mine[static_cast<size_t>(qrow)].data());
         }
         if (qrow >= 0 && !symmetric &&
@@ -155,9 +159,10 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
       }
     }
   }
+  kept = {};
   std::vector<Hist> spfhs(rows);
   for (size_t i = 0; i < rows; ++i) {
-    const float incr = 100.f / static_cast<float>(nn_size[i] - 1);
+    const float incr = 100.f / static_cast<float>(pairs_of[i]);
     for (int j = 0; j < kFpfhDim; ++j) {
       uint32_t c = 0;
       for (const auto& t : counts)
@@ -167,6 +172,43 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
       spfhs[i][static_cast<size_t>(j)] = v;
     }
   }
+  return spfhs;
+}
+
+}  // namespace
+
+std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& keypoints, double radius_mm,
+                                int threads, int max_support) {
+  std::vector<float> out(keypoints.size() * kFpfhDim, std::numeric_limits<float>::quiet_NaN());
+  if (keypoints.empty() || !cloud.has_normals() || !(radius_mm > 0)) return out;
+  const std::vector<Vec3f>& pts = cloud.points;
+  const int n = static_cast<int>(pts.size());
+  const CloudNeighbours tree(pts);
+  const float r2 = static_cast<float>(radius_mm * radius_mm);
+  // A keypoint's neighbours, thinned evenly in tree order to max_support as
+  // the SPFH rows are, then in order of distance (its weighted sum follows
+  // PCL's order).
+  const auto keypoint_neighbours = [&](int k, std::vector<std::pair<float, int>>& nn) {
+    tree.within(pts[k], r2, nn, true, max_support);
+  };
+  const int nthreads = omp_threads(threads);
+
+  // Which points need an SPFH: every (kept) neighbour of a (finite) keypoint.
+  std::vector<int> row_of(static_cast<size_t>(n), -1);
+  std::vector<int> needed;
+  {
+    std::vector<std::pair<float, int>> nn;
+    for (int k : keypoints) {
+      if (k < 0 || k >= n || !pts[k].allFinite()) continue;
+      keypoint_neighbours(k, nn);
+      for (const auto& e : nn)
+        if (row_of[static_cast<size_t>(e.second)] < 0) {
+          row_of[static_cast<size_t>(e.second)] = static_cast<int>(needed.size());
+          needed.push_back(e.second);
+        }
+    }
+  }
+  const std::vector<Hist> spfhs = spfh_histograms(cloud, tree, r2, needed, row_of, max_support, nthreads);
 
   // FPFH: the weighted SPFHs of each keypoint's neighbours.
 #pragma omp parallel num_threads(nthreads) if (keypoints.size() > 64)
@@ -176,7 +218,7 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
     for (long i = 0; i < static_cast<long>(keypoints.size()); ++i) {
       const int k = keypoints[static_cast<size_t>(i)];
       if (k < 0 || k >= n || !pts[k].allFinite()) continue;
-      neighbours(k, nn, true);  // weighted sums: in order of distance, as PCL
+      keypoint_neighbours(k, nn);  // weighted sums: in order of distance, as PCL
       Hist h{};
       std::array<double, 3> sum{0, 0, 0};
       for (const auto& [d2, q] : nn) {

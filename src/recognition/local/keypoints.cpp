@@ -1,6 +1,7 @@
 // Keypoints of the local pipeline: a second, coarser voxel grid (THESIS.md
 // "Local pipeline" step 1), on the shared grid (preprocess/voxel_grid.h).
 // PCL-free.
+#include <algorithm>
 #include <cmath>
 
 #include "recognition/local/internal.h"
@@ -35,9 +36,19 @@ std::vector<Vec3f> finite_points(const std::vector<Vec3f>& points, std::vector<i
 
 CloudNeighbours::CloudNeighbours(const std::vector<Vec3f>& points) : tree_(finite_points(points, cloud_index_)) {}
 
-void CloudNeighbours::within(const Vec3f& q, float r2, std::vector<std::pair<float, int>>& out, bool sorted) const {
-  tree_.within(q, r2, out, sorted);
+size_t CloudNeighbours::within(const Vec3f& q, float r2, std::vector<std::pair<float, int>>& out, bool sorted,
+                               int max_points) const {
+  const bool thin = max_points > 0;
+  tree_.within(q, r2, out, sorted && !thin);
+  const size_t found = out.size();
+  if (thin) {
+    keep_evenly(out, max_points);
+    // (squared distance, tree index) pairs order as the kd-tree's sorted keys
+    if (sorted) std::sort(out.begin(), out.end());
+  }
+  // tree index -> cloud index keeps the order (finite_points keeps it)
   for (auto& e : out) e.second = cloud_index_[static_cast<size_t>(e.second)];
+  return found;
 }
 
 }  // namespace pb::local

@@ -12,6 +12,14 @@ struct LocalSettings {
   double descriptor_radius_mm = 60.0;   // FPFH / SHOT support radius (the thesis gives none;
                                         // on generated table scenes with 10 mm voxels SHOT
                                         // did clearly better at 60 than at 40, FPFH alike)
+  int max_support_points = 256;         // FPFH / SHOT: a support of more points than this is
+                                        // thinned evenly to this many before a histogram is
+                                        // summed over it (FPFH: every SPFH and the keypoint's
+                                        // sum; SHOT: the histogram, its frame still from every
+                                        // point; 0 = every point, PCL's definitions). Bounds the
+                                        // cost where a support radius holds thousands of points
+                                        // (large objects on small voxels, noise that turns a
+                                        // surface into a volume)
   double lrf_radius_mm = 40.0;          // BOARD local reference frame radius (Hough voting)
   double match_threshold = 0.5;         // SHOT: max squared L2 distance between SHOT
                                         // descriptors (unit L2 norm, so in [0, 2]; PCL's
@@ -33,6 +41,7 @@ struct LocalSettings {
   static void fields(S& s, F& f) {
     f("keypoint_voxel_mm", s.keypoint_voxel_mm, fields::length(fields::positive()));
     f("descriptor_radius_mm", s.descriptor_radius_mm, fields::length(fields::positive()));
+    f("max_support_points", s.max_support_points, fields::at_least(0));
     f("lrf_radius_mm", s.lrf_radius_mm, fields::length(fields::positive()));
     f("match_threshold", s.match_threshold, fields::positive());
     f("fpfh_match_threshold", s.fpfh_match_threshold, fields::positive());

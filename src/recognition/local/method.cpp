@@ -47,8 +47,8 @@ struct Described {
 
 std::vector<float> descriptors(Kind kind, const PointSet& cloud, const std::vector<int>& idx,
                                const LocalSettings& s) {
-  return kind == Kind::Fpfh ? compute_fpfh(cloud, idx, s.descriptor_radius_mm, s.threads)
-                            : compute_shot(cloud, idx, s.descriptor_radius_mm, s.threads);
+  return kind == Kind::Fpfh ? compute_fpfh(cloud, idx, s.descriptor_radius_mm, s.threads, s.max_support_points)
+                            : compute_shot(cloud, idx, s.descriptor_radius_mm, s.threads, s.max_support_points);
 }
 
 Described keep_valid(const PointSet& cloud, const std::vector<int>& idx, const std::vector<float>& desc,

@@ -204,7 +204,7 @@ bool describe(const Vec3f& q, const Frame& f, const PointSet& cloud, const Neigh
 }  // namespace
 
 std::vector<float> compute_shot(const PointSet& cloud, const std::vector<int>& keypoints, double radius_mm,
-                                int threads) {
+                                int threads, int max_support) {
   std::vector<float> out(keypoints.size() * kShotDim, std::numeric_limits<float>::quiet_NaN());
   if (keypoints.empty() || !cloud.has_normals() || !(radius_mm > 0)) return out;
   const std::vector<Vec3f>& pts = cloud.points;
@@ -223,7 +223,13 @@ std::vector<float> compute_shot(const PointSet& cloud, const std::vector<int>& k
       tree.within(q, r2, nn);
       Frame f;
       float* row = out.data() + static_cast<size_t>(k) * kShotDim;
-      if (!reference_frame(q, pts, nn, radius_mm, &f, off) || !describe(q, f, cloud, nn, radius_mm, row))
+      // The frame from every neighbour (thinned, it turns: on the tests'
+      // surface 128 of ~175 points left 9 of 46 rows nearer another
+      // keypoint's full row than their own), the histogram from an even
+      // sample in order of distance.
+      const bool framed = reference_frame(q, pts, nn, radius_mm, &f, off);
+      keep_evenly(nn, max_support);
+      if (!framed || !describe(q, f, cloud, nn, radius_mm, row))
         std::fill(row, row + kShotDim, std::numeric_limits<float>::quiet_NaN());
     }
   }

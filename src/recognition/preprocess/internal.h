@@ -31,8 +31,9 @@ std::vector<char> ransac_plane(const std::vector<Vec3f>& points, double threshol
 // omp_get_max_threads(), the same result for any count), flipped toward the
 // viewpoint (origin), and the surface variation as curvature. Points whose
 // normal cannot be estimated (fewer than 3 neighbours) are dropped, with
-// their pixel.
-void estimate_normals(PointSet& cloud, double radius_mm);
+// their pixel. max_points > 0: a neighbourhood of more points is thinned
+// evenly in tree order to that many (keep_evenly, kdtree.h).
+void estimate_normals(PointSet& cloud, double radius_mm, int max_points = 0);
 
 // Keeps the points whose flag is set (all per-point arrays).
 PointSet select(const PointSet& in, const std::vector<char>& keep);

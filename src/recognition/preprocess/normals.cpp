@@ -44,7 +44,7 @@ bool pca_normal(const std::vector<Vec3f>& pts, const std::vector<int>& nb, Vec3f
 
 }  // namespace
 
-void estimate_normals(PointSet& ps, double radius_mm) {
+void estimate_normals(PointSet& ps, double radius_mm, int max_points) {
   ps.normals.clear();
   ps.curvature.clear();
   if (ps.points.empty()) return;
@@ -60,6 +60,7 @@ void estimate_normals(PointSet& ps, double radius_mm) {
     for (long i = 0; i < n; ++i) {
       const size_t k = static_cast<size_t>(i);
       tree.radius_unsorted(ps.points[k], static_cast<float>(radius_mm), nb);
+      keep_evenly(nb, max_points);
       Vec3f nrm;
       float curv = 0;
       if (!pca_normal(ps.points, nb, nrm, curv)) continue;

@@ -29,6 +29,9 @@ struct PreprocessSettings {
                                     // of this many points (0 = all); the winner's inliers are then
                                     // selected among all points and refitted
   double normal_radius_mm = 20.0;   // PCA neighbourhood radius for normals
+  int normal_max_points = 64;       // a normal's neighbourhood of more points than this is thinned
+                                    // evenly (in kd-tree order: spatially stratified) to this many
+                                    // before the PCA (0 = every point, as pcl::NormalEstimation)
 
   template <class S, class F>
   static void fields(S& s, F& f) {
@@ -43,6 +46,7 @@ struct PreprocessSettings {
     f("max_planes", s.max_planes, fields::at_least(0));
     f("plane_sample_points", s.plane_sample_points, fields::at_least(0));
     f("normal_radius_mm", s.normal_radius_mm, fields::length(fields::positive()));
+    f("normal_max_points", s.normal_max_points, fields::at_least(0));
   }
   void validate(const YamlNode& node) const;  // max_range_mm > min_range_mm
 };
