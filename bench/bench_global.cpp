@@ -79,16 +79,21 @@ void BM_Preprocess(benchmark::State& state) {
   state.counters["points"] = static_cast<double>(f.scene.size());
 }
 
-void BM_EuclideanClusters(benchmark::State& state) {
+// Scene segmentation: ours (a grid) and PCL's (a radius search per point),
+// the same clusters; the argument multiplies the tolerance (1: the
+// fixture's; 4: a tolerance of many voxels, as relative lengths give large
+// objects on small voxels).
+using Clusters = std::vector<std::vector<int>> (*)(const std::vector<Vec3f>&, double, int, int);
+void clusters_bench(benchmark::State& state, Clusters fn) {
   const Fixture& f = fixture();
+  const GlobalSettings& g = f.s.global;
+  const double tol = g.cluster_tolerance_mm * static_cast<double>(state.range(0));
   size_t n = 0;
-  for (auto _ : state) {
-    const GlobalSettings& g = f.s.global;
-    n = global::euclidean_clusters(f.scene.points, g.cluster_tolerance_mm, g.cluster_min_points, g.cluster_max_points)
-            .size();
-  }
+  for (auto _ : state) n = fn(f.scene.points, tol, g.cluster_min_points, g.cluster_max_points).size();
   state.counters["clusters"] = static_cast<double>(n);
 }
+void BM_EuclideanClusters(benchmark::State& state) { clusters_bench(state, global::euclidean_clusters); }
+void BM_EuclideanClustersPcl(benchmark::State& state) { clusters_bench(state, global::euclidean_clusters_pcl); }
 
 // ESF of one training view: ours (20000 samples, seeded) and PCL's.
 void BM_EsfOurs(benchmark::State& state) {
@@ -179,7 +184,8 @@ void BM_Online(benchmark::State& state, const std::string& name) {
 }  // namespace
 
 BENCHMARK(BM_Preprocess)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_EuclideanClusters)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_EuclideanClusters)->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_EuclideanClustersPcl)->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_EsfOurs)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_EsfPcl)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_CvfhView)->Unit(benchmark::kMillisecond)->UseRealTime();

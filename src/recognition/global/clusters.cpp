@@ -14,8 +14,8 @@
 
 namespace pb::global {
 
-std::vector<std::vector<int>> euclidean_clusters(const std::vector<Vec3f>& points, double tolerance_mm,
-                                                 int min_points, int max_points) {
+std::vector<std::vector<int>> euclidean_clusters_pcl(const std::vector<Vec3f>& points, double tolerance_mm,
+                                                     int min_points, int max_points) {
   std::vector<std::vector<int>> out;
   if (points.empty() || static_cast<int>(points.size()) < std::max(min_points, 1)) return out;
   const auto cloud = pcl_adapter::xyz(points);

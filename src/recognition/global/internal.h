@@ -32,11 +32,19 @@ struct Signature {
   int source = -1;                 // training view index, or scene cluster index
 };
 
-// --- global_clusters.cpp (PCL) ---
-// Euclidean cluster extraction (pcl::EuclideanClusterExtraction), largest
-// first; each cluster's indices ascending.
+// --- euclidean.cpp ---
+// Euclidean clusters: the connected components of "closer than
+// tolerance_mm" (pcl::EuclideanClusterExtraction's clusters, found on a grid
+// instead of a radius search per point), those of min_points to max_points
+// points, largest first (ties: lower first index); each cluster's indices
+// ascending. Non-finite points are in no cluster.
 std::vector<std::vector<int>> euclidean_clusters(const std::vector<Vec3f>& points, double tolerance_mm,
                                                  int min_points, int max_points);
+// --- clusters.cpp (PCL) ---
+// pcl::EuclideanClusterExtraction itself, in the same order: the reference of
+// euclidean_clusters (tests and benchmarks only).
+std::vector<std::vector<int>> euclidean_clusters_pcl(const std::vector<Vec3f>& points, double tolerance_mm,
+                                                     int min_points, int max_points);
 // The points (and normals, curvature, pixels) at `indices`.
 PointSet subset(const PointSet& cloud, const std::vector<int>& indices);
 
