@@ -4,7 +4,10 @@
 // a "margin" point), the set-up of PCL's correspondence grouping tutorial
 // (board_pcl.cpp keeps PCL's as the reference):
 //   - neighbourhood: every cloud point with squared distance below r^2, in
-//     order of distance (KdTree3); fewer than 6: no frame;
+//     kd-tree order (KdTree3; PCL's is in order of distance, which only
+//     changes the rounding of the sums below and which of two equal
+//     deviations wins, and sorting it took a third of the warehouse
+//     bench's group stage); fewer than 6: no frame;
 //   - z: the normal of the least-squares plane through the neighbours,
 //     pointing along the mean of their normals;
 //   - x: toward the margin point whose normal deviates most from z
@@ -206,7 +209,7 @@ std::vector<float> compute_board_lrf(const PointSet& cloud, const std::vector<in
     if (p < 0 || static_cast<size_t>(p) >= cloud.points.size() || !cloud.points[static_cast<size_t>(p)].allFinite())
       continue;
     const Vec3f& q = cloud.points[static_cast<size_t>(p)];
-    tree.within(q, r2, nn);
+    tree.within(q, r2, nn, false);  // tree order: nothing below needs distance order
     if (board_frame(q, cloud, nn, start, row) && usable_frame(row))
       std::copy(row, row + kLrfDim, out.begin() + static_cast<long>(k) * kLrfDim);
   }
