@@ -67,7 +67,9 @@ std::vector<std::vector<int>> euclidean_clusters(const std::vector<Vec3f>& point
                                                  int min_points, int max_points) {
   std::vector<std::vector<int>> out;
   if (points.empty() || static_cast<int>(points.size()) < std::max(min_points, 1) || !(tolerance_mm > 0)) return out;
-  const float t2 = static_cast<float>(tolerance_mm) * static_cast<float>(tolerance_mm);
+  // PCL's bound: the tolerance as a float, squared in double, then a float.
+  const double tol_f = static_cast<float>(tolerance_mm);
+  const float t2 = static_cast<float>(tol_f * tol_f);
   // Cells small enough that their diagonal stays below t after rounding.
   const double edge = tolerance_mm / std::sqrt(3.0) * (1.0 - 1e-4);
   std::unordered_map<Cell, int, CellHash> cell_id;
