@@ -76,7 +76,9 @@ inline int bin_of(double x) {
 }
 
 using Hist = std::array<float, kFpfhDim>;
+using Counts = std::array<uint32_t, kFpfhDim>;
 
+// This OpenMP thread's number (0 without OpenMP).
 inline int thread_num() {
 #ifdef _OPENMP
   return omp_get_thread_num();
@@ -84,7 +86,6 @@ inline int thread_num() {
   return 0;
 #endif
 }
-using Counts = std::array<uint32_t, kFpfhDim>;
 
 // The three bins of a pair's features.
 inline void count_pair(float f1, float f2, float f3, uint32_t* c) {
