@@ -169,25 +169,35 @@ void BM_BoardLrfPcl(benchmark::State& state) {
   state.counters["keypoints"] = static_cast<double>(f.scene_kp.size());
 }
 
-// All scene keypoints against the descriptors of every view (one thread).
+// All scene keypoints against the descriptors of every view (one thread);
+// the argument is match_max_checks (0 = exact). Counter `recall`: the share
+// of the keypoints the exact search matches that get the same match here.
 void BM_Match(benchmark::State& state, int d) {
   const Fixture& f = fixture();
   const int dim = d == 0 ? local::kFpfhDim : local::kShotDim;
   const float thr = static_cast<float>(d == 0 ? f.s.local.fpfh_match_threshold : f.s.local.match_threshold);
   const int n = static_cast<int>(f.scene_desc[d].kp.size());
-  std::vector<std::vector<std::pair<int, float>>> nn(static_cast<size_t>(n));
-  size_t kept = 0;
-  for (auto _ : state) {
-    kept = 0;
-    for (int first = 0; first < n; first += 32) {  // blocks of 32 queries, as the method
+  const int checks = static_cast<int>(state.range(0));
+  using Result = std::vector<std::vector<std::pair<int, float>>>;
+  const auto match = [&](int max_checks, Result& nn) {
+    for (int first = 0; first < n; first += 32)  // blocks of 32 queries, as the method
       f.index[d]->knn_block(&f.scene_desc[d].desc[static_cast<size_t>(first) * dim], std::min(32, n - first),
-                            f.s.local.matches_per_keypoint, thr, nn.data() + first);
-    }
-    for (const auto& v : nn) kept += v.size();
+                            f.s.local.matches_per_keypoint, thr, nn.data() + first, max_checks);
+  };
+  Result nn(static_cast<size_t>(n)), exact(static_cast<size_t>(n));
+  for (auto _ : state) match(checks, nn);
+  match(0, exact);
+  size_t kept = 0, matched = 0, same = 0;
+  for (int i = 0; i < n; ++i) {
+    kept += nn[i].size();
+    if (exact[i].empty()) continue;
+    ++matched;
+    same += nn[i] == exact[i];
   }
   state.counters["model_descriptors"] = static_cast<double>(f.index[d]->size());
   state.counters["scene_descriptors"] = static_cast<double>(f.scene_desc[d].kp.size());
   state.counters["matches"] = static_cast<double>(kept);
+  state.counters["recall"] = matched ? static_cast<double>(same) / static_cast<double>(matched) : 1.0;
 }
 
 // 3D Hough voting of every view's matches.
@@ -278,8 +288,8 @@ BENCHMARK(BM_Shot)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()
 BENCHMARK(BM_ShotPcl)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_BoardLrf)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_BoardLrfPcl)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_Match, fpfh, 0)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_Match, shot, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Match, fpfh, 0)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Match, shot, 1)->Arg(0)->Arg(16)->Arg(32)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Hough, fpfh, 0)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Hough, shot, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Train, fpfh, 0)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -25,8 +25,12 @@ constexpr char kMagic[8] = {'P', 'B', 'T', 'R', 'A', 'I', 'N', '\0'};
 // radius on its kd-tree) replace PCL's in preprocessing: models trained by
 // version 2 are retrained. 4: the project's own FPFH. 5: the project's own
 // SHOT (descriptors equal to PCL's at rounding level). 6: the project's own
-// BOARD frames (deterministic start axis of the hole search).
-constexpr uint32_t kVersion = 6;
+// BOARD frames (deterministic start axis of the hole search). 7: BOARD
+// frames from their neighbours in kd-tree order (bbe454f changed the frames
+// without this bump, so caches written before it kept the views' old frames
+// under the same key: found when a new setting changed the key and moved
+// seven bench-pipeline FPFH estimates).
+constexpr uint32_t kVersion = 7;
 
 std::string sanitize(const std::string& name) {
   std::string o;

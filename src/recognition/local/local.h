@@ -26,6 +26,14 @@ struct LocalSettings {
                                         // tutorial uses 0.25, too strict at 10 mm voxels)
   double fpfh_match_threshold = 250;    // FPFH: max squared L2 distance between PCL FPFH
                                         // histograms (each of the 3 sub-histograms sums to 100)
+  int match_max_checks = 64;            // SHOT: approximate matching, at most this many model
+                                        // descriptors measured exactly per scene keypoint (those
+                                        // of the lowest bounds from 32 principal axes); 0 = exact.
+                                        // Measured recall of the exact match at 64 (one image
+                                        // each, Figure 4.11's statue): 97.7% of the matched
+                                        // keypoints in the warehouse, 98.0-99.3% on the table,
+                                        // 96.8% at 25 mm of added noise (match stage 12.1 ->
+                                        // 4.6 s there); FPFH's kd-tree search stays exact
   int matches_per_keypoint = 1;         // k: up to k nearest model descriptors (over all
                                         // views) under the threshold kept per scene keypoint
   double hough_bin_mm = 50.0;           // 3D Hough bin size (Table 4.2)
@@ -45,6 +53,7 @@ struct LocalSettings {
     f("lrf_radius_mm", s.lrf_radius_mm, fields::length(fields::positive()));
     f("match_threshold", s.match_threshold, fields::positive());
     f("fpfh_match_threshold", s.fpfh_match_threshold, fields::positive());
+    f("match_max_checks", s.match_max_checks, fields::at_least(0));
     f("matches_per_keypoint", s.matches_per_keypoint, fields::at_least(1));
     f("hough_bin_mm", s.hough_bin_mm, fields::length(fields::positive()));
     f("hough_min_votes", s.hough_min_votes, fields::at_least(1));

@@ -11,8 +11,12 @@
 // their bounds until the bound exceeds the k-th best exact distance (or the
 // threshold), with a margin for the product's rounding. Every row that can
 // be among the k nearest is measured exactly and offered in ascending row
-// order, so the result is the exact scan's, bit for bit. Searches are const
-// and thread-safe, and deterministic (no randomized trees).
+// order, so the result is the exact scan's, bit for bit. Approximate on
+// request (max_checks > 0): at most that many rows, those of the lowest
+// bounds, are measured exactly per query; the answer is still exact whenever
+// the early exit comes first (measured recall: LocalSettings'
+// match_max_checks). Searches are const and thread-safe, and deterministic
+// (no randomized trees).
 #include <flann/algorithms/dist.h>
 #include <flann/algorithms/kdtree_single_index.h>
 #include <flann/util/matrix.h>
@@ -136,7 +140,7 @@ inline void offer(std::vector<std::pair<int, float>>& out, size_t kk, int row, f
 }  // namespace
 
 void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq_dist,
-                                std::vector<std::pair<int, float>>* out) const {
+                                std::vector<std::pair<int, float>>* out, int max_checks) const {
   const size_t dim = static_cast<size_t>(impl_->dim);
   if (impl_->index || impl_->rows == 0 || k <= 0) {
     for (int i = 0; i < n; ++i) knn(queries + static_cast<size_t>(i) * dim, k, max_sq_dist, out[i]);
@@ -188,6 +192,10 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
     cand.clear();
     for (size_t r = 0; r < m.rows; ++r)
       if (lbs[r] <= limit) cand.emplace_back(lbs[r], static_cast<int>(r));
+    if (max_checks > 0 && cand.size() > static_cast<size_t>(max_checks)) {  // approximate: the lowest bounds
+      std::nth_element(cand.begin(), cand.begin() + max_checks, cand.end());
+      cand.resize(static_cast<size_t>(max_checks));
+    }
     std::sort(cand.begin(), cand.end());
     best.clear();
     measured.clear();

@@ -154,7 +154,7 @@ class LocalMethod : public Method {
     for (int b = 0; b < nblocks; ++b) {
       const int first = b * kMatchBlock, count = std::min(kMatchBlock, nkp - first);
       index_.knn_block(sc.desc.data() + static_cast<size_t>(first) * dim, count, s.matches_per_keypoint, thr,
-                       nn.data() + first);
+                       nn.data() + first, s.match_max_checks);
     }
     std::vector<std::vector<Match>> per_view(views_.size());
     for (size_t i = 0; i < nn.size(); ++i)
