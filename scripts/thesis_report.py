@@ -379,11 +379,18 @@ def section_intro(res, host):
          "each single-threaded." % (fmt_dur(total), ntrials, host["cores"], host["cpu"] or "cpu unknown",
                                     host["jobs"])]
     loads = [l for x in res.x.values() for l in x.runs.loads]
-    if loads:
+    try:
+        jobs = float(host["jobs"])
+    except (TypeError, ValueError):
+        jobs = float(host["cores"])
+    if loads and max(loads) > jobs + 0.5:
         o.append("The machine was shared with other jobs while it ran: the 15-minute load average at the end of the "
-                 "experiments ranged from %.1f to %.1f on %d cores, so wall times (and the per-image times in the "
-                 "tables, which are wall-clock times of the online computation inside a worker) are inflated by the "
-                 "competition for the CPU." % (min(loads), max(loads), host["cores"]))
+                 "experiments ranged from %.1f to %.1f on %d cores, more than the run's own workers, so wall times "
+                 "(and the per-image times in the tables, which are wall-clock times of the online computation inside "
+                 "a worker) are inflated by the competition for the CPU." % (min(loads), max(loads), host["cores"]))
+    elif loads:
+        o.append("The 15-minute load average at the end of the experiments ranged from %.1f to %.1f on %d cores: the "
+                 "run's own workers, no other load." % (min(loads), max(loads), host["cores"]))
     return o + ["\n"]
 
 

@@ -101,6 +101,27 @@ class Readme(unittest.TestCase):
         self.assertIn("**Total wall time of the regeneration: 1h03m08s** for 16 trials", text)
         self.assertIn("2 worker processes, each single-threaded.", text)
         self.assertIn("ranged from 0.5 to 2.0 on", text)
+        # 2 workers: a load up to 2.5 is the run's own.
+        self.assertIn("the run's own workers, no other load.", text)
+        self.assertNotIn("shared with other jobs", text)
+
+    def test_a_load_beyond_the_workers_is_called_shared(self):
+        class Runs:
+            loads = [1.9, 3.4]
+
+        class X:
+            runs = Runs()
+
+        class Res:
+            x = {"table_4_1": X()}
+
+            def totals(self):
+                return 60.0, 4
+
+        host = {"date": "today", "cores": 2, "cpu": "cpu", "jobs": "2"}
+        text = "\n".join(thesis_report.section_intro(Res(), host))
+        self.assertIn("The machine was shared with other jobs while it ran", text)
+        self.assertIn("ranged from 1.9 to 3.4 on 2 cores, more than the run's own workers", text)
 
     def test_table_4_1_rows_come_from_the_report_with_the_thesis_beside(self):
         # cvfh: 1 of 2 correct (thesis 43%), fpfh: 2 of 2 (thesis 67%).
