@@ -34,12 +34,14 @@ void BM_TableAstra(benchmark::State& s) { generate_images(s, "astra", false); }
 void BM_TableAstraOccluded(benchmark::State& s) { generate_images(s, "astra", true); }
 void BM_TableKinectOne(benchmark::State& s) { generate_images(s, "kinect_one", false); }
 
-// A 10-image scene set written to disk (BOP files, masks, preview).
+// A 20-image scene set written to disk (BOP files, masks, preview) by as
+// many worker threads as the argument (`posebench generate --threads`).
 void BM_TableAstraDataset(benchmark::State& state) {
   pb::SceneSettings s = table("astra", false);
-  s.images = 10;
+  s.images = 20;
+  const int threads = static_cast<int>(state.range(0));
   const std::string out = (std::filesystem::temp_directory_path() / "posebench_bench_generate").string();
-  for (auto _ : state) pb::generate_dataset(s, out);
+  for (auto _ : state) pb::generate_dataset(s, out, nullptr, threads);
   std::filesystem::remove_all(out);
   state.counters["images_per_s"] =
       benchmark::Counter(static_cast<double>(state.iterations() * s.images), benchmark::Counter::kIsRate);
@@ -52,6 +54,6 @@ BENCHMARK(BM_TableSyntheticOccluded)->Unit(benchmark::kMillisecond)->MinTime(3.0
 BENCHMARK(BM_TableAstra)->Unit(benchmark::kMillisecond)->MinTime(3.0)->UseRealTime();
 BENCHMARK(BM_TableAstraOccluded)->Unit(benchmark::kMillisecond)->MinTime(3.0)->UseRealTime();
 BENCHMARK(BM_TableKinectOne)->Unit(benchmark::kMillisecond)->MinTime(3.0)->UseRealTime();
-BENCHMARK(BM_TableAstraDataset)->Unit(benchmark::kMillisecond)->Iterations(2)->UseRealTime();
+BENCHMARK(BM_TableAstraDataset)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Iterations(2)->UseRealTime();
 
 BENCHMARK_MAIN();
