@@ -854,7 +854,8 @@ def conclusion_5(res):
     return [
         "5. **Nothing ran at 30 frames per second: %s.** Mean time per image in the recognition tables ranged from "
         "%.2f s (%s, %s, %s) to %.2f s (%s, %s, %s), against 0.033 s for 30 fps; the thesis: 0.12 to 14 s on a "
-        "3 GHz two-core laptop.%s Our times are single-threaded per image, on a shared, loaded machine (see above)."
+        "3 GHz two-core laptop.%s Our times are single-threaded per image, one worker per core (the load: see "
+        "above)."
         "\n" % ((v,) + lo + hi + (fig_txt,))]
 
 
