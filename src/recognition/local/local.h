@@ -30,10 +30,11 @@ struct LocalSettings {
                                         // descriptors measured exactly per scene keypoint (those
                                         // of the lowest bounds from 32 principal axes); 0 = exact.
                                         // Measured recall of the exact match at 64 (one image
-                                        // each, Figure 4.11's statue): 97.7% of the matched
-                                        // keypoints in the warehouse, 98.0-99.3% on the table,
-                                        // 96.8% at 25 mm of added noise (match stage 12.1 ->
-                                        // 4.6 s there); FPFH's kd-tree search stays exact
+                                        // each, Figure 4.11's statue, 0 and 2 mm of added
+                                        // noise): 97.7-97.9% of the matched keypoints in the
+                                        // warehouse, 99.2-99.3% on the table; 96.8% at 25 mm
+                                        // (match stage 12.1 -> 4.6 s there). FPFH's kd-tree
+                                        // search stays exact
   int matches_per_keypoint = 1;         // k: up to k nearest model descriptors (over all
                                         // views) under the threshold kept per scene keypoint
   double hough_bin_mm = 50.0;           // 3D Hough bin size (Table 4.2)
