@@ -4,8 +4,7 @@
 #
 #   scripts/thesis.sh [--jobs N] [--only NAME[,NAME...]] [--readme-only]
 #
-# Runs every experiment of configs/thesis/ (table_4_1 ... fig_4_12, and two
-# variants of Tables 4.3 / 4.4 with the one view from 45 degrees above) with
+# Runs every experiment of configs/thesis/ (table_4_1 ... fig_4_12) with
 # `posebench run` into results/thesis/raw/NAME (git-ignored; the run itself
 # logs its wall time and load to NAME/runs.jsonl), reports each (markdown,
 # csv, plots), copies the plots to results/thesis/plots/ and writes
@@ -37,7 +36,7 @@ while [ $# -gt 0 ]; do
 done
 OUT=results/thesis
 RAW=$OUT/raw
-EXPERIMENTS=(table_4_1 table_4_3 table_4_4 table_4_3_view45 table_4_4_view45 table_4_5 table_4_7 table_4_9 fig_4_6 fig_4_12
+EXPERIMENTS=(table_4_1 table_4_3 table_4_4 table_4_5 table_4_7 table_4_9 fig_4_6 fig_4_12
              fig_4_7_global fig_4_7_local fig_4_11_global fig_4_11_local)
 
 # --readme-only with no raw results (a fresh clone) has nothing to report:

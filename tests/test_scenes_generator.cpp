@@ -308,3 +308,22 @@ TEST(SceneGenerator, MissingModelLeavesNothing) {
   EXPECT_FALSE(fs::exists(out));
   EXPECT_FALSE(fs::exists(out + ".partial"));
 }
+
+// warehouse.wall: false leaves the floor as the one plane (the thesis's
+// warehouse). Seen from 5 degrees above, the wall fills the top rows; the
+// floor alone leaves them empty (sky), and the targets are the same.
+TEST(SceneGenerator, WarehouseWithoutWallHasOnlyTheFloor) {
+  const std::string low = std::string(kWarehouse) + "camera: {elevation_deg: [5, 5]}\n";
+  SceneGenerator with(settings_from(low));
+  SceneGenerator without(settings_from(low + "warehouse: {wall: false}\n"));
+  const GeneratedImage a = with.generate(0), b = without.generate(0);
+  const auto top_valid = [](const DepthImage& d) {
+    int n = 0;
+    for (int u = 0; u < d.width; ++u) n += d.at(u, 0) > 0;
+    return n;
+  };
+  EXPECT_GT(top_valid(a.depth), a.depth.width / 2);
+  EXPECT_EQ(top_valid(b.depth), 0);
+  ASSERT_EQ(a.info.gt.size(), b.info.gt.size());
+  EXPECT_EQ(a.info.gt[0].obj_id, b.info.gt[0].obj_id);
+}

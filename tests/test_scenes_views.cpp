@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 #include "core/error.h"
 #include "models/procedural.h"
@@ -71,4 +73,48 @@ TEST(TrainingViews, CloudsLieOnTheModel) {
       EXPECT_EQ(v.depth.at(u, 127), 0.f);
     }
   }
+}
+
+// views.follow_scene: the ring and the single view at the middle of the
+// scene set's camera elevation range; a set without that range is an input
+// error naming posebench_scene.json and the field.
+TEST(TrainingViews, FollowSceneTakesTheSceneSetsElevation) {
+  const std::string dir = pbtest::temp_dir("follow_scene");
+  const auto write = [&](const std::string& text) {
+    std::ofstream(dir + "/posebench_scene.json") << text;
+  };
+  ViewSettings s;
+  s.views = 8;
+  EXPECT_EQ(views_for_scene_set(s, dir).elevation_deg, 20.0);  // follow_scene off: unchanged, no file read
+  s.follow_scene = true;
+  try {
+    views_for_scene_set(s, dir);
+    ADD_FAILURE() << "no posebench_scene.json: expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("posebench_scene.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("views.follow_scene"), std::string::npos) << e.what();
+  }
+  write(R"({"settings": {"camera": {"distance_mm": [600, 1500], "elevation_deg": [30, 70]}}})");
+  const ViewSettings r = views_for_scene_set(s, dir);
+  EXPECT_EQ(r.elevation_deg, 50.0);
+  EXPECT_EQ(r.side_elevation_deg, 50.0);
+  EXPECT_EQ(r.below_elevation_deg, s.below_elevation_deg);
+  EXPECT_FALSE(r.follow_scene);
+  for (const auto& v : view_directions(r)) EXPECT_NEAR(std::asin(v.z()) * 180 / M_PI, 50.0, 1e-9);
+  ViewSettings one = s;
+  one.views = 1;
+  const auto d1 = view_directions(views_for_scene_set(one, dir));
+  ASSERT_EQ(d1.size(), 1u);
+  EXPECT_NEAR(std::asin(d1[0].z()) * 180 / M_PI, 50.0, 1e-9);
+  for (const char* bad : {R"({"settings": {"camera": {}}})", R"({"settings": {"camera": {"elevation_deg": [70]}}})",
+                          R"({"settings": {"camera": {"elevation_deg": [70, 30]}}})", "{not json"}) {
+    write(bad);
+    try {
+      views_for_scene_set(s, dir);
+      ADD_FAILURE() << bad << ": expected an InputError";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("posebench_scene.json"), std::string::npos) << e.what();
+    }
+  }
+  std::filesystem::remove_all(dir);
 }

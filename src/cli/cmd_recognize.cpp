@@ -274,6 +274,11 @@ static pb::cli::Command recognize_cmd(
       pb::TrainOptions topt;
       topt.cache_dir = o.cache;
       bool from_cache = false;
+      if (s.views.follow_scene) {  // the scene set's camera elevations (InputError without a scene set)
+        if (o.src.dataset_dir.empty())
+          throw pb::InputError("", "views.follow_scene", "needs --dataset (a scene set made by `posebench generate`)");
+        s.views = pb::views_for_scene_set(s.views, o.src.dataset_dir);
+      }
       const pb::TrainingViews views = obj.cloud.empty() ? pb::training_views(mesh, s.views, model_name)
                                                         : pb::cloud_training_views(obj.cloud, model_name);
       // Relative lengths in mm: the model's diameter, the sensor's floor at this image.

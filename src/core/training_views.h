@@ -21,6 +21,12 @@ struct ViewSettings {
   double elevation_deg = 20.0;   // ring elevation above the horizontal plane
   double side_elevation_deg = 0.0;    // the single side view (views = 1): no top, no bottom
   double below_elevation_deg = -45.0; // the 4 extra views of views = 12 (from below)
+  // true: the ring (elevation_deg) and the single view (side_elevation_deg)
+  // are rendered from the middle of the scene set's camera elevation range
+  // (`camera.elevation_deg` of the scene config that generated it, read
+  // from its posebench_scene.json), so the model is trained as the scenes
+  // see it. Only for generated scene sets; the 4 views from below stay.
+  bool follow_scene = false;
   double distance_factor = 3.0;  // camera distance = factor * bounding-box diagonal (>= diameter)
   int resolution = 256;          // square image, pixels
   double fov_deg = 30.0;         // field of view, degrees
@@ -31,6 +37,7 @@ struct ViewSettings {
     f("elevation_deg", s.elevation_deg, fields::in_range(-90, 90));
     f("side_elevation_deg", s.side_elevation_deg, fields::in_range(-90, 90));
     f("below_elevation_deg", s.below_elevation_deg, fields::in_range(-90, 90));
+    f("follow_scene", s.follow_scene);
     f("distance_factor", s.distance_factor, fields::positive());
     f("resolution", s.resolution, fields::in_range(8, 4096));
     f("fov_deg", s.fov_deg, fields::positive());

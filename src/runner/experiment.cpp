@@ -15,6 +15,7 @@
 #include "io/cloud.h"
 #include "recognition/pipeline.h"
 #include "recognition/registry.h"
+#include "scenes/views.h"
 
 namespace fs = std::filesystem;
 
@@ -393,6 +394,7 @@ std::vector<Trial> expand_trials(const ExperimentConfig& cfg) {
 
   std::vector<Trial> trials;
   for (const auto& src : cfg.scenes) {
+    const size_t first = trials.size();
     BopDataset ds(src.dataset);
     std::vector<int> sids = src.scene_ids.empty() ? ds.scene_ids(src.split) : src.scene_ids;
     const Targets targets = read_targets(src, ds, cfg.object);
@@ -420,6 +422,17 @@ std::vector<Trial> expand_trials(const ExperimentConfig& cfg) {
               for (const auto& p : points)
                 for (double noise : cfg.added_noise_mm)
                   trials.push_back(make_trial(cfg, src, sid, im_id, target, d, r, p, noise));
+      }
+    }
+    // views.follow_scene needs the scene set's camera elevations: a set
+    // without them fails here, before any trial runs, not in every trial.
+    for (size_t i = first; i < trials.size(); ++i) {
+      const auto& v = trials[i].settings;
+      if (v.contains("views") && v["views"].is_object() && v["views"].value("follow_scene", false)) {
+        ViewSettings probe;
+        probe.follow_scene = true;
+        views_for_scene_set(probe, src.dataset);
+        break;
       }
     }
   }

@@ -39,7 +39,9 @@ struct SceneSource {
   // Refinements for this scene set, replacing the experiment's list (the
   // thesis used ICP point-to-plane in the warehouse, point-to-point on tables).
   std::vector<std::string> refinements;
-  nlohmann::json generator_overrides = nlohmann::json::object();  // e.g. images, seed
+  // Overrides of the scene config (`generator:`), merged into it section by
+  // section (JSON merge patch): {images: 60}, {warehouse: {wall: true}}.
+  nlohmann::json generator_overrides = nlohmann::json::object();
   // Recognition settings overrides for this scene (YAML sections, as in
   // `settings`), as in the thesis's per-scenario Tables 4.2 and 4.8.
   nlohmann::json settings = nlohmann::json::object();

@@ -119,8 +119,7 @@ void prepare_scenes(ExperimentConfig& cfg, const RunOptions& opt) {
     if (!src.clouds.empty()) import_scene_clouds(src, cfg, opt);
     if (src.generate.empty()) continue;
     nlohmann::json gen = yaml_to_json_file(src.generate);
-    for (auto it = src.generator_overrides.begin(); it != src.generator_overrides.end(); ++it)
-      gen[it.key()] = it.value();
+    gen.merge_patch(src.generator_overrides);  // sections merge key by key: {warehouse: {wall: true}}
     // The copy lives in scenes_dir: make a relative registry path absolute
     // against the original config's folder.
     if (gen.contains("registry") && gen["registry"].is_string() &&

@@ -60,14 +60,18 @@ std::shared_ptr<const TrainedModel> trained(const BopDataset& ds, int obj_id, co
                                             const RecognitionSettings& st, const TrialContext& ctx,
                                             TrialRecord& rec) {
   Timer timer;
-  const std::string train_key = ds.root() + "#" + std::to_string(obj_id) + "#" + settings_to_json(st);
+  // The views as rendered (views.follow_scene resolved for this scene set):
+  // the training key and the cache name the elevations actually used.
+  RecognitionSettings use = st;
+  use.views = views_for_scene_set(st.views, ds.root());
+  const std::string train_key = ds.root() + "#" + std::to_string(obj_id) + "#" + settings_to_json(use);
   auto& model = cache().models[train_key];
   bool from_cache = model != nullptr;
   if (!model) {
     TrainOptions opt;
     opt.cache_dir = ctx.cache_dir;
     const std::string name = ds.model_info(obj_id).name.empty() ? bop_id(obj_id) : ds.model_info(obj_id).name;
-    model = train_model(training_views(mesh, st.views, name), st, opt, &from_cache);
+    model = train_model(training_views(mesh, use.views, name), use, opt, &from_cache);
   }
   rec.train_s = timer.seconds();
   rec.train_from_cache = from_cache;

@@ -54,8 +54,8 @@ bool SceneGenerator::Impl::place_camera(Rng& rng, Layout& L, GeneratedImage& img
   return true;
 }
 
-// 3. Table under everything; warehouse: a floor and a wall behind the target
-// as seen from the camera.
+// 3. Table under everything; warehouse: a floor and (warehouse.wall) a wall
+// behind the target as seen from the camera.
 void SceneGenerator::Impl::place_background(Rng& rng, Layout& L) const {
   L.wall_point = Vec2::Zero();
   L.wall_n = L.g;
@@ -75,6 +75,7 @@ void SceneGenerator::Impl::place_background(Rng& rng, Layout& L) const {
   floor.mesh = &floor_mesh;
   floor.T_world_model.t = Vec3(0, 0, -0.5 * w.floor_thickness_mm);
   L.bg.push_back(floor);
+  if (!w.wall) return;  // the floor alone (on_ground_area: no wall bounds it)
   Placed wall;
   wall.mesh = &wall_mesh;
   const double yaw = std::atan2(L.wall_n.y(), L.wall_n.x()) - M_PI / 2;  // box y axis along wall_n
@@ -85,7 +86,7 @@ void SceneGenerator::Impl::place_background(Rng& rng, Layout& L) const {
 }
 
 bool SceneGenerator::Impl::on_ground_area(const Layout& L, const Vec2& q, double table_margin) const {
-  if (warehouse()) return !((q - L.wall_point).dot(L.wall_n) < gap());
+  if (warehouse()) return !s.warehouse.wall || !((q - L.wall_point).dot(L.wall_n) < gap());
   return !(std::abs(q.x()) > 0.5 * s.table.size_mm - table_margin ||
            std::abs(q.y()) > 0.5 * s.table.size_mm - table_margin);
 }

@@ -163,7 +163,8 @@ void parse_table(const YamlNode& t, TableSettings& ts) {
 
 void parse_warehouse(const YamlNode& w, WarehouseSettings& ws) {
   w.check_keys({"object_size_mm", "wall_distance_mm", "wall_height_mm", "gap_mm", "wall_yaw_deg",
-                "wall_thickness_mm", "wall_length_mm", "floor_size_mm", "floor_thickness_mm"});
+                "wall_thickness_mm", "wall_length_mm", "floor_size_mm", "floor_thickness_mm", "wall"});
+  if (w.has("wall")) ws.wall = w["wall"].as<bool>();
   read_range(w, "object_size_mm", ws.object_size_mm, true);
   read_range(w, "wall_distance_mm", ws.wall_distance_mm, true);
   ws.wall_height_mm = w.get_positive("wall_height_mm", ws.wall_height_mm);
@@ -274,7 +275,7 @@ ordered_json layout_details(const SceneSettings& s) {
   if (s.scenario == Scenario::warehouse)
     j["warehouse"] = {{"wall_yaw_deg", w.wall_yaw_deg}, {"wall_thickness_mm", w.wall_thickness_mm},
                       {"wall_length_mm", w.wall_length_mm}, {"floor_size_mm", w.floor_size_mm},
-                      {"floor_thickness_mm", w.floor_thickness_mm}};
+                      {"floor_thickness_mm", w.floor_thickness_mm}, {"wall", w.wall}};
   return j;
 }
 

@@ -153,6 +153,10 @@ struct WarehouseSettings {
   double wall_length_mm = 30000;    // wall length, mm
   double floor_size_mm = 40000;     // edge of the square floor slab, mm
   double floor_thickness_mm = 100;  // floor slab thickness (its top is z = 0), mm
+  // A wall behind the target as well as the floor. false: the floor alone,
+  // one dominant plane, as the thesis's warehouse scenes ("a plane was added
+  // behind the objects to simulate a floor or a wall").
+  bool wall = true;
 };
 
 struct SceneSettings {

@@ -1,6 +1,10 @@
 #include "scenes/views.h"
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
 
 #include "core/error.h"
 #include "core/rotation.h"
@@ -38,6 +42,36 @@ std::vector<Vec3> view_directions(const ViewSettings& s) {
     }
   }
   return dirs;
+}
+
+ViewSettings views_for_scene_set(const ViewSettings& settings, const std::string& dataset_root) {
+  if (!settings.follow_scene) return settings;
+  const std::string path = (std::filesystem::path(dataset_root) / "posebench_scene.json").string();
+  const std::string field = "settings.camera.elevation_deg";
+  std::ifstream in(path);
+  if (!in)
+    throw InputError(path, "views.follow_scene",
+                     "needs a scene set made by `posebench generate` (its posebench_scene.json), and there is none");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path, "", std::string("malformed JSON: ") + e.what());
+  }
+  const nlohmann::json* e = &j;
+  for (const char* k : {"settings", "camera", "elevation_deg"}) {
+    if (!e->is_object() || !e->contains(k)) throw InputError(path, field, "missing (needed by views.follow_scene)");
+    e = &(*e)[k];
+  }
+  if (!e->is_array() || e->size() != 2 || !(*e)[0].is_number() || !(*e)[1].is_number())
+    throw InputError(path, field, "must be [low, high] in degrees, got " + e->dump());
+  const double lo = (*e)[0].get<double>(), hi = (*e)[1].get<double>();
+  if (!(lo >= -90 && hi <= 90 && lo <= hi))
+    throw InputError(path, field, "must be [low, high] within [-90, 90], got " + e->dump());
+  ViewSettings out = settings;
+  out.elevation_deg = out.side_elevation_deg = 0.5 * (lo + hi);
+  out.follow_scene = false;
+  return out;
 }
 
 std::vector<TrainingView> render_training_views(const Mesh& mesh, const ViewSettings& s) {

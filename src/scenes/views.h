@@ -18,6 +18,15 @@ std::vector<Vec3> view_directions(const ViewSettings& settings);
 
 std::vector<TrainingView> render_training_views(const Mesh& mesh, const ViewSettings& settings);
 
+// `settings` with follow_scene resolved for the scene set at dataset_root:
+// elevation_deg and side_elevation_deg set to the middle of the set's camera
+// elevation range (ROOT/posebench_scene.json, settings.camera.elevation_deg)
+// and follow_scene cleared, so the result names the views it renders.
+// Unchanged when follow_scene is false. InputError naming the file and the
+// field when the set has no such file or range (e.g. a BOP data set not made
+// by `posebench generate`).
+ViewSettings views_for_scene_set(const ViewSettings& settings, const std::string& dataset_root);
+
 // The training views recognition learns from (train_model): rendered, or
 // none with the reason when the mesh is empty or degenerate.
 TrainingViews training_views(const Mesh& mesh, const ViewSettings& settings, const std::string& model_name);
