@@ -1,0 +1,144 @@
+#!/usr/bin/env python3
+"""The ablation experiments of the thesis regeneration: each cause of a gap
+between our tables and the thesis's (configs/thesis/ablations.yaml) switched
+back in a copy of the experiments it concerns, so a reader sees the cells
+that cause moves.
+
+    thesis_ablations.py SPEC OUT_DIR        write OUT_DIR/NAME.yaml for every
+                                            ablation experiment; print NAME
+                                            and the path, one per line
+
+An ablation names the experiments it copies and what it switches: `scenes`
+(the scene sets kept; default all), `generator` (merged into each kept
+scene's generator overrides, JSON merge patch: {warehouse: {wall: true}}),
+`settings` (merged into the experiment's settings). The copy of experiment
+E is named ablation_NAME_E, keeps E's report reference, and differs from E
+only by the switch. Exit 2 with the file and field on a bad spec."""
+import copy
+import os
+import sys
+
+import yaml
+
+
+class SpecError(Exception):
+    def __init__(self, path, field, what):
+        super().__init__("%s: %s: %s" % (path, field, what))
+
+
+def merge_patch(base, patch):
+    """RFC 7386 merge: dicts merge key by key, None deletes, anything else replaces."""
+    if not isinstance(patch, dict):
+        return copy.deepcopy(patch)
+    out = copy.deepcopy(base) if isinstance(base, dict) else {}
+    for k, v in patch.items():
+        if v is None:
+            out.pop(k, None)
+        else:
+            out[k] = merge_patch(out.get(k), v)
+    return out
+
+
+def ablation_name(ablation, experiment):
+    return "ablation_%s_%s" % (ablation, experiment)
+
+
+def load_spec(path):
+    """The ablations of SPEC as a list of dicts, checked."""
+    try:
+        with open(path) as f:
+            spec = yaml.safe_load(f)
+    except OSError as e:
+        raise SpecError(path, "", "cannot read (%s)" % e.strerror)
+    except yaml.YAMLError as e:
+        raise SpecError(path, "", "malformed YAML (%s)" % str(e).replace("\n", " "))
+    if not isinstance(spec, dict) or not isinstance(spec.get("ablations"), list):
+        raise SpecError(path, "ablations", "must be a list")
+    seen = set()
+    for i, a in enumerate(spec["ablations"]):
+        where = "ablations[%d]" % i
+        if not isinstance(a, dict):
+            raise SpecError(path, where, "must be a mapping")
+        for key in ("name", "cause", "switched"):
+            if not isinstance(a.get(key), str) or not a[key]:
+                raise SpecError(path, where + "." + key, "must be a non-empty string")
+        if a["name"] in seen:
+            raise SpecError(path, where + ".name", "'%s' appears twice" % a["name"])
+        seen.add(a["name"])
+        if not isinstance(a.get("experiments"), list) or not a["experiments"]:
+            raise SpecError(path, where + ".experiments", "must be a non-empty list of experiment names")
+        for key in ("generator", "settings"):
+            if key in a and not isinstance(a[key], dict):
+                raise SpecError(path, where + "." + key, "must be a mapping")
+        if "scenes" in a and not (isinstance(a["scenes"], list) and a["scenes"]):
+            raise SpecError(path, where + ".scenes", "must be a non-empty list of scene names")
+        if not any(k in a for k in ("generator", "settings")):
+            raise SpecError(path, where, "switches nothing (give 'generator' or 'settings')")
+    return spec["ablations"]
+
+
+def derive(ablation, experiment, config, config_path="experiment"):
+    """The ablation copy of one experiment config (a dict): renamed, its
+    scenes filtered, the switch merged in."""
+    out = copy.deepcopy(config)
+    out["name"] = ablation_name(ablation["name"], experiment)
+    out["description"] = "%s; ablation '%s': %s" % (config.get("description", experiment), ablation["name"],
+                                                    ablation["switched"])
+    keep = ablation.get("scenes")
+    scenes = [s for s in out.get("scenes", []) if keep is None or s.get("name") in keep]
+    if not scenes:
+        raise SpecError(config_path, "scenes", "none of %s in experiment %s" % (keep, experiment))
+    for s in scenes:
+        if "generator" in ablation:
+            if "generate" not in s:
+                raise SpecError(config_path, "scenes.%s" % s.get("name"), "is not generated: no generator to switch")
+            s["generator"] = merge_patch(s.get("generator", {}), ablation["generator"])
+    out["scenes"] = scenes
+    if "settings" in ablation:
+        out["settings"] = merge_patch(out.get("settings", {}), ablation["settings"])
+    return out
+
+
+def pairs(ablations):
+    """(ablation, experiment as reported, its ablation copy) for every ablation and experiment."""
+    return [(a["name"], e, ablation_name(a["name"], e)) for a in ablations for e in a["experiments"]]
+
+
+def write_all(spec_path, out_dir, config_dir):
+    ablations = load_spec(spec_path)
+    os.makedirs(out_dir, exist_ok=True)
+    written = []
+    for a in ablations:
+        for e in a["experiments"]:
+            src = os.path.join(config_dir, e + ".yaml")
+            try:
+                with open(src) as f:
+                    config = yaml.safe_load(f)
+            except OSError:
+                raise SpecError(spec_path, "ablations.%s.experiments" % a["name"], "no config %s" % src)
+            d = derive(a, e, config, src)
+            path = os.path.join(out_dir, d["name"] + ".yaml")
+            with open(path, "w") as f:
+                f.write("# Derived from %s by scripts/thesis_ablations.py (%s): do not edit.\n" % (src, spec_path))
+                yaml.safe_dump(d, f, sort_keys=False, default_flow_style=None)
+            written.append((d["name"], path))
+    return written
+
+
+def main(argv=None):
+    argv = sys.argv[1:] if argv is None else argv
+    if len(argv) != 2 or argv[0] in ("-h", "--help"):
+        print(__doc__.strip(), file=sys.stderr)
+        return 0 if argv and argv[0] in ("-h", "--help") else 2
+    spec, out_dir = argv
+    try:
+        for name, path in write_all(spec, out_dir, os.path.dirname(spec) or "."):
+            print(name, path)
+    except SpecError as e:
+        print("thesis_ablations.py: %s" % e, file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
