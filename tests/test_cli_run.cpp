@@ -136,6 +136,27 @@ TEST_F(RunTest, DatasetThatIsNotBopIsExit2) {
   EXPECT_FALSE(fs::exists(tmp.path + "/rb")) << "a failed run must not leave a results folder";
 }
 
+// views.follow_scene reads the scene set's camera elevations: a generated
+// set runs; the same set without its posebench_scene.json is exit 2 naming
+// that file and the setting, before any trial runs.
+TEST_F(RunTest, FollowSceneViewsNeedAGeneratedSceneSet) {
+  auto g = pbcli::run("generate scene.yaml --out ds --images 1 --quiet", tmp.path);
+  ASSERT_EQ(g.code, 0) << g.err;
+  const std::string exp = "object: ls5\nscenes:\n  - dataset: " + tmp.path + "/ds\n    scenario: table\n"
+                          "descriptors: [cvfh]\nrefinements: [icp]\nsettings:\n  views: {views: 1, follow_scene: true}\n";
+  pbcli::write_file(tmp.path + "/follow.yaml", exp);
+  auto ok = pbcli::run("run follow.yaml --out rf " + common(), tmp.path);
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_EQ(pbcli::records_by_key(tmp.path + "/rf/records.jsonl").size(), 1u);
+
+  fs::remove(tmp.path + "/ds/posebench_scene.json");
+  auto r = pbcli::run("run follow.yaml --out rb " + common(), tmp.path);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("ds/posebench_scene.json"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("views.follow_scene"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(tmp.path + "/rb/records.jsonl"));
+}
+
 TEST_F(RunTest, ReportOnAFolderWithoutRecordsIsExit2) {
   fs::create_directories(tmp.path + "/empty");
   auto r = pbcli::run("report empty", tmp.path);
