@@ -33,6 +33,7 @@
 #include "runner/pool.h"
 #include "runner/store.h"
 #include "runner/trial.h"
+#include "scenes/generator.h"
 
 namespace fs = std::filesystem;
 
@@ -127,7 +128,11 @@ void prepare_scenes(ExperimentConfig& cfg, const RunOptions& opt) {
       gen["registry"] = fs::absolute(fs::path(src.generate).parent_path() / gen["registry"].get<std::string>())
                             .lexically_normal()
                             .string();
-    const std::string stem = src.name + "_" + hash_hex(gen.dump()).substr(0, 8);
+    // One set per config and generator version (version 1 keeps the names
+    // of the sets made before the version existed).
+    const std::string versioned =
+        gen.dump() + (kSceneSetVersion > 1 ? "#scene_set_version=" + std::to_string(kSceneSetVersion) : "");
+    const std::string stem = src.name + "_" + hash_hex(versioned).substr(0, 8);
     const fs::path dir = fs::path(opt.scenes_dir) / stem;
     src.dataset = dir.string();
     const auto command = [&]() -> std::vector<std::string> {

@@ -100,6 +100,13 @@ struct GenerateSummary {
   double seconds = 0;
 };
 
+// The version of what the generator makes from a config: bump it whenever
+// the same config gives other images (a sensor model's defaults, the layout,
+// the renderer), so that `posebench run`, which keeps one scene set per
+// config in its --scenes folder, generates the set again instead of reusing
+// an old one. 1 = the sets made before it existed.
+constexpr int kSceneSetVersion = 1;
+
 // Generates the whole scene set into `out_dir` (BOP layout, see README):
 // written to `out_dir.partial` and renamed into place at the end, so an
 // interrupted or failed run never leaves `out_dir` looking complete (a failed
