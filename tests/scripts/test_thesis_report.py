@@ -11,6 +11,7 @@ judgements (and "-" without them), and times and loads from runs.jsonl.
 No network, no binary needed (the schema comparison is skipped without one).
 """
 import contextlib
+import csv
 import io
 import json
 import os
@@ -28,25 +29,38 @@ sys.path.insert(0, os.path.join(ROOT, "scripts"))
 import thesis_report  # noqa: E402
 
 EXPERIMENTS = ("table_4_1", "table_4_5", "fig_4_12")
+ABLATIONS = os.path.join(FIXTURES, "ablations.yaml")
 
 
 class Run:
     """Copies the fixtures to a temporary OUT, applies edit(raw folder), runs
     main() with the schema copy (POSEBENCH unless given is no binary) and
-    keeps the exit code, stderr and the README's lines."""
+    keeps the exit code, stderr, stdout, the README's lines and cells.csv's
+    rows (dicts). Ablations from fixtures/ablations.yaml unless given."""
 
-    def __init__(self, edit=None, experiments=EXPERIMENTS, posebench=""):
+    def __init__(self, edit=None, experiments=EXPERIMENTS, posebench="", ablations=None, args=()):
         with tempfile.TemporaryDirectory() as tmp:
             out = os.path.join(tmp, "thesis")
             shutil.copytree(os.path.join(FIXTURES, "raw"), os.path.join(out, "raw"))
             if edit:
                 edit(os.path.join(out, "raw"))
-            err = io.StringIO()
+            err, std = io.StringIO(), io.StringIO()
+            argv = [out] + list(experiments) + ["--ablations", ablations or ABLATIONS] + [
+                a.replace("{tmp}", tmp) for a in args]
             with mock.patch.dict(os.environ, {"POSEBENCH": posebench, "JOBS": "2"}), \
-                    contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
-                self.code = thesis_report.main([out] + list(experiments))
-            self.err = err.getvalue()
+                    contextlib.redirect_stderr(err), contextlib.redirect_stdout(std):
+                self.code = thesis_report.main(argv)
+            self.err, self.out = err.getvalue(), std.getvalue()
             self.lines = read_lines(os.path.join(out, "README.md"))
+            self.cells = read_csv_rows(os.path.join(out, "cells.csv"))
+            self.files = {f: read_lines(os.path.join(tmp, f)) for f in os.listdir(tmp) if f.endswith(".json")}
+
+
+def read_csv_rows(path):
+    if not os.path.exists(path):
+        return None
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
 
 
 def read_lines(path):
@@ -90,11 +104,11 @@ class Readme(unittest.TestCase):
 
     def test_experiments_table_times_and_loads_from_runs_jsonl(self):
         # table_4_1: two invocations, 30.5 s + 12.0 s, loads 1.5 and 2.0.
-        self.assertLine("| Table 4.1 | `configs/thesis/table_4_1.yaml` | 2 | 4 | no_hypothesis 1, ok 3 | 0m42s | 1.5/2.0 |")
-        self.assertLine("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 4 | no_hypothesis 1, ok 3 | 0m20s | 0.5 |")
+        self.assertLine("| Table 4.1 | `configs/thesis/table_4_1.yaml` | 2 | 2 | 4 | no_hypothesis 1, ok 3 | 0m42s | 1.5/2.0 |")
+        self.assertLine("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 2 | 4 | no_hypothesis 1, ok 3 | 0m20s | 0.5 |")
         # fig_4_12: 3725.2 s with an unknown load (null); its second line ran nothing and is left out.
-        self.assertLine("| Figure 4.12 | `configs/thesis/fig_4_12.yaml` | 2 | 8 | ok 8 | 1h02m05s | - |")
-        self.assertLine("| **total** | | | 16 | | **1h03m08s** | |")
+        self.assertLine("| Figure 4.12 | `configs/thesis/fig_4_12.yaml` | 2 | 2 | 8 | ok 8 | 1h02m05s | - |")
+        self.assertLine("| **total** | | | | 16 | | **1h03m08s** | |")
 
     def test_intro_totals_and_load_range(self):
         text = "\n".join(self.run_.lines)
@@ -124,11 +138,19 @@ class Readme(unittest.TestCase):
         self.assertIn("ranged from 1.9 to 3.4 on 2 cores, more than the run's own workers", text)
 
     def test_table_4_1_rows_come_from_the_report_with_the_thesis_beside(self):
-        # cvfh: 1 of 2 correct (thesis 43%), fpfh: 2 of 2 (thesis 67%).
+        # cvfh: 1 of 2 correct (Wilson 9-91%; thesis 43% = 13/30, Fisher p = 1), fpfh: 2 of 2 (34-100%; thesis 67%
+        # = 20/30, p = 1): no mark. The other rows are report.md's.
         self.assertLine("#### Table 4.1: LS5, multiple model views (12 synthetic, 8 real)")
         self.assertLine("| scenario | measure | cvfh | fpfh |")
-        self.assertLine("| table_synthetic | robustness | 50% (43%) | 100% (67%) |")
+        self.assertLine("| table_synthetic | robustness | 50% 1/2 [9-91] (43%) | 100% 2/2 [34-100] (67%) |")
         self.assertLine("|  | time (s) | 0.25 (0.19) | 0.75 (1.22) |")
+        self.assertLine("|  | rotation error (1-|p.q|) | 0.0010 | 0.0010 |")
+
+    def test_legend_states_both_sample_sizes(self):
+        text = "\n".join(self.run_.lines)
+        self.assertIn("`*` p < 0.05, `**` p < 0.01", text)
+        self.assertIn("Our n per cell (trials, from the records): table_4_1 2; table_4_5 2.", text)
+        self.assertIn("20 per occluded one (table_*_occluded), 19 in Table 4.9", text)
 
     def test_carton_faces_row_from_the_records_judgements(self):
         # cvfh: 1 of 2 correct with the half turn, 2 of 2 faces on faces; fpfh: 0 and 0.
@@ -144,17 +166,51 @@ class Readme(unittest.TestCase):
         self.assertLine("| icp_plane (warehouse_synthetic) | 100% / 0.3s | 50% / 0.3s |")
 
     def test_noise_conclusion_from_the_figure(self):
-        line = [l for l in self.run_.lines if l.startswith("6. ")]
-        self.assertEqual(len(line), 1, self.run_.lines)
-        self.assertTrue(line[0].startswith(
-            "6. **Better with about 2 mm of added noise than with none (thesis section 5.1): partly supported.** Of "
-            "the 2 curves of Figures 4.7, 4.11 and 4.12, 1 are higher at 2 mm than at 0 mm, 1 lower, 0 equal. "
-            "Higher: icp (warehouse_synthetic) 50% -> 100%."), line[0])
+        # icp 1/2 -> 2/2 and icp_plane 2/2 -> 1/2: both changes within sampling noise (p = 1).
+        i = self.run_.lines.index("**C6. Better with about 2 mm of added noise than with none (thesis section 5.1): "
+                                  "not supported.**")
+        self.assertTrue(self.run_.lines[i + 2].startswith("- Rule: Over every curve of Figures 4.7, 4.11 and 4.12"))
+        self.assertEqual(self.run_.lines[i + 3],
+                         "- Here: 2 curves: 0 up, 0 down, 2 flat at p < 0.05 (up: none; down: none). In direction "
+                         "alone: 1 higher at 2 mm, 1 lower, 0 equal.")
+        self.assertEqual(self.run_.lines[i + 4], "- On the thesis's own numbers: no numbers (figures only).")
 
     def test_agreement_rows(self):
-        # Table 4.1: ours 50% and 100%, thesis 43% and 67%: means 75% and 55%, |difference| 7 and 33 points.
-        self.assertLine("| Table 4.1 | 2 | 75% | 55% | 20 points |")
-        self.assertLine("| Table 4.5 | 2 | 25% | 24% | 18 points |")
+        # Table 4.1: 1/2 vs 43% (7 points), 2/2 vs 67% (33): 1 within 15; fpfh best in both; tau 1.
+        # Table 4.5: 1/2 vs 31% (19 points), 0/2 vs 16% (16): none within; cvfh best in both; tau 1.
+        self.assertLine("| Table 4.1 | 2 | 1 | 0 | 0 | 1 | 1 | 1 | 75% | 55% |")
+        self.assertLine("| Table 4.5 | 2 | 0 | 0 | 0 | 1 | 1 | 1 | 25% | 24% |")
+        self.assertLine("| **total** (of the thesis's 107) | 4 | 1 | 0 | 0 | 2 | 2 | 2 | 50% | 39% |")
+        # the carton judged faces on faces: cvfh 2/2 (69 points off), fpfh 0/2
+        self.assertLine("| Table 4.5: table_4_5, judged faces on faces (the thesis's judgement) | 2 | 0 | 0 | 0 | 1 | "
+                        "1 | 1 | 50% | 24% |")
+
+    def test_inexact_thesis_values_are_named(self):
+        # 31% and 16% are no k/60; 18/58 and 9/58 print as 31% and 16%.
+        self.assertIn("2 of the thesis's 4 values cannot be k/n at the n assumed (whole percent): Table 4.5 "
+                      "table_astra (n 60): cvfh 31%, fpfh 16%; the row's values all fit n = 58.",
+                      "\n".join(self.run_.lines))
+
+    def test_cells_csv(self):
+        cells = self.run_.cells
+        self.assertEqual(list(cells[0]), thesis_report.CSV_COLUMNS)
+        self.assertEqual([(c["experiment"], c["scenario"], c["measure"], c["method"]) for c in cells], [
+            ("table_4_1", "table_synthetic", "robustness", "cvfh"), ("table_4_1", "table_synthetic", "robustness", "fpfh"),
+            ("table_4_1", "table_synthetic", "time", "cvfh"), ("table_4_1", "table_synthetic", "time", "fpfh"),
+            ("table_4_5", "table_astra", "robustness", "cvfh"), ("table_4_5", "table_astra", "robustness", "fpfh"),
+            ("table_4_5", "table_astra", "robustness_faces", "cvfh"),
+            ("table_4_5", "table_astra", "robustness_faces", "fpfh"),
+            ("table_4_5", "table_astra", "time", "cvfh"), ("table_4_5", "table_astra", "time", "fpfh")])
+        c = cells[0]
+        self.assertEqual((c["table"], c["kind"], c["ours_k"], c["n"], c["ours"], c["thesis"], c["thesis_n"],
+                          c["thesis_k"], c["thesis_exact"], c["p_value"], c["within_15"], c["significant_05"]),
+                         ("4.1", "main", "1", "2", "0.5", "0.43", "30", "13", "true", "1", "true", "false"))
+        self.assertEqual((c["wilson_lo"], c["wilson_hi"]), ("0.0945", "0.9055"))
+        self.assertEqual(cells[5]["thesis_exact"], "false")  # 16% of 60
+        self.assertEqual((cells[6]["ours_k"], cells[6]["thesis"]), ("2", "0.31"))  # faces: cvfh 2 of 2
+        t = cells[2]
+        self.assertEqual((t["ours"], t["thesis"], t["ours_k"], t["n"], t["p_value"], t["within_15"]),
+                         ("0.25", "0.19", "", "", "", ""))
 
 
 class Runs(unittest.TestCase):
@@ -185,7 +241,7 @@ class Runs(unittest.TestCase):
     def test_folder_without_runs_jsonl_shows_no_time_and_says_why(self):
         run = Run(lambda raw: os.remove(os.path.join(raw, "table_4_5", "runs.jsonl")))
         self.assertEqual(run.code, 0, run.err)
-        self.assertIn("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 4 | no_hypothesis 1, ok 3 | - | - |",
+        self.assertIn("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 2 | 4 | no_hypothesis 1, ok 3 | - | - |",
                       run.lines)
         self.assertIn("No `runs.jsonl` (nor the `run_seconds.txt` of older runs), so no wall time or load: "
                       "table_4_5.", run.lines)
@@ -198,7 +254,7 @@ class Runs(unittest.TestCase):
                 f.write("2026-11-22 10:00:00 61.4 3 2 3.7\n2026-11-22 11:00:00 58.9 1 2 1.2\n")
         run = Run(older)
         self.assertEqual(run.code, 0, run.err)
-        self.assertIn("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 4 | no_hypothesis 1, ok 3 | 2m00s | 3.7/1.2 |",
+        self.assertIn("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 2 | 4 | no_hypothesis 1, ok 3 | 2m00s | 3.7/1.2 |",
                       run.lines)
         self.assertFalse(any(line.startswith("No `runs.jsonl`") for line in run.lines))
 
@@ -207,7 +263,7 @@ class Runs(unittest.TestCase):
             with open(os.path.join(raw, "table_4_5", "run_seconds.txt"), "w") as f:
                 f.write("2026-11-22 10:00:00 999.0 3 2 9.9\n")
         run = Run(both)
-        self.assertIn("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 4 | no_hypothesis 1, ok 3 | 0m20s | 0.5 |",
+        self.assertIn("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 2 | 4 | no_hypothesis 1, ok 3 | 0m20s | 0.5 |",
                       run.lines)
 
     def test_run_seconds_txt_sums_seconds_trials_and_loads(self):
@@ -319,7 +375,7 @@ class StrictRecords(unittest.TestCase):
             r.update(status="timeout", correct=False, message="trial timed out after 300 s")
         run = Run(edit_record("table_4_1", 1, crash))
         self.assertEqual(run.code, 0, run.err)
-        self.assertIn("| Table 4.1 | `configs/thesis/table_4_1.yaml` | 2 | 4 | ok 3, timeout 1 | 0m42s | 1.5/2.0 |",
+        self.assertIn("| Table 4.1 | `configs/thesis/table_4_1.yaml` | 2 | 2 | 4 | ok 3, timeout 1 | 0m42s | 1.5/2.0 |",
                       run.lines)
 
     def test_records_of_the_binary_read_back(self):
