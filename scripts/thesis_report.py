@@ -275,13 +275,13 @@ def load_experiment(raw, name, schema):
 
 class Results:
     """The loaded experiments (in the order given, then those only an
-    ablation names: `ablation_only`; `partner`: ablated experiment -> the
-    experiment it is paired with) and where plots go."""
+    ablation names), `partner`: ablated experiment -> the experiment it is
+    paired with, and where plots go."""
 
-    def __init__(self, experiments, raw="", plots="", ablation_only=(), partner=None):
+    def __init__(self, experiments, raw="", plots="", partner=None):
         self.x = {e.name: e for e in experiments}
         self.raw, self.plots = raw, plots
-        self.ablation_only, self.partner = set(ablation_only), dict(partner or {})
+        self.partner = dict(partner or {})
 
     def __contains__(self, e):
         return e in self.x
@@ -338,8 +338,7 @@ def load_results(out_dir, experiments, schema, ablations=()):
                 if name not in experiments and name not in extra:
                     extra.append(name)
     more = [load_experiment(raw, e, schema) for e in extra]
-    return Results([x for x in loaded + more if x is not None], raw, os.path.join(out_dir, "plots"),
-                   [x.name for x in more if x is not None], partner)
+    return Results([x for x in loaded + more if x is not None], raw, os.path.join(out_dir, "plots"), partner)
 
 
 # ---- formatting -------------------------------------------------------------------
@@ -422,7 +421,9 @@ def section_reproduce():
         "```sh\ncmake -S . -B build -DCMAKE_BUILD_TYPE=Release && cmake --build build --target posebench\n"
         "scripts/thesis.sh            # all experiments; resumable (re-running does only what is missing)\n"
         "scripts/thesis.sh --only table_4_1 --jobs 2    # one experiment\n"
-        "scripts/thesis.sh --readme-only                # rewrite this file from the raw records\n```\n",
+        "scripts/thesis.sh --readme-only                # rewrite this file from the raw records\n"
+        "scripts/thesis_report.py results/thesis EXPERIMENT... --scorecard-json FILE  # the scorecard and verdicts "
+        "as JSON\n```\n",
         "Each experiment is `posebench run configs/thesis/NAME.yaml --out results/thesis/raw/NAME --jobs 2 --cache "
         "cache --scenes scenes` followed by `posebench report results/thesis/raw/NAME --format md,csv --plots`. The "
         "scene sets are generated on the first run into `scenes/` from `configs/scenes/*.yaml` (deterministic: same "
@@ -923,10 +924,10 @@ def all_cells(res):
     """Every table experiment's cells: main tables, variants, then ablations."""
     cells = []
     for e, x in res.x.items():
-        ref = res.x.get(res.partner.get(e)) if e in res.ablation_only else x
+        ref = res.x.get(res.partner.get(e)) if e in res.partner else x
         if ref is None or not (table_of(x) or table_of(ref)):
             continue
-        kind = "ablation" if e in res.ablation_only else ("main" if e in MAIN_TABLES else "variant")
+        kind = "ablation" if e in res.partner else ("main" if e in MAIN_TABLES else "variant")
         cells += table_cells(res, x, kind, ref)
     order = {"main": 0, "variant": 1, "ablation": 2}
     return sorted(cells, key=lambda c: order[c.kind])  # stable: experiments keep their order
@@ -1094,7 +1095,7 @@ def figure_curves(res):
     trials and mean time per x value (the experiment's report.plot_x)."""
     curves = []
     for e, x in res.x.items():
-        if e in res.ablation_only or table_of(x) or not x.exp:
+        if e in res.partner or table_of(x) or not x.exp:
             continue
         plot_x = x.exp.get("report", {}).get("plot_x", "added_noise_mm")
         col = method_column(experiment_json(res, x))
@@ -1173,8 +1174,14 @@ def section_conclusions(res, cells):
 
 # ---- ablations -----------------------------------------------------------------------------
 
-ABLATIONS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "configs", "thesis",
-                         "ablations.yaml")
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ABLATIONS = os.path.join(ROOT, "configs", "thesis", "ablations.yaml")
+
+
+def shown_path(path):
+    """A path as the README shows it: relative to the source root when inside it."""
+    a = os.path.abspath(path)
+    return os.path.relpath(a, ROOT) if a.startswith(ROOT + os.sep) else path
 NAME_CHARS = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-")
 
 
@@ -1340,11 +1347,11 @@ EXPLAIN_RULE = (
 def section_ablations(res, ablations, cells, path):
     o = ["## Ablations: what each change of the set-up does\n"]
     if not ablations:
-        return o + ["No ablations (`%s` is missing or lists none).\n" % os.path.relpath(path)]
+        return o + ["No ablations (`%s` is missing or lists none).\n" % shown_path(path)]
     o.append("Each ablation runs an experiment again with one cause switched back (`%s`). Per ablation: the cells "
              "compared, those that move by more than 15 points, those whose two counts differ at p < 0.05 (Fisher's "
              "exact test), the mean robustness both ways and how many cells are within 15 points of the thesis both "
-             "ways.\n" % os.path.relpath(path))
+             "ways.\n" % shown_path(path))
     thesis = {(c.experiment, c.scenario, c.method): c.thesis for c in cells if c.measure == "robustness"
               and c.kind != "ablation"}
     by_ablation = []

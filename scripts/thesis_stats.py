@@ -24,7 +24,8 @@ def wilson(k, n, z=Z95):
     d = 1 + z * z / n
     c = (p + z * z / (2 * n)) / d
     h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
-    return max(0.0, c - h), min(1.0, c + h)
+    # exactly 0 / 1 at the ends (c - h and c + h are 0 and 1 there but for rounding)
+    return (0.0 if k == 0 else max(0.0, c - h)), (1.0 if k == n else min(1.0, c + h))
 
 
 def fisher_exact(a, n, b, m):

@@ -213,6 +213,209 @@ class Readme(unittest.TestCase):
                          ("0.25", "0.19", "", "", "", ""))
 
 
+def records_with(template, method, correct):
+    """Copies of a record, one per entry of `correct` (its method and judgement set)."""
+    out = []
+    for i, c in enumerate(correct):
+        r = json.loads(json.dumps(template))
+        r.update(descriptor=method, im_id=i, correct=c, key="%s/%d/%s" % (r["scene"], i, method))
+        out.append(r)
+    return out
+
+
+def ablation_fixture(raw):
+    """table_4_1 with 10 trials per cell (cvfh 0 of 10, fpfh 10 of 10) and its
+    ablation `ablation_views_table_4_1` (cvfh 1 of 10, fpfh 2 of 10; no report)."""
+    ok = records_of(raw, "table_4_1")[0]
+    write_records(raw, "table_4_1", records_with(ok, "cvfh", [False] * 10) + records_with(ok, "fpfh", [True] * 10))
+    d = os.path.join(raw, "ablation_views_table_4_1")
+    os.makedirs(d)
+    with open(os.path.join(raw, "table_4_1", "experiment.json")) as f:
+        exp = json.load(f)
+    exp["name"] = "ablation_views_table_4_1"
+    with open(os.path.join(d, "experiment.json"), "w") as f:
+        json.dump(exp, f)
+    write_records(raw, "ablation_views_table_4_1", records_with(ok, "cvfh", [True] + [False] * 9) +
+                  records_with(ok, "fpfh", [True] * 2 + [False] * 8))
+
+
+class Ablations(unittest.TestCase):
+    longMessage = False
+
+    @classmethod
+    def setUpClass(cls):
+        cls.run_ = Run(ablation_fixture)
+
+    def assertLine(self, line):
+        self.assertIn(line, self.run_.lines, "README lines:\n" + "\n".join(self.run_.lines))
+
+    def test_exit_code_zero(self):
+        self.assertEqual(self.run_.code, 0, self.run_.err)
+
+    def test_ablation_row(self):
+        # 2 cells; fpfh moves 100% -> 20% (p = 90/125970), cvfh 0% -> 10% (p = 1); none within 15 of the thesis.
+        self.assertLine("| views | training views at 0 / 20 deg | views.elevation_deg: 20 | 1 of 1 | 2 | 1 | 1 | 50% | "
+                        "15% | 0 of 2 | 0 of 2 |")
+        self.assertLine("- views, cells moved by more than 15 points (scene set, method: as reported -> switched back, "
+                        "thesis): table_4_1 table_synthetic fpfh: 10/10 -> 2/10 (100% -> 20%, p = 0.00071), thesis 67%.")
+
+    def test_explained_and_unexplained_gaps(self):
+        # fpfh: gap 67 - 100 = -33, the ablation moves it -80 at p < 0.05: explained. cvfh: gap +43, moved +10:
+        # not. The two carton cells (19 and 16 points off) have no ablation.
+        self.assertLine("Of the 4 main cells outside 15 points, 1 explained (Table 4.1 table_synthetic fpfh by views), "
+                        "3 unexplained.")
+        self.assertLine("Unexplained (ours vs the thesis): Table 4.1 table_synthetic cvfh 0% vs 43%; Table 4.5 "
+                        "table_astra cvfh 50% vs 31%; Table 4.5 table_astra fpfh 0% vs 16%.")
+
+    def test_ablated_cells_in_cells_csv_against_the_partners_thesis(self):
+        abl = [c for c in self.run_.cells if c["kind"] == "ablation"]
+        self.assertEqual([(c["experiment"], c["measure"], c["method"], c["ours_k"], c["n"], c["thesis"])
+                          for c in abl if c["measure"] == "robustness"],
+                         [("ablation_views_table_4_1", "robustness", "cvfh", "1", "10", "0.43"),
+                          ("ablation_views_table_4_1", "robustness", "fpfh", "2", "10", "0.67")])
+
+    def test_ablated_experiment_is_not_in_the_scorecard(self):
+        # 0/10 against 13/30: p = 0.016; 10/10 against 20/30: p = 0.043; both p < 0.05, neither < 0.01.
+        self.assertLine("| Table 4.1 | 2 | 0 | 2 | 0 | 1 | 1 | 1 | 50% | 55% |")
+
+    def test_missing_pairs_are_skipped_and_said(self):
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "ablations.yaml")
+            with open(path, "w") as f:
+                f.write("ablations:\n  - name: plane\n    cause: c\n    switched: s\n    pairs:\n"
+                        "      - [table_4_1, ablation_plane_table_4_1]\n")
+            run = Run(ablations=path)
+        self.assertEqual(run.code, 0, run.err)
+        self.assertIn("- plane: pair table_4_1 / ablation_plane_table_4_1 skipped, no records for "
+                      "ablation_plane_table_4_1 (`results/thesis/raw/NAME/records.jsonl`).", run.lines)
+        self.assertIn("| plane | c | s | 0 of 1 | 0 | 0 | 0 | - | - | - | - |", run.lines)
+
+    def test_no_ablations_file(self):
+        run = Run(ablations="/nonexistent/ablations.yaml")
+        self.assertEqual(run.code, 0, run.err)
+        self.assertIn("No ablations (`/nonexistent/ablations.yaml` is missing or lists none).", run.lines)
+
+
+class AblationsFile(unittest.TestCase):
+    def parse(self, text):
+        return thesis_report.parse_ablations(text, "abl.yaml")
+
+    def test_the_schema(self):
+        a = self.parse('# c\nablations:\n  - name: views   # c\n    cause: "a # b, c"\n    switched: \'x: 1\'\n'
+                       '    pairs:            # c\n      - [table_4_1, ablation_views_table_4_1]\n'
+                       '      - ["table_4_3", ablation_views_table_4_3]\n  - name: plane\n    cause: p\n'
+                       '    switched: q\n    pairs: [[table_4_7, ablation_plane_table_4_7]]\n')
+        self.assertEqual([(x["name"], x["cause"], x["switched"], x["pairs"]) for x in a], [
+            ("views", "a # b, c", "x: 1", [["table_4_1", "ablation_views_table_4_1"],
+                                           ["table_4_3", "ablation_views_table_4_3"]]),
+            ("plane", "p", "q", [["table_4_7", "ablation_plane_table_4_7"]])])
+
+    def test_the_committed_file_reads(self):
+        a = thesis_report.load_ablations(thesis_report.ABLATIONS)
+        self.assertTrue(a and all(x["pairs"] for x in a))
+
+    def assertRefused(self, text, message):
+        with self.assertRaises(thesis_report.InputError) as c:
+            self.parse(text)
+        self.assertIn(message, str(c.exception))
+
+    def test_errors_name_file_line_and_field(self):
+        self.assertRefused("abl:\n", "abl.yaml: line 1: expected `ablations:`")
+        self.assertRefused("ablations:\n  - name: a\n    cause: c\n    pairs:\n      - [x, y]\n",
+                           "abl.yaml: ablation at line 2: missing field 'switched'")
+        self.assertRefused("ablations:\n  - name: a\n    caus: c\n", "abl.yaml: line 3: unknown key 'caus'")
+        self.assertRefused("ablations:\n  - name: a\n    cause: c\n    switched: s\n    pairs:\n      - [x]\n",
+                           "abl.yaml: line 6: a pair is two different experiment names")
+        self.assertRefused("ablations:\n  - name: a\n    cause: c\n    switched: s\n    pairs: []\n"
+                           "  - name: a\n    cause: c\n    switched: s\n    pairs: []\n",
+                           "abl.yaml: ablation at line 6: name 'a' used twice")
+
+    def test_a_bad_file_is_exit_2(self):
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "ablations.yaml")
+            with open(path, "w") as f:
+                f.write("ablations:\n  - name: a\n    cause: \"c\n")
+            run = Run(ablations=path)
+        self.assertEqual(run.code, 2)
+        self.assertIn("ablations.yaml: line 3: unterminated \"string\"", run.err)
+
+
+class Scorecard(unittest.TestCase):
+    def test_json_to_a_file_and_no_readme(self):
+        run = Run(args=["--scorecard-json", "{tmp}/card.json"])
+        self.assertEqual(run.code, 0, run.err)
+        self.assertEqual(run.lines, [])
+        self.assertIsNone(run.cells)
+        card = json.loads("\n".join(run.files["card.json"]))
+        self.assertEqual([(t["table"], t["cells"], t["within_15"], t["significant_05"], t["best_agrees"],
+                           t["tau_positive"]) for t in card["tables"]], [("4.1", 2, 1, 0, 1, 1), ("4.5", 2, 0, 0, 1, 1)])
+        self.assertEqual((card["total"]["of"], card["total"]["cells"], card["total"]["within_15"]), (107, 4, 1))
+        self.assertEqual([(v["experiment"], v["measure"]) for v in card["variants"]],
+                         [("table_4_5", "robustness_faces")])
+        self.assertEqual(card["verdicts"]["C6"]["ours"], "not supported")
+        self.assertIsNone(card["verdicts"]["C2"]["ours"])  # no CVFH/ESF/CESF row in the fixtures
+
+    def test_json_to_stdout(self):
+        run = Run(args=["--scorecard-json", "-"])
+        self.assertEqual(run.code, 0, run.err)
+        self.assertEqual(json.loads(run.out)["total"]["rows"], 2)
+
+    def test_significance_marks(self):
+        # 0 of 10 against the thesis's 67% (20 of 30): p < 0.01; 10 of 10 against 43% (13 of 30): p < 0.01.
+        def edit(raw):
+            ok = records_of(raw, "table_4_1")[0]
+            write_records(raw, "table_4_1", records_with(ok, "cvfh", [True] * 10) +
+                          records_with(ok, "fpfh", [False] * 10))
+        run = Run(edit)
+        self.assertIn("| table_synthetic | robustness | 100% 10/10 [72-100] (43%) ** | 0% 0/10 [0-28] (67%) ** |",
+                      run.lines)
+        row = [c for c in run.cells if c["method"] == "fpfh" and c["measure"] == "robustness"][0]
+        self.assertEqual((row["significant_05"], row["significant_01"], row["within_15"]), ("true", "true", "false"))
+
+    def test_best_agrees_and_tau_rules(self):
+        def cell(ours, thesis):
+            return thesis_report.Cell("4.1", "e", "main", "s", "robustness", "m", round(10 * ours), 10, thesis=thesis,
+                                      thesis_n_=30)
+        tie = [cell(0.5, 0.9), cell(0.5, 0.2), cell(0.1, 0.1)]
+        self.assertTrue(thesis_report.best_agrees(tie))  # ours tie includes the thesis's best
+        self.assertTrue(thesis_report.tau_positive(tie))
+        flat = [cell(1.0, 0.9), cell(1.0, 0.8)]
+        self.assertTrue(thesis_report.best_agrees(flat))
+        self.assertFalse(thesis_report.tau_positive(flat))  # all tied: tau undefined, not counted
+        self.assertFalse(thesis_report.best_agrees([cell(0.9, 0.1), cell(0.1, 0.9)]))
+
+
+class BadInput(unittest.TestCase):
+    def test_a_missing_thesis_value_names_file_and_field(self):
+        def blank(raw):
+            path = os.path.join(raw, "table_4_1", "report.csv")
+            with open(path) as f:
+                text = f.read()
+            with open(path, "w") as f:
+                f.write(text.replace("robustness,cvfh,0.5,0.43,", "robustness,cvfh,0.5,,"))
+        run = Run(blank)
+        self.assertEqual(run.code, 2, run.err)
+        self.assertIn("table_4_1/report.csv: no thesis value (field 'thesis') for scenario table_synthetic, measure "
+                      "robustness, method cvfh", run.err)
+        self.assertEqual(run.lines, [])
+
+    def test_a_thesis_value_not_a_number(self):
+        def garble(raw):
+            path = os.path.join(raw, "table_4_5", "report.csv")
+            with open(path) as f:
+                text = f.read()
+            with open(path, "w") as f:
+                f.write(text.replace("robustness,fpfh,0,0.16,", "robustness,fpfh,0,16%,"))
+        run = Run(garble)
+        self.assertEqual(run.code, 2, run.err)
+        self.assertIn("table_4_5/report.csv: line 3: field 'thesis' is not a number: '16%'", run.err)
+
+    def test_a_table_without_report_csv(self):
+        run = Run(lambda raw: os.remove(os.path.join(raw, "table_4_5", "report.csv")))
+        self.assertEqual(run.code, 2, run.err)
+        self.assertIn("table_4_5/report.csv: missing or empty", run.err)
+
+
 class Runs(unittest.TestCase):
     def write(self, text):
         d = tempfile.mkdtemp()
