@@ -9,11 +9,12 @@
 # `posebench run` into results/thesis/raw/NAME (git-ignored; the run itself
 # logs its wall time and load to NAME/runs.jsonl), reports each (markdown,
 # csv, plots), copies the plots to results/thesis/plots/ and writes
-# results/thesis/README.md with scripts/thesis_report.py. Resumable: `posebench
-# run` only runs the trials a results folder is missing, so running this again
-# after an interruption (or after adding an experiment) does only what is
-# missing. --readme-only: report and rewrite the README from the raw folders
-# (none yet: the README is left as it is).
+# results/thesis/README.md and cells.csv with scripts/thesis_report.py (with
+# the ablation pairs of configs/thesis/ablations.yaml whose folders exist).
+# Resumable: `posebench run` only runs the trials a results folder is missing,
+# so running this again after an interruption (or after adding an experiment)
+# does only what is missing. --readme-only: report and rewrite the README from
+# the raw folders (none yet: the README is left as it is).
 #
 # Environment: POSEBENCH (the binary, default build/posebench), JOBS (worker
 # processes, default 2), NICE (niceness of the runs, default 0). Workers run
@@ -31,7 +32,7 @@ while [ $# -gt 0 ]; do
     --jobs) JOBS=$2; shift 2 ;;
     --only) ONLY=$2; shift 2 ;;
     --readme-only) README_ONLY=1; shift ;;
-    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,21p' "$0"; exit 0 ;;
     *) echo "thesis.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done

@@ -14,12 +14,19 @@ Every record is checked against the trial record's schema (`posebench schema
 record` of the binary in POSEBENCH, default build/posebench, or the copy
 RECORD_SCHEMA below when there is no binary): an unknown key or a missing
 required key is an error naming the file, the line and the key (exit code 2).
-The README's numbers all come from those files: tables from report.csv /
-report.md, wall times and loads from runs.jsonl (one line per `posebench run`
-that ran trials; folders of older runs: their run_seconds.txt), the milk
-carton's "faces on faces" row from each record's judgements.faces. Without
-any experiment's records the README is left as it is. Environment: JOBS
-(worker processes, for the text).
+The README's numbers all come from those files: each robustness cell of a
+table experiment counted from its records (k of n correct, the 95% Wilson
+interval, Fisher's exact test against the thesis's k of n; the thesis's
+value from report.csv), the other rows from report.md, wall times and loads
+from runs.jsonl (one line per `posebench run` that ran trials; folders of
+older runs: their run_seconds.txt), the milk carton's "faces on faces" row
+from each record's judgements.faces. OUT/cells.csv has every cell (CSV_COLUMNS).
+The agreement scorecard, the verdicts on the thesis's conclusions (rules in
+scripts/thesis_verdicts.py) and the ablation section (pairs of experiments
+from the ablations file) are computed from the same cells. A missing thesis
+value or a malformed file is an error naming file and field (exit code 2).
+Without any experiment's records the README is left as it is. Environment:
+JOBS (worker processes, for the text).
 """
 import collections
 import csv
@@ -275,13 +282,15 @@ def load_experiment(raw, name, schema):
 
 class Results:
     """The loaded experiments (in the order given, then those only an
-    ablation names), `partner`: ablated experiment -> the experiment it is
-    paired with, and where plots go."""
+    ablation names: `ablation_only`), `partner`: ablated experiment -> the
+    experiment it is paired with, and where plots go. An experiment named on
+    the command line stays what it is (a main table, a variant, a figure)
+    even when an ablation also pairs it."""
 
-    def __init__(self, experiments, raw="", plots="", partner=None):
+    def __init__(self, experiments, raw="", plots="", ablation_only=(), partner=None):
         self.x = {e.name: e for e in experiments}
         self.raw, self.plots = raw, plots
-        self.partner = dict(partner or {})
+        self.ablation_only, self.partner = set(ablation_only), dict(partner or {})
 
     def __contains__(self, e):
         return e in self.x
@@ -338,7 +347,8 @@ def load_results(out_dir, experiments, schema, ablations=()):
                 if name not in experiments and name not in extra:
                     extra.append(name)
     more = [load_experiment(raw, e, schema) for e in extra]
-    return Results([x for x in loaded + more if x is not None], raw, os.path.join(out_dir, "plots"), partner)
+    return Results([x for x in loaded + more if x is not None], raw, os.path.join(out_dir, "plots"),
+                   [x.name for x in more if x is not None], partner)
 
 
 # ---- formatting -------------------------------------------------------------------
@@ -763,7 +773,7 @@ THESIS_N_TEXT = ("30 per synthetic scene set (warehouse_synthetic, table_synthet
                  "19 in Table 4.9 (its 95/84/100% imply n = 19)")
 
 
-def thesis_n(table, scenario):
+def thesis_images(table, scenario):
     """The thesis's images per cell (THESIS.md), None when it says none for this scene set."""
     if table == "4.9":
         return 19
@@ -781,16 +791,16 @@ class Cell:
     thesis's value, its k of its n) or a time (mean seconds; no counts)."""
 
     def __init__(self, table, experiment, kind, scenario, measure, method, k=None, n=None, ours=None, thesis=None,
-                 thesis_n_=None):
+                 thesis_n=None):
         self.table, self.experiment, self.kind = table, experiment, kind
         self.scenario, self.measure, self.method = scenario, measure, method
-        self.k, self.n, self.thesis, self.thesis_n = k, n, thesis, thesis_n_
+        self.k, self.n, self.thesis, self.thesis_n = k, n, thesis, thesis_n
         self.ours = k / n if k is not None and n else ours
         counted = k is not None and n
         self.lo, self.hi = wilson(k, n) if counted else (None, None)
-        self.thesis_k = count_of(thesis, thesis_n_) if counted and thesis is not None and thesis_n_ else None
-        self.exact = printable_as_count(thesis, thesis_n_) if self.thesis_k is not None else None
-        self.p = fisher_exact(k, n, self.thesis_k, thesis_n_) if self.thesis_k is not None else None
+        self.thesis_k = count_of(thesis, thesis_n) if counted and thesis is not None and thesis_n else None
+        self.exact = printable_as_count(thesis, thesis_n) if self.thesis_k is not None else None
+        self.p = fisher_exact(k, n, self.thesis_k, thesis_n) if self.thesis_k is not None else None
         self.within = (within_points(self.ours, thesis, POINTS) if counted and thesis is not None else None)
 
     @property
@@ -819,7 +829,7 @@ def method_column(exp):
     return "refinement" if exp.get("report", {}).get("columns") == "refinement" else "descriptor"
 
 
-def condition_of(r, exp):
+def condition_of(r):
     """A record's condition: its added noise and swept parameters."""
     return (float(r["added_noise_mm"]), json.dumps(r["params"], sort_keys=True))
 
@@ -845,13 +855,13 @@ def group_records(res, x):
     when all records share one condition."""
     exp = experiment_json(res, x)
     col = method_column(exp)
-    conds = sorted({condition_of(r, exp) for r in x.records})
+    conds = sorted({condition_of(r) for r in x.records})
     single = len(conds) <= 1
     order = {s["name"]: i for i, s in enumerate(exp["scenes"])}
     meths = {m: i for i, m in enumerate(exp["refinements"] if col == "refinement" else exp["descriptors"])}
     groups = {}
     for r in x.records:
-        c = condition_of(r, exp)
+        c = condition_of(r)
         groups.setdefault((r["scene"], r[col], "" if single else condition_label(c)), (c, []))[1].append(r)
     keys = sorted(groups, key=lambda k: (order.get(k[0], len(order)), k[0], meths.get(k[1], len(meths)), k[1],
                                          groups[k][0]))
@@ -907,14 +917,14 @@ def table_cells(res, x, kind, ref):
         if th is None:
             raise InputError("%s: no thesis value (field 'thesis') for scenario %s, measure robustness, method %s" %
                              (path, s, m))
-        tn = thesis_n(table, s)
+        tn = thesis_images(table, s)
         if tn is None:
             raise InputError("%s: scenario %s: the thesis's number of images is not known for this scene set "
-                             "(thesis_n in scripts/thesis_report.py)" % (os.path.join(res.raw, x.name, "records.jsonl"), s))
-        rob.append(Cell(table, x.name, kind, s, "robustness", m, n_correct(recs), len(recs), thesis=th, thesis_n_=tn))
+                             "(thesis_images in scripts/thesis_report.py)" % (os.path.join(res.raw, x.name, "records.jsonl"), s))
+        rob.append(Cell(table, x.name, kind, s, "robustness", m, n_correct(recs), len(recs), thesis=th, thesis_n=tn))
         if faces:
             face.append(Cell(table, x.name, kind, s, FACES, m, n_correct(recs, True), len(recs), thesis=th,
-                             thesis_n_=tn))
+                             thesis_n=tn))
         t = mean([r["times"]["total"] for r in recs if "times" in r])
         times.append(Cell(table, x.name, kind, s, "time", m, ours=t, thesis=tv.get((s, "time", m))))
     return rob + face + times
@@ -924,10 +934,11 @@ def all_cells(res):
     """Every table experiment's cells: main tables, variants, then ablations."""
     cells = []
     for e, x in res.x.items():
-        ref = res.x.get(res.partner.get(e)) if e in res.partner else x
+        ablated = e in res.ablation_only
+        ref = res.x.get(res.partner.get(e)) if ablated else x
         if ref is None or not (table_of(x) or table_of(ref)):
             continue
-        kind = "ablation" if e in res.partner else ("main" if e in MAIN_TABLES else "variant")
+        kind = "ablation" if ablated else ("main" if e in MAIN_TABLES else "variant")
         cells += table_cells(res, x, kind, ref)
     order = {"main": 0, "variant": 1, "ablation": 2}
     return sorted(cells, key=lambda c: order[c.kind])  # stable: experiments keep their order
@@ -1095,7 +1106,7 @@ def figure_curves(res):
     trials and mean time per x value (the experiment's report.plot_x)."""
     curves = []
     for e, x in res.x.items():
-        if e in res.partner or table_of(x) or not x.exp:
+        if e in res.ablation_only or table_of(x) or not x.exp:
             continue
         plot_x = x.exp.get("report", {}).get("plot_x", "added_noise_mm")
         col = method_column(experiment_json(res, x))
@@ -1429,7 +1440,7 @@ def scorecard_json(res, cells):
         (cid, collections.OrderedDict([("ours", v.word if v else None), ("thesis_numbers", t.word if t else None),
                                        ("numbers", v.numbers if v else None)]))
         for cid, _title, _rule, v, t in verdicts(res, cells))
-    card["raw"] = res.raw
+    card["raw"] = os.path.realpath(res.raw)
     return json.dumps(card, indent=1) + "\n"
 
 

@@ -290,6 +290,21 @@ class Ablations(unittest.TestCase):
                       "ablation_plane_table_4_1 (`results/thesis/raw/NAME/records.jsonl`).", run.lines)
         self.assertIn("| plane | c | s | 0 of 1 | 0 | 0 | 0 | - | - | - | - |", run.lines)
 
+    def test_an_experiment_named_on_the_command_line_stays_what_it_is(self):
+        # a variant (a copy of table_4_1's folder) that an ablation also pairs: still a variant in cells.csv and
+        # the scorecard, and compared in the ablation
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "ablations.yaml")
+            with open(path, "w") as f:
+                f.write("ablations:\n  - name: v\n    cause: c\n    switched: s\n    pairs:\n"
+                        "      - [table_4_1, table_4_3_view45]\n")
+            run = Run(lambda raw: shutil.copytree(os.path.join(raw, "table_4_1"), os.path.join(raw, "table_4_3_view45")),
+                      experiments=EXPERIMENTS + ("table_4_3_view45",), ablations=path)
+        self.assertEqual(run.code, 0, run.err)
+        self.assertEqual({c["kind"] for c in run.cells if c["experiment"] == "table_4_3_view45"}, {"variant"})
+        self.assertIn("| v | c | s | 1 of 1 | 2 | 0 | 0 | 75% | 75% | 1 of 2 | 1 of 2 |", run.lines)
+        self.assertIn("| Table 4.1: table_4_3_view45 | 2 | 1 | 0 | 0 | 1 | 1 | 1 | 75% | 55% |", run.lines)
+
     def test_no_ablations_file(self):
         run = Run(ablations="/nonexistent/ablations.yaml")
         self.assertEqual(run.code, 0, run.err)
@@ -375,7 +390,7 @@ class Scorecard(unittest.TestCase):
     def test_best_agrees_and_tau_rules(self):
         def cell(ours, thesis):
             return thesis_report.Cell("4.1", "e", "main", "s", "robustness", "m", round(10 * ours), 10, thesis=thesis,
-                                      thesis_n_=30)
+                                      thesis_n=30)
         tie = [cell(0.5, 0.9), cell(0.5, 0.2), cell(0.1, 0.1)]
         self.assertTrue(thesis_report.best_agrees(tie))  # ours tie includes the thesis's best
         self.assertTrue(thesis_report.tau_positive(tie))
