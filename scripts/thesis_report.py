@@ -307,11 +307,6 @@ class Results:
                 return r
         return None
 
-    def val(self, e, scene, measure, method, cond=""):
-        """A cell's value (None when absent or empty)."""
-        r = self.cell(e, scene, measure, method, cond)
-        return float(r["value"]) if r and r["value"] != "" else None
-
     def thesis(self, e, scene, measure, method):
         """The thesis's value beside a cell (None when it printed none)."""
         r = self.cell(e, scene, measure, method)
@@ -920,7 +915,8 @@ def table_cells(res, x, kind, ref):
         tn = thesis_images(table, s)
         if tn is None:
             raise InputError("%s: scenario %s: the thesis's number of images is not known for this scene set "
-                             "(thesis_images in scripts/thesis_report.py)" % (os.path.join(res.raw, x.name, "records.jsonl"), s))
+                             "(thesis_images in scripts/thesis_report.py)" % (
+                                 os.path.join(res.raw, x.name, "records.jsonl"), s))
         rob.append(Cell(table, x.name, kind, s, "robustness", m, n_correct(recs), len(recs), thesis=th, thesis_n=tn))
         if faces:
             face.append(Cell(table, x.name, kind, s, FACES, m, n_correct(recs, True), len(recs), thesis=th,
@@ -984,11 +980,11 @@ def inexact_text(cells):
     for c in bad:
         rows.setdefault((c.table, c.experiment, c.scenario, c.thesis_n), []).append(c)
     fits = []
-    for (t, e, s, n), _bad in rows.items():
+    for (t, e, s, n), row_bad in rows.items():
         m = fitting_n([c.thesis for c in cells if c.main and (c.experiment, c.scenario) == (e, s)], n)
-        fits.append("Table %s %s (n %d): %s; %s" % (t, s, n, ", ".join("%s %s" % (c.method, pct(c.thesis)) for c in _bad),
-                                                 "the row's values all fit n = %d" % m if m else
-                                                 "the row's values fit no n from %d to %d" % (n // 2, n)))
+        fits.append("Table %s %s (n %d): %s; %s" % (
+            t, s, n, ", ".join("%s %s" % (c.method, pct(c.thesis)) for c in row_bad),
+            "the row's values all fit n = %d" % m if m else "the row's values fit no n from %d to %d" % (n // 2, n)))
     return ("%d of the thesis's %d values cannot be k/n at the n assumed (whole percent): %s. Those scene sets "
             "probably had fewer usable images than the thesis states; k is round(value x n) all the same, so the "
             "test is approximate there." % (len(bad), len([c for c in cells if c.main]), "; ".join(fits)))

@@ -51,9 +51,6 @@ class Data:
                 out.append(s)
         return out
 
-    def has(self, e):
-        return any(x == e for (x, _s, _m) in self.rob)
-
 
 def word(checks):
     """supported when every check holds, not supported when none, else partly."""
@@ -259,13 +256,15 @@ def conclusion_4(d):
     fig_most = [m for m, (k, n) in fig.items() if k / n >= fig_top - 1e-12]
     b = "icp_plane" in most_robust and (not fig or "icp_plane" in fig_most)
     v = NOT if not a else (SUPPORTED if b else PARTLY)
-    ev = ("(a) mean translation error in Table 4.9: %s; lowest: %s: %s. (b) most robust in Table 4.9: %s (%s)%s: %s." % (
+    ev = ("(a) mean translation error in Table 4.9: %s; lowest: %s: %s. (b) most robust in Table 4.9: %s (%s)%s: "
+          "%s." % (
         ", ".join("%s %.2f mm" % (m, te[m]) for m in acc), ", ".join(m for m in acc if te[m] <= lowest + 1e-12),
         "holds" if a else "fails", ", ".join(most_robust), pct(top),
         ("; over Figure 4.12's noise levels pooled: " + ", ".join("%s %d/%d" % (m, k, n) for m, (k, n) in fig.items())
          + ", most robust " + ", ".join(fig_most)) if fig else "", "holds" if b else "fails"))
     return Verdict(v, ev, {"icp_lowest_translation": a, "lowest": [m for m in acc if te[m] <= lowest + 1e-12],
-                           "icp_plane_most_robust": b, "most_robust_table": most_robust, "most_robust_figure": fig_most})
+                           "icp_plane_most_robust": b, "most_robust_table": most_robust,
+                           "most_robust_figure": fig_most})
 
 
 # ---- 5 -----------------------------------------------------------------------------

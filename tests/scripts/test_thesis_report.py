@@ -7,7 +7,11 @@ table_4_1 (a Table 4.1-style table), table_4_5 (the milk carton, records
 with judgements.faces) and fig_4_12 (a noise figure, registration only).
 The tests assert exact README rows, the strict record loader (exit code 2
 naming file, line and key), the carton's faces row from the records'
-judgements (and "-" without them), and times and loads from runs.jsonl.
+judgements (and "-" without them), times and loads from runs.jsonl, the
+robustness cells (k/n, Wilson interval, Fisher's mark), cells.csv, the
+agreement scorecard (also as --scorecard-json), the ablation section (pairs
+built in the tests from the fixtures) and its file's parser, and exit code 2
+for a missing thesis value. The verdict rules: test_thesis_verdicts.py.
 No network, no binary needed (the schema comparison is skipped without one).
 """
 import contextlib
@@ -195,7 +199,8 @@ class Readme(unittest.TestCase):
         cells = self.run_.cells
         self.assertEqual(list(cells[0]), thesis_report.CSV_COLUMNS)
         self.assertEqual([(c["experiment"], c["scenario"], c["measure"], c["method"]) for c in cells], [
-            ("table_4_1", "table_synthetic", "robustness", "cvfh"), ("table_4_1", "table_synthetic", "robustness", "fpfh"),
+            ("table_4_1", "table_synthetic", "robustness", "cvfh"),
+            ("table_4_1", "table_synthetic", "robustness", "fpfh"),
             ("table_4_1", "table_synthetic", "time", "cvfh"), ("table_4_1", "table_synthetic", "time", "fpfh"),
             ("table_4_5", "table_astra", "robustness", "cvfh"), ("table_4_5", "table_astra", "robustness", "fpfh"),
             ("table_4_5", "table_astra", "robustness_faces", "cvfh"),
@@ -257,7 +262,8 @@ class Ablations(unittest.TestCase):
         self.assertLine("| views | training views at 0 / 20 deg | views.elevation_deg: 20 | 1 of 1 | 2 | 1 | 1 | 50% | "
                         "15% | 0 of 2 | 0 of 2 |")
         self.assertLine("- views, cells moved by more than 15 points (scene set, method: as reported -> switched back, "
-                        "thesis): table_4_1 table_synthetic fpfh: 10/10 -> 2/10 (100% -> 20%, p = 0.00071), thesis 67%.")
+                        "thesis): table_4_1 table_synthetic fpfh: 10/10 -> 2/10 (100% -> 20%, p = 0.00071), "
+                        "thesis 67%.")
 
     def test_explained_and_unexplained_gaps(self):
         # fpfh: gap 67 - 100 = -33, the ablation moves it -80 at p < 0.05: explained. cvfh: gap +43, moved +10:
@@ -298,12 +304,36 @@ class Ablations(unittest.TestCase):
             with open(path, "w") as f:
                 f.write("ablations:\n  - name: v\n    cause: c\n    switched: s\n    pairs:\n"
                         "      - [table_4_1, table_4_3_view45]\n")
-            run = Run(lambda raw: shutil.copytree(os.path.join(raw, "table_4_1"), os.path.join(raw, "table_4_3_view45")),
+            run = Run(lambda raw: shutil.copytree(os.path.join(raw, "table_4_1"),
+                                                  os.path.join(raw, "table_4_3_view45")),
                       experiments=EXPERIMENTS + ("table_4_3_view45",), ablations=path)
         self.assertEqual(run.code, 0, run.err)
         self.assertEqual({c["kind"] for c in run.cells if c["experiment"] == "table_4_3_view45"}, {"variant"})
         self.assertIn("| v | c | s | 1 of 1 | 2 | 0 | 0 | 75% | 75% | 1 of 2 | 1 of 2 |", run.lines)
         self.assertIn("| Table 4.1: table_4_3_view45 | 2 | 1 | 0 | 0 | 1 | 1 | 1 | 75% | 55% |", run.lines)
+
+    def test_a_figure_pair_compares_per_condition(self):
+        # fig_4_12 against a copy with icp_plane's two correct trials at 0 mm made wrong: 4 cells (2 methods x 2
+        # noise levels), icp_plane at 0 mm moves 100% -> 0% (p = 1/3 at n = 2), no thesis values.
+        def edit(raw):
+            shutil.copytree(os.path.join(raw, "fig_4_12"), os.path.join(raw, "ablation_x_fig_4_12"))
+            recs = records_of(raw, "ablation_x_fig_4_12")
+            for r in recs:
+                if r["refinement"] == "icp_plane" and r["added_noise_mm"] == 0.0:
+                    r["correct"] = False
+            write_records(raw, "ablation_x_fig_4_12", recs)
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "ablations.yaml")
+            with open(path, "w") as f:
+                f.write("ablations:\n  - name: x\n    cause: c\n    switched: s\n    pairs:\n"
+                        "      - [fig_4_12, ablation_x_fig_4_12]\n")
+            run = Run(edit, ablations=path)
+        self.assertEqual(run.code, 0, run.err)
+        self.assertIn("| x | c | s | 1 of 1 | 4 | 1 | 0 | 75% | 50% | - | - |", run.lines)
+        self.assertIn("- x, cells moved by more than 15 points (scene set, method: as reported -> switched back, "
+                      "thesis): fig_4_12 warehouse_synthetic icp_plane (noise 0 mm): 2/2 -> 0/2 (100% -> 0%, "
+                      "p = 0.33), thesis -.", run.lines)
+        self.assertFalse(any(c["experiment"] == "ablation_x_fig_4_12" for c in run.cells))
 
     def test_no_ablations_file(self):
         run = Run(ablations="/nonexistent/ablations.yaml")
@@ -363,7 +393,8 @@ class Scorecard(unittest.TestCase):
         self.assertIsNone(run.cells)
         card = json.loads("\n".join(run.files["card.json"]))
         self.assertEqual([(t["table"], t["cells"], t["within_15"], t["significant_05"], t["best_agrees"],
-                           t["tau_positive"]) for t in card["tables"]], [("4.1", 2, 1, 0, 1, 1), ("4.5", 2, 0, 0, 1, 1)])
+                           t["tau_positive"]) for t in card["tables"]],
+                         [("4.1", 2, 1, 0, 1, 1), ("4.5", 2, 0, 0, 1, 1)])
         self.assertEqual((card["total"]["of"], card["total"]["cells"], card["total"]["within_15"]), (107, 4, 1))
         self.assertEqual([(v["experiment"], v["measure"]) for v in card["variants"]],
                          [("table_4_5", "robustness_faces")])
