@@ -1,7 +1,11 @@
 #!/usr/bin/env python3
-"""Writes results/thesis/README.md from the raw results of scripts/thesis.sh.
+"""Writes results/thesis/README.md and cells.csv from the raw results of scripts/thesis.sh.
 
-    scripts/thesis_report.py OUT EXPERIMENT...
+    scripts/thesis_report.py OUT EXPERIMENT... [--ablations FILE] [--scorecard-json FILE]
+
+--scorecard-json FILE: write only the agreement scorecard and the verdicts as
+JSON to FILE ("-": stdout), no README. --ablations FILE: the ablation pairs
+(default configs/thesis/ablations.yaml; a missing file means none).
 
 OUT is results/thesis: each experiment's folder OUT/raw/NAME holds what
 `posebench run` and `posebench report` wrote (experiment.json, records.jsonl,
@@ -10,13 +14,21 @@ Every record is checked against the trial record's schema (`posebench schema
 record` of the binary in POSEBENCH, default build/posebench, or the copy
 RECORD_SCHEMA below when there is no binary): an unknown key or a missing
 required key is an error naming the file, the line and the key (exit code 2).
-The README's numbers all come from those files: tables from report.csv /
-report.md, wall times and loads from runs.jsonl (one line per `posebench run`
-that ran trials; folders of older runs: their run_seconds.txt), the milk
-carton's "faces on faces" row from each record's judgements.faces. Without
-any experiment's records the README is left as it is. Environment: JOBS
-(worker processes, for the text).
+The README's numbers all come from those files: each robustness cell of a
+table experiment counted from its records (k of n correct, the 95% Wilson
+interval, Fisher's exact test against the thesis's k of n; the thesis's
+value from report.csv), the other rows from report.md, wall times and loads
+from runs.jsonl (one line per `posebench run` that ran trials; folders of
+older runs: their run_seconds.txt), the milk carton's "faces on faces" row
+from each record's judgements.faces. OUT/cells.csv has every cell (CSV_COLUMNS).
+The agreement scorecard, the verdicts on the thesis's conclusions (rules in
+scripts/thesis_verdicts.py) and the ablation section (pairs of experiments
+from the ablations file) are computed from the same cells. A missing thesis
+value or a malformed file is an error naming file and field (exit code 2).
+Without any experiment's records the README is left as it is. Environment:
+JOBS (worker processes, for the text).
 """
+import collections
 import csv
 import datetime
 import difflib
@@ -24,6 +36,10 @@ import json
 import os
 import subprocess
 import sys
+
+import thesis_ablations
+from thesis_stats import count_of, fisher_exact, fitting_n, kendall_tau, printable_as_count, wilson, within_points
+from thesis_verdicts import Curve, Data, evaluate
 
 # ---- the trial record's schema ------------------------------------------------
 # A copy of `posebench schema record` ("fields"; src/eval/record.cpp), used
@@ -266,11 +282,16 @@ def load_experiment(raw, name, schema):
 
 
 class Results:
-    """The loaded experiments (in the order given) and where plots go."""
+    """The loaded experiments (in the order given, then those only an
+    ablation names: `ablation_only`), `partner`: ablated experiment -> the
+    experiment it is paired with, and where plots go. An experiment named on
+    the command line stays what it is (a main table, a variant, a figure)
+    even when an ablation also pairs it."""
 
-    def __init__(self, experiments, raw="", plots=""):
+    def __init__(self, experiments, raw="", plots="", ablation_only=(), partner=None):
         self.x = {e.name: e for e in experiments}
         self.raw, self.plots = raw, plots
+        self.ablation_only, self.partner = set(ablation_only), dict(partner or {})
 
     def __contains__(self, e):
         return e in self.x
@@ -286,11 +307,6 @@ class Results:
             if r["scenario"] == scene and r["measure"] == measure and r["method"] == method and r["condition"] == cond:
                 return r
         return None
-
-    def val(self, e, scene, measure, method, cond=""):
-        """A cell's value (None when absent or empty)."""
-        r = self.cell(e, scene, measure, method, cond)
-        return float(r["value"]) if r and r["value"] != "" else None
 
     def thesis(self, e, scene, measure, method):
         """The thesis's value beside a cell (None when it printed none)."""
@@ -314,10 +330,21 @@ class Results:
         return (sum(x.runs.seconds for x in self.x.values()), sum(len(x.records) for x in self.x.values()))
 
 
-def load_results(out_dir, experiments, schema):
+def load_results(out_dir, experiments, schema, ablations=()):
+    """The experiments named, then those of the ablations' pairs not among
+    them (each folder without records is left out)."""
     raw = os.path.join(out_dir, "raw")
     loaded = [load_experiment(raw, e, schema) for e in experiments]
-    return Results([x for x in loaded if x is not None], raw, os.path.join(out_dir, "plots"))
+    partner, extra = {}, []
+    for a in ablations:
+        for e, e2 in a["pairs"]:
+            partner.setdefault(e2, e)
+            for name in (e, e2):
+                if name not in experiments and name not in extra:
+                    extra.append(name)
+    more = [load_experiment(raw, e, schema) for e in extra]
+    return Results([x for x in loaded + more if x is not None], raw, os.path.join(out_dir, "plots"),
+                   [x.name for x in more if x is not None], partner)
 
 
 # ---- formatting -------------------------------------------------------------------
@@ -345,8 +372,6 @@ TITLES = {
     "table_4_1": "Table 4.1: LS5, several model views (12 synthetic, 8 real-sensor)",
     "table_4_3": "Table 4.3: LS5, one model view (from the side)",
     "table_4_4": "Table 4.4: LS5, one view, CRH skipped",
-    "table_4_3_view45": "Table 4.3, variant: LS5, one model view from 45 degrees above (table scenes)",
-    "table_4_4_view45": "Table 4.4, variant: LS5, one view from 45 degrees above, CRH skipped",
     "table_4_5": "Table 4.5: milk carton",
     "table_4_7": "Table 4.7: Statue of Liberty (armadillo stand-in)",
     "table_4_9": "Table 4.9: registration alone, statue, warehouse",
@@ -357,7 +382,7 @@ TITLES = {
     "fig_4_11_local": "Figure 4.11 (local part): statue robustness vs added noise, SHOT FPFH, 12 views",
     "fig_4_12": "Figure 4.12: registration robustness vs added noise",
 }
-TABLES = ["table_4_1", "table_4_3", "table_4_4", "table_4_3_view45", "table_4_4_view45", "table_4_5", "table_4_7",
+TABLES = ["table_4_1", "table_4_3", "table_4_4", "table_4_5", "table_4_7",
           "table_4_9"]
 
 
@@ -400,7 +425,9 @@ def section_reproduce():
         "```sh\ncmake -S . -B build -DCMAKE_BUILD_TYPE=Release && cmake --build build --target posebench\n"
         "scripts/thesis.sh            # all experiments; resumable (re-running does only what is missing)\n"
         "scripts/thesis.sh --only table_4_1 --jobs 2    # one experiment\n"
-        "scripts/thesis.sh --readme-only                # rewrite this file from the raw records\n```\n",
+        "scripts/thesis.sh --readme-only                # rewrite this file from the raw records\n"
+        "scripts/thesis_report.py results/thesis EXPERIMENT... --scorecard-json FILE  # the scorecard and verdicts "
+        "as JSON\n```\n",
         "Each experiment is `posebench run configs/thesis/NAME.yaml --out results/thesis/raw/NAME --jobs 2 --cache "
         "cache --scenes scenes` followed by `posebench report results/thesis/raw/NAME --format md,csv --plots`. The "
         "scene sets are generated on the first run into `scenes/` from `configs/scenes/*.yaml` (deterministic: same "
@@ -417,8 +444,22 @@ DIFFERENCES = [
     "warehouse distractors are 1500 mm too); the milk carton is the procedural gable-top `milk_carton`.",
     "Real sensors: the thesis's Fotonic Astra and Kinect One recordings had no ground truth (judged by eye); here "
     "they are simulated sensors (`astra`, `kinect_one`) rendering generated table scenes with ground truth.",
-    "Images: %s per scenario for the tables (the thesis: 30 synthetic, 60 + 20 occluded per real sensor); "
-    "see the table below for the figures.",
+    "Images: %s per scene set in the tables (the thesis's sizes: 30 per synthetic set, 60 per real sensor and 20 "
+    "occluded); the figures' points: see the table below (the thesis: 30 per noise level).",
+    "Scene set-up, as read from the thesis. Its text gives no camera height or elevation, and its figures of the "
+    "scenes (4.3-4.5) are not in the text we have. The table scenes here are seen from 0.6-1.5 m at 30-70 degrees "
+    "above the table (`configs/scenes/table_*.yaml`, `thesis_*`), the warehouse from 2-5 m at 5-30 degrees. The "
+    "thesis chose its model views by hand (\"the viewpoints of these are manually chosen\") and rendered its "
+    "single view \"from the side, so no top nor bottom were captured\"; its one-view results (Table 4.3: CVFH "
+    "70-80% on the real scenes) only fit scenes seen from near that view. So the training views are rendered at "
+    "the middle of each scene set's elevation range (`views.follow_scene`: 50 degrees on the tables, 17.5 in the "
+    "warehouse): the ring of 8 and the single view at that elevation, the 4 extra views of the 12-view layout from "
+    "below (-45 degrees), as the thesis. The views ablation runs Tables 4.1, 4.3 and 4.4 with the earlier layout "
+    "(ring at 20 degrees, single view at 0).",
+    "Warehouse: one plane, the floor (`warehouse.wall: false` in the thesis configs), as the thesis's \"a plane "
+    "was added behind the objects to simulate a floor or a wall\"; preprocessing removes one plane "
+    "(`preprocess.max_planes: 1`), as the thesis. The planes ablation runs the warehouse rows with a floor and a "
+    "wall, the set-up before issue 10.",
     "Lengths the thesis does not give follow the default profile, relative to the object's diameter (issue 9; "
     "`settings_resolved` in every record has them in mm): normal radius 0.1 d, RANSAC plane threshold 0.05 d, "
     "FPFH/SHOT radius 0.3 d, LRF radius 0.2 d, cluster distance 0.1 d, CVFH region distance 0.075 d and normal "
@@ -447,25 +488,47 @@ def section_differences(res):
     return ["## How this run differs from the thesis\n"] + ["- " + line for line in lines] + [""]
 
 
+def trials_per_cell(res, e):
+    """Our trials per cell (per point for the figures) of an experiment, from its records: `10` or `5-10`."""
+    ns = [len(recs) for recs in group_records(res, res[e]).values()]
+    return "-" if not ns else ("%d" % ns[0] if min(ns) == max(ns) else "%d-%d" % (min(ns), max(ns)))
+
+
 def experiment_row(res, e):
     """A row of the experiments table: sizes, statuses, time and loads from runs.jsonl."""
     x = res[e]
     st = {}
     for r in x.records:
         st[r["status"]] = st.get(r["status"], 0) + 1
-    return "| %s | `configs/thesis/%s.yaml` | %s | %d | %s | %s | %s |" % (
-        short_title(e), e, res.images_of(e), len(x.records), ", ".join("%s %d" % kv for kv in sorted(st.items())),
+    return "| %s | `configs/thesis/%s.yaml` | %s | %s | %d | %s | %s | %s |" % (
+        short_title(e), e, res.images_of(e), trials_per_cell(res, e), len(x.records),
+        ", ".join("%s %d" % kv for kv in sorted(st.items())),
         fmt_dur(x.runs.seconds) if x.runs.seconds else "-", "/".join("%.1f" % l for l in x.runs.loads) or "-")
+
+
+def resolution_text(res):
+    """What n trials per cell can tell apart, for each n of the table experiments."""
+    ns = sorted({len(recs) for e, x in res.x.items() if table_of(x) for recs in group_records(res, x).values()})
+    out = []
+    for n in ns:
+        lo, hi = wilson(n // 2, n)
+        first = next((k for k in range(n + 1) if fisher_exact(0, n, k, n) < 0.05), None)
+        out.append("at n = %d the 95%% Wilson interval of %d/%d is %.0f-%.0f%%%s" % (
+            n, n // 2, n, 100 * lo, 100 * hi,
+            ", and 0 of %d against k of %d first differ at p < 0.05 (Fisher) for k = %d" % (n, n, first)
+            if first is not None else ""))
+    return "; ".join(out)
 
 
 def section_experiments(res):
     total, ntrials = res.totals()
     o = ["## Experiments, sizes and times\n",
-         "| experiment | config | images per scenario | trials | status | wall time | load |",
-         "|---|---|---|---|---|---|---|"]
+         "| experiment | config | images per scenario | trials per cell | trials | status | wall time | load |",
+         "|---|---|---|---|---|---|---|---|"]
     o += [experiment_row(res, e) for e in res.x]
-    o.append("| **total** | | | %d | | **%s** | |\n" % (ntrials, fmt_dur(total)))
-    o.append("Wall time: the sum over the `posebench run` invocations that ran trials (an interrupted and resumed run "
+    o.append("| **total** | | | | %d | | **%s** | |\n" % (ntrials, fmt_dur(total)))
+    o.append("Trials per cell: records per scene set and method (per point of a figure), counted from the records. "
+             "Wall time: the sum over the `posebench run` invocations that ran trials (an interrupted and resumed run "
              "counts all its parts; scene generation included). Load: the machine's 15-minute load average at the "
              "end of each invocation (2 cores; other work was running), so per-image times of different experiments "
              "were measured under different competition for the CPU.\n")
@@ -473,10 +536,8 @@ def section_experiments(res):
     if unknown:
         o.append("No `runs.jsonl` (nor the `run_seconds.txt` of older runs), so no wall time or load: %s.\n" %
                  ", ".join(unknown))
-    o.append("The thesis used 30 synthetic images per scenario and 60 (+20 occluded) per real sensor. To fit the "
-             "budget of this 2-core machine the tables use %s images per scenario and the noise figures fewer per "
-             "noise level (column above): a robustness of 10%% is one image in 10, so differences of one or two "
-             "images are within noise.\n" % res.table_images())
+    o.append("The thesis's images per cell: %s. Ours: the column above. What a cell's count can show: %s.\n" % (
+        THESIS_N_TEXT, resolution_text(res) or "no table experiment"))
     return o
 
 
@@ -506,12 +567,32 @@ def settings_block(res, e):
     return ["Settings (`configs/thesis/%s.yaml`):\n" % e, "\n".join(settings_lines(res, e)) + "\n"]
 
 
-def table_md(res, e):
-    """report.md without its title, its table headings one level down."""
+ROBUSTNESS_ROWS = {"robustness": "robustness", "robustness, judged by faces": "robustness_faces"}
+
+
+def table_md(res, e, cells=()):
+    """report.md without its title, its table headings one level down, each
+    robustness cell rewritten from `cells` (count, interval, the thesis's value, mark)."""
+    lookup = {(c.scenario, c.measure, c.method): c for c in cells if c.experiment == e and c.counted}
+    out, methods, scene = [], [], ""
     md = res[e].md.splitlines()
     if md and md[0].startswith("# "):
         md = md[1:]
-    return "\n".join(l.replace("### ", "#### ", 1) if l.startswith("### ") else l for l in md).strip() + "\n"
+    for line in md:
+        parts = line.split("|")
+        if line.startswith("| scenario | measure |"):
+            methods, scene = [p.strip() for p in parts[3:-1]], ""
+        elif line.startswith("|") and methods and len(parts) == len(methods) + 4 and not line.startswith("|---"):
+            scene = parts[1].strip() or scene
+            measure = ROBUSTNESS_ROWS.get(parts[2].strip())
+            if measure:
+                new = [lookup.get((scene, measure, m)) for m in methods]
+                line = "|".join(parts[:3] + [" %s " % fmt_rob(c) if c else p for c, p in zip(new, parts[3:-1])] +
+                                [parts[-1]])
+        elif not line.startswith("|"):
+            methods = []
+        out.append(line.replace("### ", "#### ", 1) if line.startswith("### ") else line)
+    return "\n".join(out).strip() + "\n"
 
 
 def carton_counts(records):
@@ -570,19 +651,9 @@ def registration_times(res, e):
             " (the thesis: 0.02 to 0.09 s).\n"]
 
 
-VIEW45_NOTE = (
-    "A variant, not in the thesis. The thesis's single model view was \"rendered from the side, so no top nor "
-    "bottom were captured\", which suited its real scenes; the generated table scenes are seen from 30-70 "
-    "degrees above (`configs/scenes/table_*.yaml`), so a side view shows the LS5 differently from the scenes "
-    "(no top). Here the one view is rendered from 45 degrees above (`views.side_elevation_deg: 45`) in the "
-    "table scenes; everything else as in the main table.\n")
-
-
-def table_section(res, e):
+def table_section(res, e, cells):
     o = ["### %s\n" % TITLES[e]]
-    if e.endswith("_view45"):
-        o.append(VIEW45_NOTE)
-    o += settings_block(res, e) + [table_md(res, e)]
+    o += settings_block(res, e) + [table_md(res, e, cells)]
     if e == "table_4_5":
         o += carton_section(res, e)
     if e == "table_4_9":
@@ -590,17 +661,17 @@ def table_section(res, e):
     return o + [""]
 
 
-def section_tables(res):
+def section_tables(res, cells):
     o = ["## Tables\n",
          "Rows: scene set x measure; columns: descriptor (refinement for Table 4.9). Robustness = fraction of images "
          "where the chosen pose is correct (translation error < 50 mm on tables, < 100 mm in the warehouse, and "
          "1 - |p.q| < 0.05, symmetry-aware); errors are means over the correct trials; time is the mean online time "
          "per image (s). BOP AR is the BOP average recall (VSD, MSSD, MSPD) of the same poses. Scene sets named "
          "`table_astra` / `table_kinect_one` use the simulated Astra / Kinect One sensors (the thesis's real "
-         "sensors).\n"]
+         "sensors).\n", legend(cells)]
     for e in TABLES:
         if e in res:
-            o += table_section(res, e)
+            o += table_section(res, e, cells)
     return o
 
 
@@ -685,249 +756,557 @@ def section_figures(res):
     return o
 
 
-# ---- the thesis's conclusions ---------------------------------------------------------
-# Each returns its paragraph (a list of at most one block; empty when the
-# experiments it needs were not run).
+# ---- cells: counts per table cell, against the thesis -------------------------------
 
-GLOBAL, LOCAL = ["cvfh", "cesf"], ["shot", "fpfh"]
-
-
-def verdict(checks):
-    return "supported" if all(checks) else ("partly supported" if any(checks) else "not supported")
-
-
-def best(res, e, s, methods, measure="robustness"):
-    v = [res.val(e, s, measure, m) for m in methods]
-    v = [a for a in v if a is not None]
-    return max(v) if v else None
+MAIN_TABLES = collections.OrderedDict([("table_4_1", "4.1"), ("table_4_3", "4.3"), ("table_4_4", "4.4"),
+                                       ("table_4_5", "4.5"), ("table_4_7", "4.7"), ("table_4_9", "4.9")])
+MAIN_CELLS = 107  # robustness values of the thesis's Tables 4.1, 4.3, 4.4, 4.5, 4.7 and 4.9
+POINTS = 15       # "within 15 points" of the thesis
+FACES = "robustness_faces"
+CSV_COLUMNS = ["table", "experiment", "kind", "scenario", "measure", "method", "ours_k", "n", "ours", "wilson_lo",
+               "wilson_hi", "thesis", "thesis_n", "thesis_k", "thesis_exact", "p_value", "within_15",
+               "significant_05", "significant_01"]
+THESIS_N_TEXT = ("30 per synthetic scene set (warehouse_synthetic, table_synthetic), 60 per simulated-sensor scene set "
+                 "(table_astra, table_kinect_one; the thesis's real sensors), 20 per occluded one (table_*_occluded), "
+                 "19 in Table 4.9 (its 95/84/100% imply n = 19)")
 
 
-def time_pairs(res):
-    """(rows of Tables 4.1 and 4.3, [(global, local) mean times per row])."""
-    rows = [(e, s) for e in ("table_4_1", "table_4_3") for s in res.scenes_of(e)]
-    pairs = [(mean([res.val(e, s, "time", m) for m in GLOBAL]), mean([res.val(e, s, "time", m) for m in LOCAL]))
-             for e, s in rows]
-    return rows, [p for p in pairs if None not in p]
+def thesis_images(table, scenario):
+    """The thesis's images per cell (THESIS.md), None when it says none for this scene set."""
+    if table == "4.9":
+        return 19
+    if scenario.endswith("_occluded"):
+        return 20
+    if scenario in ("table_astra", "table_kinect_one"):
+        return 60
+    if scenario in ("warehouse_synthetic", "table_synthetic"):
+        return 30
+    return None
 
 
-def conclusion_1(res):
-    """Global fast and robust for smooth objects; local better for large objects in clutter and occlusion."""
-    real_rows = [(e, s) for e in ("table_4_1", "table_4_3") for s in res.scenes_of(e)
-                 if s.startswith("table_") and s != "table_synthetic"]
-    wh_rows = [(e, s) for e in ("table_4_1", "table_4_3", "table_4_7") for s in res.scenes_of(e)
-               if s.startswith("warehouse")]
-    g_real, l_real = (mean([best(res, e, s, ms) for e, s in real_rows]) for ms in (GLOBAL, LOCAL))
-    g_wh, l_wh = (mean([best(res, e, s, ms) for e, s in wh_rows]) for ms in (GLOBAL, LOCAL))
-    trows, tpairs = time_pairs(res)
-    tg, tl = mean([a for a, b in tpairs]), mean([b for a, b in tpairs])
-    tfaster = sum(1 for a, b in tpairs if a < b)
-    tg_tab, tl_tab = (mean([mean([res.val(e, s, "time", m) for m in ms]) for e, s in trows if s.startswith("table")])
-                      for ms in (GLOBAL, LOCAL))
-    if None in (g_real, l_real, g_wh, l_wh, tg, tl):
-        return []
-    a, b, c = tfaster > len(tpairs) / 2, g_real >= l_real, l_wh > g_wh
-    return [
-        "1. **Global descriptors are fast and robust for objects with a smooth visible surface; local descriptors "
-        "win for larger objects in clutter and occlusion: %s.** Time: CVFH/CESF took less time per image than "
-        "SHOT/FPFH in %d of the %d rows of Tables 4.1 and 4.3 (mean over the table rows: %.2f s vs %.2f s). "
-        "Robustness on the LS5 (smooth) in the %d real-sensor table rows of Tables 4.1 and 4.3: the better global "
-        "descriptor per row averages %s, the better local one %s (global %s). In the %d warehouse rows of Tables "
-        "4.1, 4.3 and 4.7 (large objects, clutter, occlusion) the better local descriptor averages %s and the better "
-        "global one %s (local %s). (Rule: supported when all three comparisons go the thesis's way: global faster "
-        "in most rows, at least as robust on the real-sensor LS5 rows, local more robust in the warehouse.)\n" % (
-            verdict((a, b, c)), tfaster, len(tpairs), tg_tab, tl_tab, len(real_rows), pct(g_real), pct(l_real),
-            "at least as robust" if b else "less robust", len(wh_rows), pct(l_wh), pct(g_wh),
-            "wins" if c else "does not win")]
+class Cell:
+    """One cell of a table experiment: a robustness (ours k of n against the
+    thesis's value, its k of its n) or a time (mean seconds; no counts)."""
+
+    def __init__(self, table, experiment, kind, scenario, measure, method, k=None, n=None, ours=None, thesis=None,
+                 thesis_n=None):
+        self.table, self.experiment, self.kind = table, experiment, kind
+        self.scenario, self.measure, self.method = scenario, measure, method
+        self.k, self.n, self.thesis, self.thesis_n = k, n, thesis, thesis_n
+        self.ours = k / n if k is not None and n else ours
+        counted = k is not None and n
+        self.lo, self.hi = wilson(k, n) if counted else (None, None)
+        self.thesis_k = count_of(thesis, thesis_n) if counted and thesis is not None and thesis_n else None
+        self.exact = printable_as_count(thesis, thesis_n) if self.thesis_k is not None else None
+        self.p = fisher_exact(k, n, self.thesis_k, thesis_n) if self.thesis_k is not None else None
+        self.within = (within_points(self.ours, thesis, POINTS) if counted and thesis is not None else None)
+
+    @property
+    def counted(self):
+        return self.k is not None
+
+    @property
+    def main(self):
+        """One of the thesis's 107 robustness cells."""
+        return self.kind == "main" and self.measure == "robustness"
+
+    def mark(self):
+        return "" if self.p is None else (" **" if self.p < 0.01 else (" *" if self.p < 0.05 else ""))
+
+    def csv_row(self):
+        def f(v, fmt="%.6g"):
+            return "" if v is None else (str(v).lower() if isinstance(v, bool) else fmt % v)
+        return [self.table, self.experiment, self.kind, self.scenario, self.measure, self.method, f(self.k, "%d"),
+                f(self.n, "%d"), f(self.ours), f(self.lo, "%.4f"), f(self.hi, "%.4f"), f(self.thesis),
+                f(self.thesis_n, "%d"), f(self.thesis_k, "%d"), f(self.exact), f(self.p, "%.4g"), f(self.within),
+                f(None if self.p is None else self.p < 0.05), f(None if self.p is None else self.p < 0.01)]
 
 
-def conclusion_2(res):
-    """CESF the most robust global descriptor; ESF poor with few views."""
-    rows = [(e, s) for e in ("table_4_1", "table_4_3", "table_4_4", "table_4_5", "table_4_7") for s in res.scenes_of(e)]
-    cmp_ = [tuple(res.val(e, s, "robustness", m) for m in ("cesf", "cvfh", "esf")) for e, s in rows]
-    cmp_ = [c for c in cmp_ if None not in c]
-    if not cmp_:
-        return []
-    wins = sum(1 for c, v, f in cmp_ if c > max(v, f))
-    ties = sum(1 for c, v, f in cmp_ if c == max(v, f))
-    mc, mv, mf = (mean([c[i] for c in cmp_]) for i in range(3))
-    esf1 = mean([res.val("table_4_3", s, "robustness", "esf") for s in res.scenes_of("table_4_3")])
-    esfn = mean([res.val("table_4_1", s, "robustness", "esf") for s in res.scenes_of("table_4_1")])
-    ok1, ok2 = mc > max(mv, mf), esf1 is not None and esf1 <= 0.2
-    return [
-        "2. **CESF is more robust than the other global descriptors; ESF is poor with few model views: %s.** Over "
-        "the %d rows of Tables 4.1, 4.3, 4.4, 4.5 and 4.7, CESF is strictly the most robust global descriptor in %d, "
-        "tied best in %d, and behind in %d; mean robustness CESF %s, CVFH %s, ESF %s. ESF averages %s with one "
-        "model view (Table 4.3) and %s with 8-12 views (Table 4.1) (the thesis: 0-15%%). (Rule: CESF's mean above "
-        "both others, and ESF at most 20%% with one view.)\n" % (
-            verdict((ok1, ok2)), len(cmp_), wins, ties, len(cmp_) - wins - ties, pct(mc), pct(mv), pct(mf),
-            pct(esf1), pct(esfn))]
+def method_column(exp):
+    """The record key a table's columns are: refinement (registration tables) or descriptor."""
+    return "refinement" if exp.get("report", {}).get("columns") == "refinement" else "descriptor"
 
 
-def crh_pairs(res, e_skip, e_crh):
-    """(scene, method, robustness without CRH, with CRH) of the global descriptors."""
-    out = []
-    for s in res.scenes_of(e_skip):
-        for m in GLOBAL:
-            a, b = res.val(e_skip, s, "robustness", m), res.val(e_crh, s, "robustness", m)
-            if a is not None and b is not None:
-                out.append((s, m, a, b))
+def condition_of(r):
+    """A record's condition: its added noise and swept parameters."""
+    return (float(r["added_noise_mm"]), json.dumps(r["params"], sort_keys=True))
+
+
+def condition_label(cond):
+    noise, params = cond
+    p = json.loads(params)
+    return ", ".join(["noise %g mm" % noise] + ["%s %s" % (k, json.dumps(v)) for k, v in sorted(p.items())])
+
+
+def experiment_json(res, x):
+    if not x.exp:
+        raise InputError("%s: missing or empty" % os.path.join(res.raw, x.name, "experiment.json"))
+    for key in ("scenes", "descriptors", "refinements"):
+        if key not in x.exp:
+            raise InputError("%s: no '%s'" % (os.path.join(res.raw, x.name, "experiment.json"), key))
+    return x.exp
+
+
+def group_records(res, x):
+    """{(scene, method, condition label): records} of an experiment, in its
+    config's order (scenes, then methods, then conditions); the label is ""
+    when all records share one condition."""
+    exp = experiment_json(res, x)
+    col = method_column(exp)
+    conds = sorted({condition_of(r) for r in x.records})
+    single = len(conds) <= 1
+    order = {s["name"]: i for i, s in enumerate(exp["scenes"])}
+    meths = {m: i for i, m in enumerate(exp["refinements"] if col == "refinement" else exp["descriptors"])}
+    groups = {}
+    for r in x.records:
+        c = condition_of(r)
+        groups.setdefault((r["scene"], r[col], "" if single else condition_label(c)), (c, []))[1].append(r)
+    keys = sorted(groups, key=lambda k: (order.get(k[0], len(order)), k[0], meths.get(k[1], len(meths)), k[1],
+                                         groups[k][0]))
+    return collections.OrderedDict((k, groups[k][1]) for k in keys)
+
+
+def n_correct(records, faces=False):
+    if faces:
+        return sum(1 for r in records if r.get("judgements", {}).get("faces", {}).get("correct"))
+    return sum(1 for r in records if r.get("correct"))
+
+
+def thesis_values(res, x):
+    """{(scenario, measure, method): thesis value or None} of report.csv's unconditioned rows."""
+    path = os.path.join(res.raw, x.name, "report.csv")
+    if not x.rows:
+        raise InputError("%s: missing or empty; the thesis's values beside the cells come from it (run `posebench "
+                         "report %s --format md,csv`)" % (path, os.path.join(res.raw, x.name)))
+    out = {}
+    for i, r in enumerate(x.rows, 2):
+        missing = [c for c in ("condition", "scenario", "measure", "method", "thesis") if r.get(c) is None]
+        if missing:
+            raise InputError("%s: line %d: no column '%s'" % (path, i, missing[0]))
+        if r["condition"] != "":
+            continue
+        try:
+            out[(r["scenario"], r["measure"], r["method"])] = float(r["thesis"]) if r["thesis"] != "" else None
+        except ValueError:
+            raise InputError("%s: line %d: field 'thesis' is not a number: %r" % (path, i, r["thesis"])) from None
     return out
 
 
-def conclusion_3(res):
-    """CRH is the weak link: Table 4.4 (CRH skipped) vs 4.3 (with CRH), same rows."""
-    item3 = []
-    for e_skip, e_crh, what in (("table_4_4", "table_4_3", "side view (0 degrees, as the thesis)"),
-                                ("table_4_4_view45", "table_4_3_view45", "view from 45 degrees above (variant)")):
-        gl = crh_pairs(res, e_skip, e_crh)
-        if gl:
-            up = sum(1 for p in gl if p[2] > p[3])
-            down = sum(1 for p in gl if p[2] < p[3])
-            item3.append((what, gl, up, down, mean([p[3] for p in gl]), mean([p[2] for p in gl])))
-    if not item3:
-        return []
-    txt = ["with one %s, skipping the CRH changes CVFH/CESF robustness from %s to %s on average over %d cells "
-           "(higher in %d, lower in %d; per cell, with CRH -> without: %s)" % (
-               what, pct(mw), pct(ms), len(gl), up, down,
-               "; ".join("%s %s %s -> %s" % (s, m, pct(b), pct(a)) for s, m, a, b in gl))
-           for what, gl, up, down, mw, ms in item3]
-    v = verdict([ms > mw and up > down for what, gl, up, down, mw, ms in item3])
-    return ["3. **CRH is the weak link of the global pipeline (Table 4.4 vs 4.3): %s.** On the same real-sensor rows, "
-            "%s. (Rule: supported when the mean rises and more cells rise than fall, for every view setting run.)\n" % (
-                v, "; ".join(txt))]
+def table_of(x):
+    return (x.exp or {}).get("report", {}).get("reference_table")
 
 
-def noise_robustness(res, fig):
-    """Mean robustness over the noise levels per method (the label's first word) of a figure."""
-    return {s["label"].split(" ")[0]: mean(s["robustness"]) for pl in res[fig].plots for s in pl["series"]} \
-        if fig in res else {}
+def table_cells(res, x, kind, ref):
+    """The cells of a table experiment: robustness (and for the milk carton,
+    judged faces on faces when every record is), then time; the thesis's
+    values from `ref`'s report.csv (the experiment itself, or the one an
+    ablation is paired with)."""
+    table = table_of(x) or table_of(ref)
+    groups = group_records(res, x)
+    if any(c for _s, _m, c in groups):
+        raise InputError("%s: records of several conditions (added_noise_mm, params); a table experiment has one" %
+                         os.path.join(res.raw, x.name, "records.jsonl"))
+    tv = thesis_values(res, ref)
+    path = os.path.join(res.raw, ref.name, "report.csv")
+    faces = table == "4.5" and carton_counts(x.records)[1]
+    rob, face, times = [], [], []
+    for (s, m, _c), recs in groups.items():
+        th = tv.get((s, "robustness", m))
+        if th is None:
+            raise InputError("%s: no thesis value (field 'thesis') for scenario %s, measure robustness, method %s" %
+                             (path, s, m))
+        tn = thesis_images(table, s)
+        if tn is None:
+            raise InputError("%s: scenario %s: the thesis's number of images is not known for this scene set "
+                             "(thesis_images in scripts/thesis_report.py)" % (
+                                 os.path.join(res.raw, x.name, "records.jsonl"), s))
+        rob.append(Cell(table, x.name, kind, s, "robustness", m, n_correct(recs), len(recs), thesis=th, thesis_n=tn))
+        if faces:
+            face.append(Cell(table, x.name, kind, s, FACES, m, n_correct(recs, True), len(recs), thesis=th,
+                             thesis_n=tn))
+        t = mean([r["times"]["total"] for r in recs if "times" in r])
+        times.append(Cell(table, x.name, kind, s, "time", m, ours=t, thesis=tv.get((s, "time", m))))
+    return rob + face + times
 
 
-def conclusion_4(res):
-    """ICP most accurate, ICP point-to-plane most robust."""
-    if "table_4_9" not in res:
-        return []
-    meth = res["table_4_9"].exp["refinements"]
-    s0 = res.scenes_of("table_4_9")[0]
-    rob, te, re = ({m: res.val("table_4_9", s0, measure, m) for m in meth}
-                   for measure in ("robustness", "translation_mm", "rotation_1mpq"))
-    noise_rob = noise_robustness(res, "fig_4_12")
-    acc = [m for m in meth if te[m] is not None]
-    most_acc_t = min(acc, key=lambda m: te[m]) if acc else None
-    most_acc_r = min(acc, key=lambda m: re[m]) if acc else None
-    top = max(rob.values()) if rob else None
-    most_rob = [m for m in meth if rob[m] == top]
-    nr_top = max(noise_rob.values()) if noise_rob else None
-    most_rob_noise = [m for m in noise_rob if noise_rob[m] == nr_top]
-    ok1 = most_acc_t == "icp"
-    ok2 = "icp_plane" in most_rob and ("icp_plane" in most_rob_noise if noise_rob else True)
-    noise_txt = (" Averaged over the noise levels of Figure 4.12: " + ", ".join(
-        "%s %s" % (m, pct(v)) for m, v in noise_rob.items()) + " (most robust: %s)." % ", ".join(
-        most_rob_noise)) if noise_rob else ""
-    return [
-        "4. **ICP is the most accurate registration, ICP point-to-plane the most robust: %s.** Table 4.9 (from "
-        "perturbed ground truth): robustness %s; mean translation error over correct trials %s; rotation error %s. "
-        "Most accurate in translation: %s, in rotation: %s; most robust: %s.%s (Rule: ICP lowest translation error "
-        "and ICP point-to-plane among the most robust, in Table 4.9 and averaged over Figure 4.12's noise levels.)\n"
-        % (verdict((ok1, ok2)), ", ".join("%s %s" % (m, pct(rob[m])) for m in meth),
-           ", ".join("%s %s" % (m, "-" if te[m] is None else "%.1f mm" % te[m]) for m in meth),
-           ", ".join("%s %s" % (m, "-" if re[m] is None else "%.2g" % re[m]) for m in meth),
-           most_acc_t, most_acc_r, ", ".join(most_rob), noise_txt)]
-
-
-def time_cells(res, figures):
-    """(mean time, experiment, scene set, method) of the recognition experiments' time cells."""
-    return [(float(r["value"]), e, r["scenario"], r["method"]) for e, x in res.x.items() for r in x.rows
-            if r["measure"] == "time" and r["value"] != "" and not x.exp.get("registration_only")
-            and e.startswith("fig_") == figures]
-
-
-def conclusion_5(res):
-    """Nothing at 30 fps."""
-    times, ftimes = time_cells(res, False), time_cells(res, True)
-    if not times:
-        return []
-    lo, hi = min(times), max(times)
-    v = "supported" if lo[0] > 1 / 30 and (not ftimes or min(ftimes)[0] > 1 / 30) else "not supported"
-    fig_txt = (" In the noise figures: %.2f s (%s, %s, %s) to %.2f s (%s, %s, %s; large added noise fills many more "
-               "voxels)." % (min(ftimes) + max(ftimes))) if ftimes else ""
-    return [
-        "5. **Nothing ran at 30 frames per second: %s.** Mean time per image in the recognition tables ranged from "
-        "%.2f s (%s, %s, %s) to %.2f s (%s, %s, %s), against 0.033 s for 30 fps; the thesis: 0.12 to 14 s on a "
-        "3 GHz two-core laptop.%s Our times are single-threaded per image, one worker per core (the load: see "
-        "above)."
-        "\n" % ((v,) + lo + hi + (fig_txt,))]
-
-
-NOISE_FIGS = ("fig_4_7_global", "fig_4_7_local", "fig_4_11_global", "fig_4_11_local", "fig_4_12")
-
-
-def noise_series(res):
-    """(experiment, series label, {noise: robustness}) of every noise curve."""
-    return [(f, s["label"], dict(zip(s["x"], s["robustness"]))) for f in NOISE_FIGS if f in res
-            for pl in res[f].plots for s in pl["series"]]
-
-
-def conclusion_6(res, series):
-    """Better with about 2 mm of added noise than with none (thesis section 5.1)."""
-    if not series:
-        return []
-    cmp2 = [(f, l, m[0.0], m[2.0]) for f, l, m in series if 0.0 in m and 2.0 in m and None not in (m[0.0], m[2.0])]
-    better = [c for c in cmp2 if c[3] > c[2]]
-    worse = [c for c in cmp2 if c[3] < c[2]]
-    v = "supported" if len(better) > len(cmp2) / 2 else ("partly supported" if better else "not supported")
-    return [
-        "6. **Better with about 2 mm of added noise than with none (thesis section 5.1): %s.** Of the %d curves of "
-        "Figures 4.7, 4.11 and 4.12, %d are higher at 2 mm than at 0 mm, %d lower, %d equal. Higher: %s. (Rule: "
-        "supported when more than half are higher.)\n" % (
-            v, len(cmp2), len(better), len(worse), len(cmp2) - len(better) - len(worse),
-            "; ".join("%s %s -> %s" % (l, pct(a), pct(b)) for f, l, a, b in better) or "none")]
-
-
-def conclusion_7(res, series):
-    """The global descriptors more robust against noise than the local ones (thesis section 5.1)."""
-    def level(fig, scen):
-        return mean([mean([v for v in m.values() if v is not None]) for f, l, m in series if f == fig and scen in l])
-
-    rows7 = []
-    for fig in ("fig_4_7", "fig_4_11"):
-        for scen in ("warehouse", "table"):
-            g, lo = level(fig + "_global", scen), level(fig + "_local", scen)
-            if g is not None and lo is not None:
-                rows7.append((fig, scen, g, lo))
-    if not rows7:
-        return []
-    return [
-        "7. **The global descriptors are more robust against noise than the local ones (thesis section 5.1, "
-        "Figure 4.7): %s.** Mean robustness over all noise levels, global (CVFH, CESF) vs local (SHOT, FPFH): %s. "
-        "(Rule: global higher in every figure and scenario.)\n" % (
-            verdict([g > lo for f, sc, g, lo in rows7]),
-            "; ".join("%s %s: %s vs %s" % (f.replace("fig_", "Figure ").replace("_", "."), sc, pct(a), pct(b))
-                      for f, sc, a, b in rows7))]
-
-
-def section_conclusions(res):
-    series = noise_series(res)
-    return (["## The thesis's conclusions against these numbers\n",
-             "Each verdict below is computed by `scripts/thesis.sh` from the tables above (the rule is stated with "
-             "it).\n"] + conclusion_1(res) + conclusion_2(res) + conclusion_3(res) + conclusion_4(res) +
-            conclusion_5(res) + conclusion_6(res, series) + conclusion_7(res, series))
-
-
-def section_agreement(res):
-    o = ["## Agreement with the thesis, per table\n",
-         "| table | cells with a thesis value | mean robustness, ours | mean robustness, thesis | mean abs. difference |",
-         "|---|---|---|---|---|"]
-    for e in TABLES:
-        if e not in res:
+def all_cells(res):
+    """Every table experiment's cells: main tables, variants, then ablations."""
+    cells = []
+    for e, x in res.x.items():
+        ablated = e in res.ablation_only
+        ref = res.x.get(res.partner.get(e)) if ablated else x
+        if ref is None or not (table_of(x) or table_of(ref)):
             continue
-        c = [(float(r["value"]), float(r["thesis"])) for r in res[e].rows
-             if r["measure"] == "robustness" and r["value"] != "" and r["thesis"] != "" and r["condition"] == ""]
-        if c:
-            o.append("| %s | %d | %s | %s | %.0f points |" % (
-                short_title(e), len(c), pct(mean([a for a, _ in c])), pct(mean([b for _, b in c])),
-                100 * mean([abs(a - b) for a, b in c])))
-    return o + [""]
+        kind = "ablation" if ablated else ("main" if e in MAIN_TABLES else "variant")
+        cells += table_cells(res, x, kind, ref)
+    order = {"main": 0, "variant": 1, "ablation": 2}
+    return sorted(cells, key=lambda c: order[c.kind])  # stable: experiments keep their order
+
+
+def write_cells_csv(path, cells):
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(CSV_COLUMNS)
+        for c in cells:
+            w.writerow(c.csv_row())
+
+
+def fmt_rob(c):
+    """`70% 7/10 [39-89] (35%) *`: ours, k/n, 95% Wilson interval, the thesis's value, Fisher's mark."""
+    return "%s %d/%d [%.0f-%.0f] (%s)%s" % (pct(c.ours), c.k, c.n, 100 * c.lo, 100 * c.hi, pct(c.thesis), c.mark())
+
+
+def legend(cells):
+    return ("Robustness cells read `70%% 7/10 [39-89] (35%%) *`: our fraction correct, the count k/n from the "
+            "records, its 95%% Wilson interval (%%), the thesis's value in parentheses, and a mark when Fisher's exact "
+            "test (two-sided) of our k/n against the thesis's k/n is significant: `*` p < 0.05, `**` p < 0.01. The "
+            "thesis's n per cell: %s; its k = round(value x n). %s\n" % (THESIS_N_TEXT, sample_sizes_text(cells)))
+
+
+def sample_sizes_text(cells):
+    """Our trials per cell, per experiment (from the records)."""
+    per = collections.OrderedDict()
+    for c in cells:
+        if c.counted and c.measure == "robustness":
+            per.setdefault(c.experiment, set()).add(c.n)
+    return "Our n per cell (trials, from the records): " + "; ".join(
+        "%s %s" % (e, "-".join(str(v) for v in sorted({min(ns), max(ns)}))) for e, ns in per.items()) + "."
+
+
+def inexact_text(cells):
+    """The thesis's values that are no k/n at the n assumed (a percentage
+    rounded to whole), and per row the largest n they all fit."""
+    bad = [c for c in cells if c.main and c.exact is False]
+    if not bad:
+        return "Every thesis value here is some k/n at the n assumed."
+    rows = collections.OrderedDict()
+    for c in bad:
+        rows.setdefault((c.table, c.experiment, c.scenario, c.thesis_n), []).append(c)
+    fits = []
+    for (t, e, s, n), row_bad in rows.items():
+        m = fitting_n([c.thesis for c in cells if c.main and (c.experiment, c.scenario) == (e, s)], n)
+        fits.append("Table %s %s (n %d): %s; %s" % (
+            t, s, n, ", ".join("%s %s" % (c.method, pct(c.thesis)) for c in row_bad),
+            "the row's values all fit n = %d" % m if m else "the row's values fit no n from %d to %d" % (n // 2, n)))
+    return ("%d of the thesis's %d values cannot be k/n at the n assumed (whole percent): %s. Those scene sets "
+            "probably had fewer usable images than the thesis states; k is round(value x n) all the same, so the "
+            "test is approximate there." % (len(bad), len([c for c in cells if c.main]), "; ".join(fits)))
+
+
+# ---- the scorecard -----------------------------------------------------------------------
+
+def rows_of(cells):
+    """Cells grouped by (experiment, scenario, measure), in order."""
+    rows = collections.OrderedDict()
+    for c in cells:
+        rows.setdefault((c.experiment, c.scenario, c.measure), []).append(c)
+    return list(rows.values())
+
+
+def best_set(values):
+    top = max(values)
+    return {i for i, v in enumerate(values) if v >= top - 1e-12}
+
+
+def best_agrees(row):
+    """Some method is most robust (ties included) both here and in the thesis."""
+    return bool(best_set([c.ours for c in row]) & best_set([c.thesis for c in row]))
+
+
+def tau_positive(row):
+    """Kendall's tau-b of our values against the thesis's above 0 (undefined: not)."""
+    t = kendall_tau([c.ours for c in row], [c.thesis for c in row])
+    return t is not None and t > 0
+
+
+def score(cells):
+    rows = [r for r in rows_of(cells) if len(r) > 1]
+    return collections.OrderedDict([
+        ("cells", len(cells)),
+        ("within_15", sum(1 for c in cells if c.within)),
+        ("significant_05", sum(1 for c in cells if c.p < 0.05)),
+        ("significant_01", sum(1 for c in cells if c.p < 0.01)),
+        ("rows", len(rows)),
+        ("best_agrees", sum(1 for r in rows if best_agrees(r))),
+        ("tau_positive", sum(1 for r in rows if tau_positive(r))),
+        ("mean_ours", round(mean([c.ours for c in cells]), 4) if cells else None),
+        ("mean_thesis", round(mean([c.thesis for c in cells]), 4) if cells else None)])
+
+
+def scorecard(cells):
+    """The agreement counts per main table, in total, and per variant."""
+    main = [c for c in cells if c.main]
+    tables = []
+    for e, t in MAIN_TABLES.items():
+        mine = [c for c in main if c.experiment == e]
+        if mine:
+            tables.append(collections.OrderedDict([("table", t), ("experiment", e)] + list(score(mine).items())))
+    variants = []
+    for key in collections.OrderedDict(((c.experiment, c.measure), None) for c in cells if c.counted and not c.main
+                                       and c.kind != "ablation"):
+        mine = [c for c in cells if (c.experiment, c.measure) == key]
+        variants.append(collections.OrderedDict([("table", mine[0].table), ("experiment", key[0]),
+                                                 ("measure", key[1])] + list(score(mine).items())))
+    total = collections.OrderedDict([("of", MAIN_CELLS)] + list(score(main).items()))
+    return collections.OrderedDict([
+        ("rules", collections.OrderedDict([
+            ("within_15", "|ours - thesis| <= 15 percentage points"),
+            ("significant", "Fisher's exact test, two-sided, ours k/n against the thesis's round(value x n)/n"),
+            ("thesis_n", THESIS_N_TEXT),
+            ("best_agrees", "a row agrees when some method is most robust (ties included) both in ours and in the "
+                            "thesis's"),
+            ("tau_positive", "Kendall's tau-b of a row's values against the thesis's is above 0 (undefined, a row "
+                             "all tied: not)")])),
+        ("tables", tables), ("total", total), ("variants", variants)])
+
+
+def section_agreement(res, cells, card):
+    if not card["tables"] and not card["variants"]:
+        return []
+    o = ["## Agreement with the thesis\n",
+         "Robustness cells of the thesis's Tables 4.1, 4.3, 4.4, 4.5, 4.7 and 4.9 (%d values; the milk carton judged "
+         "with the model's symmetries, as its table above), computed from the records. Within 15: |ours - thesis| "
+         "<= 15 points. p: Fisher's exact test (two-sided) of our k/n against the thesis's k/n (its n: %s; k = "
+         "round(value x n)). Best agrees: some method is the most robust, ties included, both here and in the "
+         "thesis's row. tau > 0: Kendall's tau-b of the row's values against the thesis's is positive (a row all "
+         "tied on one side has none and does not count). `--scorecard-json FILE` prints these numbers as JSON.\n" %
+         (MAIN_CELLS, THESIS_N_TEXT),
+         "| table | cells | within 15 points | p < 0.05 | p < 0.01 | rows | best agrees | tau > 0 | mean, ours | "
+         "mean, thesis |", "|---|---|---|---|---|---|---|---|---|---|"]
+
+    def line(name, s):
+        return "| %s | %d | %d | %d | %d | %d | %d | %d | %s | %s |" % (
+            name, s["cells"], s["within_15"], s["significant_05"], s["significant_01"], s["rows"], s["best_agrees"],
+            s["tau_positive"], pct(s["mean_ours"]), pct(s["mean_thesis"]))
+    o += [line("Table " + t["table"], t) for t in card["tables"]]
+    t = card["total"]
+    if t["cells"]:
+        o.append(line("**total** (of the thesis's %d)" % t["of"], t))
+    if card["variants"]:
+        o += ["", "Not counted above (the same comparison, against the thesis's values of the table named):\n",
+              "| variant | cells | within 15 points | p < 0.05 | p < 0.01 | rows | best agrees | tau > 0 | mean, ours "
+              "| mean, thesis |", "|---|---|---|---|---|---|---|---|---|---|"]
+        o += [line("Table %s: %s%s" % (v["table"], v["experiment"], ", judged faces on faces (the thesis's "
+                                       "judgement)" if v["measure"] == FACES else ""), v) for v in card["variants"]]
+    o += ["", inexact_text(cells), ""]
+    return o
+
+
+# ---- the thesis's conclusions ---------------------------------------------------------
+
+
+def accuracy_of(records):
+    ok = [r for r in records if r.get("correct") and "errors" in r]
+    return (mean([r["errors"]["translation_mm"] for r in ok]), mean([r["errors"]["rotation_1mpq"] for r in ok]))
+
+
+def figure_curves(res):
+    """thesis_verdicts.Curve per (figure experiment, scene, method): correct,
+    trials and mean time per x value (the experiment's report.plot_x)."""
+    curves = []
+    for e, x in res.x.items():
+        if e in res.ablation_only or table_of(x) or not x.exp:
+            continue
+        plot_x = x.exp.get("report", {}).get("plot_x", "added_noise_mm")
+        col = method_column(experiment_json(res, x))
+        pts = collections.OrderedDict()
+        for n, r in enumerate(x.records, 1):
+            if plot_x == "added_noise_mm":
+                xv = float(r["added_noise_mm"])
+            elif plot_x in r["params"]:
+                xv = r["params"][plot_x]
+            else:
+                raise InputError("%s: line %d: no params.%s (the experiment's report.plot_x)" % (
+                    os.path.join(res.raw, e, "records.jsonl"), n, plot_x))
+            pts.setdefault((r["scene"], r[col]), {}).setdefault(xv, []).append(r)
+        for (s, m), by_x in pts.items():
+            curves.append(Curve(e, s, m, collections.OrderedDict(
+                (xv, (n_correct(rs), len(rs), mean([r["times"]["total"] for r in rs if "times" in r])))
+                for xv, rs in sorted(by_x.items()))))
+    return curves
+
+
+def verdict_data(res, cells):
+    """Our numbers as the rules read them (main tables, variants, figures)."""
+    mine = [c for c in cells if c.kind != "ablation"]
+    acc = {}
+    for c in mine:
+        if c.measure == "robustness" and c.table == "4.9":
+            recs = [r for r in res[c.experiment].records if r["scene"] == c.scenario and
+                    r[method_column(res[c.experiment].exp)] == c.method]
+            acc[(c.experiment, c.scenario, c.method)] = accuracy_of(recs)
+    return Data(rob=collections.OrderedDict(((c.experiment, c.scenario, c.method), (c.k, c.n)) for c in mine
+                                            if c.measure == "robustness"),
+                time={(c.experiment, c.scenario, c.method): c.ours for c in mine if c.measure == "time"},
+                accuracy=acc, curves=figure_curves(res),
+                registration_only={e for e, x in res.x.items() if (x.exp or {}).get("registration_only")})
+
+
+def thesis_data(res, cells):
+    """The thesis's own numbers as the rules read them (its tables; it printed no numbers for its figures)."""
+    main = [c for c in cells if c.kind == "main"]
+    acc = {}
+    for c in main:
+        if c.measure == "robustness" and c.table == "4.9":
+            acc[(c.experiment, c.scenario, c.method)] = (res.thesis(c.experiment, c.scenario, "translation_mm",
+                                                                    c.method),
+                                                         res.thesis(c.experiment, c.scenario, "rotation_1mpq",
+                                                                    c.method))
+    return Data(rob=collections.OrderedDict(((c.experiment, c.scenario, c.method), (c.thesis_k, c.thesis_n))
+                                            for c in main if c.measure == "robustness"),
+                time={(c.experiment, c.scenario, c.method): c.thesis for c in main if c.measure == "time"},
+                accuracy=acc, registration_only={"table_4_9"})
+
+
+def verdicts(res, cells):
+    """[(id, title, rule, ours, thesis's)] of the seven conclusions."""
+    theirs = {cid: v for cid, _t, _r, v in evaluate(thesis_data(res, cells))}
+    return [(cid, title, rule, v, theirs[cid]) for cid, title, rule, v in evaluate(verdict_data(res, cells))]
+
+
+def section_conclusions(res, cells):
+    found = [v for v in verdicts(res, cells) if v[3] is not None]
+    if not found:
+        return []
+    o = ["## The thesis's conclusions against these numbers\n",
+         "Each verdict is computed by `scripts/thesis_verdicts.py` from the records, by a rule written down before "
+         "the run; the rule is printed before its evidence. The same rule applied to the thesis's own table values "
+         "(k = round(value x n) at its n; it printed no numbers for its figures) is given after it, as a check of "
+         "the rule.\n"]
+    for cid, title, rule, v, theirs in found:
+        o.append("**%s. %s: %s.**\n" % (cid, title, v.word))
+        o.append("- Rule: %s" % rule)
+        o.append("- Here: %s" % v.evidence)
+        o.append("- On the thesis's own numbers: %s\n" % (
+            "%s. %s" % (theirs.word, theirs.evidence) if theirs else "no numbers (figures only)."))
+    return o
+
+
+# ---- ablations -----------------------------------------------------------------------------
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ABLATIONS = os.path.join(ROOT, "configs", "thesis", "ablations.yaml")
+
+
+def shown_path(path):
+    """A path as the README shows it: relative to the source root when inside it."""
+    a = os.path.abspath(path)
+    return os.path.relpath(a, ROOT) if a.startswith(ROOT + os.sep) else path
+
+
+def load_ablations(path):
+    """The ablations of a file (scripts/thesis_ablations.py's schema), each
+    with its `pairs` [experiment as reported, its ablation copy]; [] without
+    a file. InputError naming the file and field on a bad one."""
+    if not path or not os.path.exists(path):
+        return []
+    try:
+        ablations = thesis_ablations.load_spec(path)
+    except thesis_ablations.SpecError as e:
+        raise InputError(str(e)) from None
+    return [dict(a, pairs=[[e, thesis_ablations.ablation_name(a["name"], e)] for e in a["experiments"]])
+            for a in ablations]
+
+
+def counts_of(res, e):
+    """{(scene, method, condition): (k, n)} of an experiment's records."""
+    return collections.OrderedDict((key, (n_correct(recs), len(recs)))
+                                   for key, recs in group_records(res, res[e]).items())
+
+
+class Moved:
+    """One cell of an ablation pair: as reported (k, n) and with the cause switched back (k2, n2)."""
+
+    def __init__(self, e, e2, key, kn, kn2, thesis):
+        self.e, self.e2, (self.scenario, self.method, self.cond) = e, e2, key
+        (self.k, self.n), (self.k2, self.n2), self.thesis = kn, kn2, thesis
+        self.a, self.b = self.k / self.n, self.k2 / self.n2
+        self.p = fisher_exact(self.k, self.n, self.k2, self.n2)
+        self.moved = not within_points(self.a, self.b, POINTS)
+
+
+def ablation_cells(res, ablation, thesis):
+    """(compared cells, skipped pairs) of an ablation; thesis: {(experiment, scene, method): value}."""
+    compared, skipped = [], []
+    for e, e2 in ablation["pairs"]:
+        missing = [x for x in (e, e2) if x not in res]
+        if missing:
+            skipped.append((e, e2, missing))
+            continue
+        a, b = counts_of(res, e), counts_of(res, e2)
+        for key in a:
+            if key in b and a[key][1] and b[key][1]:
+                compared.append(Moved(e, e2, key, a[key], b[key],
+                                      thesis.get((e, key[0], key[1])) if not key[2] else None))
+    return compared, skipped
+
+
+def explains(m, cell):
+    """Whether an ablation's cell m explains the gap of a main cell: switching
+    the cause moves it toward the thesis by at least half the gap, at p < 0.05."""
+    gap, effect = cell.thesis - cell.ours, m.b - m.a
+    return gap * effect > 0 and abs(effect) >= abs(gap) / 2 - 1e-12 and m.p < 0.05
+
+
+EXPLAIN_RULE = (
+    "A cell of the %d outside 15 points of the thesis is explained by a cause when an ablation of that cause covers "
+    "it (a pair whose first experiment is the cell's, with the same scene set and method) and switching the cause "
+    "moves the cell toward the thesis's value by at least half the gap (thesis - ours), the two counts differing at "
+    "p < 0.05 (Fisher's exact test).")
+
+
+def section_ablations(res, ablations, cells, path):
+    o = ["## Ablations: what each change of the set-up does\n"]
+    if not ablations:
+        return o + ["No ablations (`%s` is missing or lists none).\n" % shown_path(path)]
+    o.append("Each ablation runs an experiment again with one cause switched back (`%s`). Per ablation: the cells "
+             "compared, those that move by more than 15 points, those whose two counts differ at p < 0.05 (Fisher's "
+             "exact test), the mean robustness both ways and how many cells are within 15 points of the thesis both "
+             "ways.\n" % shown_path(path))
+    thesis = {(c.experiment, c.scenario, c.method): c.thesis for c in cells if c.measure == "robustness"
+              and c.kind != "ablation"}
+    by_ablation = []
+    rows = ["| ablation | cause | switched back | pairs run | cells | moved > 15 points | p < 0.05 | mean, as reported "
+            "| mean, switched back | within 15 of the thesis, as reported | switched back |",
+            "|---|---|---|---|---|---|---|---|---|---|---|"]
+    notes = []
+    for a in ablations:
+        compared, skipped = ablation_cells(res, a, thesis)
+        by_ablation.append((a, compared))
+        with_t = [m for m in compared if m.thesis is not None]
+        rows.append("| %s | %s | %s | %d of %d | %d | %d | %d | %s | %s | %s | %s |" % (
+            a["name"], a["cause"], a["switched"], len(a["pairs"]) - len(skipped), len(a["pairs"]), len(compared),
+            sum(m.moved for m in compared), sum(m.p < 0.05 for m in compared),
+            pct(mean([m.a for m in compared])), pct(mean([m.b for m in compared])),
+            "%d of %d" % (sum(within_points(m.a, m.thesis, POINTS) for m in with_t), len(with_t)) if with_t else "-",
+            "%d of %d" % (sum(within_points(m.b, m.thesis, POINTS) for m in with_t), len(with_t)) if with_t else "-"))
+        for e, e2, missing in skipped:
+            notes.append("- %s: pair %s / %s skipped, no records for %s (`results/thesis/raw/NAME/records.jsonl`)." % (
+                a["name"], e, e2, ", ".join(missing)))
+        moved = [m for m in compared if m.moved]
+        if moved:
+            notes.append("- %s, cells moved by more than 15 points (scene set, method: as reported -> switched back, "
+                         "thesis): %s." % (a["name"], "; ".join(
+                             "%s %s %s%s: %d/%d -> %d/%d (%s -> %s, p = %.2g), thesis %s" % (
+                                 m.e, m.scenario, m.method, " (%s)" % m.cond if m.cond else "", m.k, m.n, m.k2,
+                                 m.n2, pct(m.a), pct(m.b), m.p, pct(m.thesis)) for m in moved)))
+    o += rows + [""] + (notes + [""] if notes else [])
+    gaps = [c for c in cells if c.main and not c.within]
+    o.append("**Which gaps to the thesis the ablations explain.** " + EXPLAIN_RULE % len(gaps) + "\n")
+    explained, unexplained = [], []
+    for c in gaps:
+        by = [a["name"] for a, compared in by_ablation for m in compared
+              if (m.e, m.scenario, m.method, m.cond) == (c.experiment, c.scenario, c.method, "") and explains(m, c)]
+        (explained if by else unexplained).append((c, by))
+    o.append("Of the %d main cells outside 15 points, %d explained (%s), %d unexplained.\n" % (
+        len(gaps), len(explained), "; ".join("%s %s %s by %s" % (short_title(c.experiment), c.scenario, c.method,
+                                                                 ", ".join(by)) for c, by in explained) or "none",
+        len(unexplained)))
+    if unexplained:
+        o.append("Unexplained (ours vs the thesis): " + "; ".join(
+            "%s %s %s %s vs %s" % (short_title(c.experiment), c.scenario, c.method, pct(c.ours), pct(c.thesis))
+            for c, _ in unexplained) + ".\n")
+    return o
 
 
 # ---- the README ---------------------------------------------------------------------
@@ -945,37 +1324,91 @@ def host_info():
             "jobs": os.environ.get("JOBS", "2")}
 
 
-def readme(res, host):
+def readme(res, host, cells, ablations, ablations_path):
     """The README's text."""
     blocks = (section_intro(res, host) + section_reproduce() + section_differences(res) +
-              section_experiments(res) + section_tables(res) + section_figures(res) + section_conclusions(res) +
-              section_agreement(res))
+              section_experiments(res) + section_tables(res, cells) + section_figures(res) +
+              section_agreement(res, cells, scorecard(cells)) + section_conclusions(res, cells) +
+              section_ablations(res, ablations, cells, ablations_path))
     return "\n".join(blocks) + "\n"
+
+
+def scorecard_json(res, cells):
+    """The scorecard and the verdicts as one JSON object."""
+    card = scorecard(cells)
+    card["verdicts"] = collections.OrderedDict(
+        (cid, collections.OrderedDict([("ours", v.word if v else None), ("thesis_numbers", t.word if t else None),
+                                       ("numbers", v.numbers if v else None)]))
+        for cid, _title, _rule, v, t in verdicts(res, cells))
+    card["raw"] = os.path.realpath(res.raw)
+    return json.dumps(card, indent=1) + "\n"
+
+
+USAGE_ERROR = 2
+
+
+def parse_args(argv):
+    """(OUT, experiments, {option: value}) of the command line; ValueError on a bad option."""
+    opts, rest, i = {}, [], 0
+    while i < len(argv):
+        a = argv[i]
+        if a in ("--scorecard-json", "--ablations"):
+            if i + 1 >= len(argv):
+                raise ValueError("%s needs a value" % a)
+            opts[a], i = argv[i + 1], i + 2
+            continue
+        if a.startswith("--"):
+            raise ValueError("unknown option %s" % a)
+        rest.append(a)
+        i += 1
+    if not rest:
+        raise ValueError("no OUT folder")
+    return rest[0], rest[1:], opts
 
 
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     if not argv or argv[0] in ("-h", "--help"):
         print(__doc__.strip(), file=sys.stderr)
-        return 0 if argv else 2
-    out_dir, experiments = argv[0], argv[1:]
+        return 0 if argv else USAGE_ERROR
+    try:
+        out_dir, experiments, opts = parse_args(argv)
+    except ValueError as err:
+        print("thesis_report.py: %s (see --help)" % err, file=sys.stderr)
+        return USAGE_ERROR
     binary = os.environ.get("POSEBENCH", "build/posebench")
     schema = schema_from_binary(binary)
     if schema is None and binary and os.path.exists(binary):
         print("thesis_report.py: `%s schema record` gave no schema (a binary from before it?); using the copy in "
               "thesis_report.py" % binary, file=sys.stderr)
+    ablations_path = opts.get("--ablations", ABLATIONS)
     try:
-        res = load_results(out_dir, experiments, schema or RECORD_SCHEMA)
+        ablations = load_ablations(ablations_path)
+        res = load_results(out_dir, experiments, schema or RECORD_SCHEMA, ablations)
+        cells = all_cells(res) if res.x else []
+        if "--scorecard-json" in opts:
+            text = scorecard_json(res, cells)
+        elif res.x:
+            text = readme(res, host_info(), cells, ablations, ablations_path)
     except InputError as err:
         print("thesis_report.py: %s" % err, file=sys.stderr)
         return 2
+    if "--scorecard-json" in opts:
+        if opts["--scorecard-json"] == "-":
+            sys.stdout.write(text)
+        else:
+            with open(opts["--scorecard-json"], "w") as f:
+                f.write(text)
+            print(opts["--scorecard-json"])
+        return 0
     path = os.path.join(out_dir, "README.md")
     if not res.x:  # e.g. a fresh clone: keep the committed README rather than empty it
         print("thesis_report.py: no experiment's records.jsonl in %s; %s left as it is" % (res.raw, path),
               file=sys.stderr)
         return 0
     with open(path, "w") as f:
-        f.write(readme(res, host_info()))
+        f.write(text)
+    write_cells_csv(os.path.join(out_dir, "cells.csv"), cells)
     print(path)
     return 0
 

@@ -7,10 +7,15 @@ table_4_1 (a Table 4.1-style table), table_4_5 (the milk carton, records
 with judgements.faces) and fig_4_12 (a noise figure, registration only).
 The tests assert exact README rows, the strict record loader (exit code 2
 naming file, line and key), the carton's faces row from the records'
-judgements (and "-" without them), and times and loads from runs.jsonl.
+judgements (and "-" without them), times and loads from runs.jsonl, the
+robustness cells (k/n, Wilson interval, Fisher's mark), cells.csv, the
+agreement scorecard (also as --scorecard-json), the ablation section (pairs
+built in the tests from the fixtures) and its file's parser, and exit code 2
+for a missing thesis value. The verdict rules: test_thesis_verdicts.py.
 No network, no binary needed (the schema comparison is skipped without one).
 """
 import contextlib
+import csv
 import io
 import json
 import os
@@ -28,25 +33,38 @@ sys.path.insert(0, os.path.join(ROOT, "scripts"))
 import thesis_report  # noqa: E402
 
 EXPERIMENTS = ("table_4_1", "table_4_5", "fig_4_12")
+ABLATIONS = os.path.join(FIXTURES, "ablations.yaml")
 
 
 class Run:
     """Copies the fixtures to a temporary OUT, applies edit(raw folder), runs
     main() with the schema copy (POSEBENCH unless given is no binary) and
-    keeps the exit code, stderr and the README's lines."""
+    keeps the exit code, stderr, stdout, the README's lines and cells.csv's
+    rows (dicts). Ablations from fixtures/ablations.yaml unless given."""
 
-    def __init__(self, edit=None, experiments=EXPERIMENTS, posebench=""):
+    def __init__(self, edit=None, experiments=EXPERIMENTS, posebench="", ablations=None, args=()):
         with tempfile.TemporaryDirectory() as tmp:
             out = os.path.join(tmp, "thesis")
             shutil.copytree(os.path.join(FIXTURES, "raw"), os.path.join(out, "raw"))
             if edit:
                 edit(os.path.join(out, "raw"))
-            err = io.StringIO()
+            err, std = io.StringIO(), io.StringIO()
+            argv = [out] + list(experiments) + ["--ablations", ablations or ABLATIONS] + [
+                a.replace("{tmp}", tmp) for a in args]
             with mock.patch.dict(os.environ, {"POSEBENCH": posebench, "JOBS": "2"}), \
-                    contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
-                self.code = thesis_report.main([out] + list(experiments))
-            self.err = err.getvalue()
+                    contextlib.redirect_stderr(err), contextlib.redirect_stdout(std):
+                self.code = thesis_report.main(argv)
+            self.err, self.out = err.getvalue(), std.getvalue()
             self.lines = read_lines(os.path.join(out, "README.md"))
+            self.cells = read_csv_rows(os.path.join(out, "cells.csv"))
+            self.files = {f: read_lines(os.path.join(tmp, f)) for f in os.listdir(tmp) if f.endswith(".json")}
+
+
+def read_csv_rows(path):
+    if not os.path.exists(path):
+        return None
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
 
 
 def read_lines(path):
@@ -90,11 +108,11 @@ class Readme(unittest.TestCase):
 
     def test_experiments_table_times_and_loads_from_runs_jsonl(self):
         # table_4_1: two invocations, 30.5 s + 12.0 s, loads 1.5 and 2.0.
-        self.assertLine("| Table 4.1 | `configs/thesis/table_4_1.yaml` | 2 | 4 | no_hypothesis 1, ok 3 | 0m42s | 1.5/2.0 |")
-        self.assertLine("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 4 | no_hypothesis 1, ok 3 | 0m20s | 0.5 |")
+        self.assertLine("| Table 4.1 | `configs/thesis/table_4_1.yaml` | 2 | 2 | 4 | no_hypothesis 1, ok 3 | 0m42s | 1.5/2.0 |")
+        self.assertLine("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 2 | 4 | no_hypothesis 1, ok 3 | 0m20s | 0.5 |")
         # fig_4_12: 3725.2 s with an unknown load (null); its second line ran nothing and is left out.
-        self.assertLine("| Figure 4.12 | `configs/thesis/fig_4_12.yaml` | 2 | 8 | ok 8 | 1h02m05s | - |")
-        self.assertLine("| **total** | | | 16 | | **1h03m08s** | |")
+        self.assertLine("| Figure 4.12 | `configs/thesis/fig_4_12.yaml` | 2 | 2 | 8 | ok 8 | 1h02m05s | - |")
+        self.assertLine("| **total** | | | | 16 | | **1h03m08s** | |")
 
     def test_intro_totals_and_load_range(self):
         text = "\n".join(self.run_.lines)
@@ -124,11 +142,19 @@ class Readme(unittest.TestCase):
         self.assertIn("ranged from 1.9 to 3.4 on 2 cores, more than the run's own workers", text)
 
     def test_table_4_1_rows_come_from_the_report_with_the_thesis_beside(self):
-        # cvfh: 1 of 2 correct (thesis 43%), fpfh: 2 of 2 (thesis 67%).
+        # cvfh: 1 of 2 correct (Wilson 9-91%; thesis 43% = 13/30, Fisher p = 1), fpfh: 2 of 2 (34-100%; thesis 67%
+        # = 20/30, p = 1): no mark. The other rows are report.md's.
         self.assertLine("#### Table 4.1: LS5, multiple model views (12 synthetic, 8 real)")
         self.assertLine("| scenario | measure | cvfh | fpfh |")
-        self.assertLine("| table_synthetic | robustness | 50% (43%) | 100% (67%) |")
+        self.assertLine("| table_synthetic | robustness | 50% 1/2 [9-91] (43%) | 100% 2/2 [34-100] (67%) |")
         self.assertLine("|  | time (s) | 0.25 (0.19) | 0.75 (1.22) |")
+        self.assertLine("|  | rotation error (1-|p.q|) | 0.0010 | 0.0010 |")
+
+    def test_legend_states_both_sample_sizes(self):
+        text = "\n".join(self.run_.lines)
+        self.assertIn("`*` p < 0.05, `**` p < 0.01", text)
+        self.assertIn("Our n per cell (trials, from the records): table_4_1 2; table_4_5 2.", text)
+        self.assertIn("20 per occluded one (table_*_occluded), 19 in Table 4.9", text)
 
     def test_carton_faces_row_from_the_records_judgements(self):
         # cvfh: 1 of 2 correct with the half turn, 2 of 2 faces on faces; fpfh: 0 and 0.
@@ -144,17 +170,293 @@ class Readme(unittest.TestCase):
         self.assertLine("| icp_plane (warehouse_synthetic) | 100% / 0.3s | 50% / 0.3s |")
 
     def test_noise_conclusion_from_the_figure(self):
-        line = [l for l in self.run_.lines if l.startswith("6. ")]
-        self.assertEqual(len(line), 1, self.run_.lines)
-        self.assertTrue(line[0].startswith(
-            "6. **Better with about 2 mm of added noise than with none (thesis section 5.1): partly supported.** Of "
-            "the 2 curves of Figures 4.7, 4.11 and 4.12, 1 are higher at 2 mm than at 0 mm, 1 lower, 0 equal. "
-            "Higher: icp (warehouse_synthetic) 50% -> 100%."), line[0])
+        # icp 1/2 -> 2/2 and icp_plane 2/2 -> 1/2: both changes within sampling noise (p = 1).
+        i = self.run_.lines.index("**C6. Better with about 2 mm of added noise than with none (thesis section 5.1): "
+                                  "not supported.**")
+        self.assertTrue(self.run_.lines[i + 2].startswith("- Rule: Over every curve of Figures 4.7, 4.11 and 4.12"))
+        self.assertEqual(self.run_.lines[i + 3],
+                         "- Here: 2 curves: 0 up, 0 down, 2 flat at p < 0.05 (up: none; down: none). In direction "
+                         "alone: 1 higher at 2 mm, 1 lower, 0 equal.")
+        self.assertEqual(self.run_.lines[i + 4], "- On the thesis's own numbers: no numbers (figures only).")
 
     def test_agreement_rows(self):
-        # Table 4.1: ours 50% and 100%, thesis 43% and 67%: means 75% and 55%, |difference| 7 and 33 points.
-        self.assertLine("| Table 4.1 | 2 | 75% | 55% | 20 points |")
-        self.assertLine("| Table 4.5 | 2 | 25% | 24% | 18 points |")
+        # Table 4.1: 1/2 vs 43% (7 points), 2/2 vs 67% (33): 1 within 15; fpfh best in both; tau 1.
+        # Table 4.5: 1/2 vs 31% (19 points), 0/2 vs 16% (16): none within; cvfh best in both; tau 1.
+        self.assertLine("| Table 4.1 | 2 | 1 | 0 | 0 | 1 | 1 | 1 | 75% | 55% |")
+        self.assertLine("| Table 4.5 | 2 | 0 | 0 | 0 | 1 | 1 | 1 | 25% | 24% |")
+        self.assertLine("| **total** (of the thesis's 107) | 4 | 1 | 0 | 0 | 2 | 2 | 2 | 50% | 39% |")
+        # the carton judged faces on faces: cvfh 2/2 (69 points off), fpfh 0/2
+        self.assertLine("| Table 4.5: table_4_5, judged faces on faces (the thesis's judgement) | 2 | 0 | 0 | 0 | 1 | "
+                        "1 | 1 | 50% | 24% |")
+
+    def test_inexact_thesis_values_are_named(self):
+        # 31% and 16% are no k/60; 18/58 and 9/58 print as 31% and 16%.
+        self.assertIn("2 of the thesis's 4 values cannot be k/n at the n assumed (whole percent): Table 4.5 "
+                      "table_astra (n 60): cvfh 31%, fpfh 16%; the row's values all fit n = 58.",
+                      "\n".join(self.run_.lines))
+
+    def test_cells_csv(self):
+        cells = self.run_.cells
+        self.assertEqual(list(cells[0]), thesis_report.CSV_COLUMNS)
+        self.assertEqual([(c["experiment"], c["scenario"], c["measure"], c["method"]) for c in cells], [
+            ("table_4_1", "table_synthetic", "robustness", "cvfh"),
+            ("table_4_1", "table_synthetic", "robustness", "fpfh"),
+            ("table_4_1", "table_synthetic", "time", "cvfh"), ("table_4_1", "table_synthetic", "time", "fpfh"),
+            ("table_4_5", "table_astra", "robustness", "cvfh"), ("table_4_5", "table_astra", "robustness", "fpfh"),
+            ("table_4_5", "table_astra", "robustness_faces", "cvfh"),
+            ("table_4_5", "table_astra", "robustness_faces", "fpfh"),
+            ("table_4_5", "table_astra", "time", "cvfh"), ("table_4_5", "table_astra", "time", "fpfh")])
+        c = cells[0]
+        self.assertEqual((c["table"], c["kind"], c["ours_k"], c["n"], c["ours"], c["thesis"], c["thesis_n"],
+                          c["thesis_k"], c["thesis_exact"], c["p_value"], c["within_15"], c["significant_05"]),
+                         ("4.1", "main", "1", "2", "0.5", "0.43", "30", "13", "true", "1", "true", "false"))
+        self.assertEqual((c["wilson_lo"], c["wilson_hi"]), ("0.0945", "0.9055"))
+        self.assertEqual(cells[5]["thesis_exact"], "false")  # 16% of 60
+        self.assertEqual((cells[6]["ours_k"], cells[6]["thesis"]), ("2", "0.31"))  # faces: cvfh 2 of 2
+        t = cells[2]
+        self.assertEqual((t["ours"], t["thesis"], t["ours_k"], t["n"], t["p_value"], t["within_15"]),
+                         ("0.25", "0.19", "", "", "", ""))
+
+
+def records_with(template, method, correct):
+    """Copies of a record, one per entry of `correct` (its method and judgement set)."""
+    out = []
+    for i, c in enumerate(correct):
+        r = json.loads(json.dumps(template))
+        r.update(descriptor=method, im_id=i, correct=c, key="%s/%d/%s" % (r["scene"], i, method))
+        out.append(r)
+    return out
+
+
+def ablation_fixture(raw):
+    """table_4_1 with 10 trials per cell (cvfh 0 of 10, fpfh 10 of 10) and its
+    ablation `ablation_views_table_4_1` (cvfh 1 of 10, fpfh 2 of 10; no report)."""
+    ok = records_of(raw, "table_4_1")[0]
+    write_records(raw, "table_4_1", records_with(ok, "cvfh", [False] * 10) + records_with(ok, "fpfh", [True] * 10))
+    d = os.path.join(raw, "ablation_views_table_4_1")
+    os.makedirs(d)
+    with open(os.path.join(raw, "table_4_1", "experiment.json")) as f:
+        exp = json.load(f)
+    exp["name"] = "ablation_views_table_4_1"
+    with open(os.path.join(d, "experiment.json"), "w") as f:
+        json.dump(exp, f)
+    write_records(raw, "ablation_views_table_4_1", records_with(ok, "cvfh", [True] + [False] * 9) +
+                  records_with(ok, "fpfh", [True] * 2 + [False] * 8))
+
+
+class Ablations(unittest.TestCase):
+    longMessage = False
+
+    @classmethod
+    def setUpClass(cls):
+        cls.run_ = Run(ablation_fixture)
+
+    def assertLine(self, line):
+        self.assertIn(line, self.run_.lines, "README lines:\n" + "\n".join(self.run_.lines))
+
+    def test_exit_code_zero(self):
+        self.assertEqual(self.run_.code, 0, self.run_.err)
+
+    def test_ablation_row(self):
+        # 2 cells; fpfh moves 100% -> 20% (p = 90/125970), cvfh 0% -> 10% (p = 1); none within 15 of the thesis.
+        self.assertLine("| views | training views at 0 / 20 deg | views.follow_scene: false | 1 of 1 | 2 | 1 | 1 | 50% | "
+                        "15% | 0 of 2 | 0 of 2 |")
+        self.assertLine("- views, cells moved by more than 15 points (scene set, method: as reported -> switched back, "
+                        "thesis): table_4_1 table_synthetic fpfh: 10/10 -> 2/10 (100% -> 20%, p = 0.00071), "
+                        "thesis 67%.")
+
+    def test_explained_and_unexplained_gaps(self):
+        # fpfh: gap 67 - 100 = -33, the ablation moves it -80 at p < 0.05: explained. cvfh: gap +43, moved +10:
+        # not. The two carton cells (19 and 16 points off) have no ablation.
+        self.assertLine("Of the 4 main cells outside 15 points, 1 explained (Table 4.1 table_synthetic fpfh by views), "
+                        "3 unexplained.")
+        self.assertLine("Unexplained (ours vs the thesis): Table 4.1 table_synthetic cvfh 0% vs 43%; Table 4.5 "
+                        "table_astra cvfh 50% vs 31%; Table 4.5 table_astra fpfh 0% vs 16%.")
+
+    def test_ablated_cells_in_cells_csv_against_the_partners_thesis(self):
+        abl = [c for c in self.run_.cells if c["kind"] == "ablation"]
+        self.assertEqual([(c["experiment"], c["measure"], c["method"], c["ours_k"], c["n"], c["thesis"])
+                          for c in abl if c["measure"] == "robustness"],
+                         [("ablation_views_table_4_1", "robustness", "cvfh", "1", "10", "0.43"),
+                          ("ablation_views_table_4_1", "robustness", "fpfh", "2", "10", "0.67")])
+
+    def test_ablated_experiment_is_not_in_the_scorecard(self):
+        # 0/10 against 13/30: p = 0.016; 10/10 against 20/30: p = 0.043; both p < 0.05, neither < 0.01.
+        self.assertLine("| Table 4.1 | 2 | 0 | 2 | 0 | 1 | 1 | 1 | 50% | 55% |")
+
+    def test_missing_pairs_are_skipped_and_said(self):
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "ablations.yaml")
+            with open(path, "w") as f:
+                f.write("ablations:\n  - name: plane\n    cause: c\n    switched: s\n"
+                        "    experiments: [table_4_1]\n    generator: {warehouse: {wall: true}}\n")
+            run = Run(ablations=path)
+        self.assertEqual(run.code, 0, run.err)
+        self.assertIn("- plane: pair table_4_1 / ablation_plane_table_4_1 skipped, no records for "
+                      "ablation_plane_table_4_1 (`results/thesis/raw/NAME/records.jsonl`).", run.lines)
+        self.assertIn("| plane | c | s | 0 of 1 | 0 | 0 | 0 | - | - | - | - |", run.lines)
+
+    def test_an_experiment_named_on_the_command_line_stays_what_it_is(self):
+        # a variant (a copy of table_4_1's folder) that an ablation also pairs: still a variant in cells.csv and
+        # the scorecard, and compared in the ablation
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "ablations.yaml")
+            with open(path, "w") as f:
+                f.write("ablations:\n  - name: v\n    cause: c\n    switched: s\n    experiments: [table_4_1]\n"
+                        "    settings: {views: {follow_scene: false}}\n")
+            run = Run(lambda raw: shutil.copytree(os.path.join(raw, "table_4_1"),
+                                                  os.path.join(raw, "ablation_v_table_4_1")),
+                      experiments=EXPERIMENTS + ("ablation_v_table_4_1",), ablations=path)
+        self.assertEqual(run.code, 0, run.err)
+        self.assertEqual({c["kind"] for c in run.cells if c["experiment"] == "ablation_v_table_4_1"}, {"variant"})
+        self.assertIn("| v | c | s | 1 of 1 | 2 | 0 | 0 | 75% | 75% | 1 of 2 | 1 of 2 |", run.lines)
+        self.assertIn("| Table 4.1: ablation_v_table_4_1 | 2 | 1 | 0 | 0 | 1 | 1 | 1 | 75% | 55% |", run.lines)
+
+    def test_a_figure_pair_compares_per_condition(self):
+        # fig_4_12 against a copy with icp_plane's two correct trials at 0 mm made wrong: 4 cells (2 methods x 2
+        # noise levels), icp_plane at 0 mm moves 100% -> 0% (p = 1/3 at n = 2), no thesis values.
+        def edit(raw):
+            shutil.copytree(os.path.join(raw, "fig_4_12"), os.path.join(raw, "ablation_x_fig_4_12"))
+            recs = records_of(raw, "ablation_x_fig_4_12")
+            for r in recs:
+                if r["refinement"] == "icp_plane" and r["added_noise_mm"] == 0.0:
+                    r["correct"] = False
+            write_records(raw, "ablation_x_fig_4_12", recs)
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "ablations.yaml")
+            with open(path, "w") as f:
+                f.write("ablations:\n  - name: x\n    cause: c\n    switched: s\n    experiments: [fig_4_12]\n"
+                        "    settings: {views: {follow_scene: false}}\n")
+            run = Run(edit, ablations=path)
+        self.assertEqual(run.code, 0, run.err)
+        self.assertIn("| x | c | s | 1 of 1 | 4 | 1 | 0 | 75% | 50% | - | - |", run.lines)
+        self.assertIn("- x, cells moved by more than 15 points (scene set, method: as reported -> switched back, "
+                      "thesis): fig_4_12 warehouse_synthetic icp_plane (noise 0 mm): 2/2 -> 0/2 (100% -> 0%, "
+                      "p = 0.33), thesis -.", run.lines)
+        self.assertFalse(any(c["experiment"] == "ablation_x_fig_4_12" for c in run.cells))
+
+    def test_no_ablations_file(self):
+        run = Run(ablations="/nonexistent/ablations.yaml")
+        self.assertEqual(run.code, 0, run.err)
+        self.assertIn("No ablations (`/nonexistent/ablations.yaml` is missing or lists none).", run.lines)
+
+
+class AblationsFile(unittest.TestCase):
+    """The ablations file is scripts/thesis_ablations.py's (tested there);
+    here: the pairs the reporter derives from it, and its errors as exit 2."""
+
+    def load(self, text):
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "abl.yaml")
+            with open(path, "w") as f:
+                f.write(text)
+            return thesis_report.load_ablations(path)
+
+    def test_the_pairs(self):
+        a = self.load('ablations:\n  - name: views\n    cause: "a # b, c"\n    switched: \'x: 1\'\n'
+                      '    experiments: [table_4_1, table_4_3]\n    settings: {views: {follow_scene: false}}\n'
+                      '  - name: plane\n    cause: p\n    switched: q\n    experiments: [table_4_7]\n'
+                      '    generator: {warehouse: {wall: true}}\n')
+        self.assertEqual([(x["name"], x["cause"], x["switched"], x["pairs"]) for x in a], [
+            ("views", "a # b, c", "x: 1", [["table_4_1", "ablation_views_table_4_1"],
+                                           ["table_4_3", "ablation_views_table_4_3"]]),
+            ("plane", "p", "q", [["table_4_7", "ablation_plane_table_4_7"]])])
+
+    def test_the_committed_file_reads(self):
+        a = thesis_report.load_ablations(thesis_report.ABLATIONS)
+        self.assertTrue(a and all(x["pairs"] for x in a))
+
+    def test_errors_name_file_and_field(self):
+        with self.assertRaises(thesis_report.InputError) as c:
+            self.load("ablations:\n  - name: a\n    cause: c\n    experiments: [x]\n    settings: {}\n")
+        self.assertIn("abl.yaml: ablations[0].switched", str(c.exception))
+
+    def test_a_bad_file_is_exit_2(self):
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "ablations.yaml")
+            with open(path, "w") as f:
+                f.write("ablations:\n  - name: a\n    cause: \"c\n")
+            run = Run(ablations=path)
+        self.assertEqual(run.code, 2)
+        self.assertIn("ablations.yaml", run.err)
+        self.assertIn("malformed YAML", run.err)
+
+
+class Scorecard(unittest.TestCase):
+    def test_json_to_a_file_and_no_readme(self):
+        run = Run(args=["--scorecard-json", "{tmp}/card.json"])
+        self.assertEqual(run.code, 0, run.err)
+        self.assertEqual(run.lines, [])
+        self.assertIsNone(run.cells)
+        card = json.loads("\n".join(run.files["card.json"]))
+        self.assertEqual([(t["table"], t["cells"], t["within_15"], t["significant_05"], t["best_agrees"],
+                           t["tau_positive"]) for t in card["tables"]],
+                         [("4.1", 2, 1, 0, 1, 1), ("4.5", 2, 0, 0, 1, 1)])
+        self.assertEqual((card["total"]["of"], card["total"]["cells"], card["total"]["within_15"]), (107, 4, 1))
+        self.assertEqual([(v["experiment"], v["measure"]) for v in card["variants"]],
+                         [("table_4_5", "robustness_faces")])
+        self.assertEqual(card["verdicts"]["C6"]["ours"], "not supported")
+        self.assertIsNone(card["verdicts"]["C2"]["ours"])  # no CVFH/ESF/CESF row in the fixtures
+
+    def test_json_to_stdout(self):
+        run = Run(args=["--scorecard-json", "-"])
+        self.assertEqual(run.code, 0, run.err)
+        self.assertEqual(json.loads(run.out)["total"]["rows"], 2)
+
+    def test_significance_marks(self):
+        # 0 of 10 against the thesis's 67% (20 of 30): p < 0.01; 10 of 10 against 43% (13 of 30): p < 0.01.
+        def edit(raw):
+            ok = records_of(raw, "table_4_1")[0]
+            write_records(raw, "table_4_1", records_with(ok, "cvfh", [True] * 10) +
+                          records_with(ok, "fpfh", [False] * 10))
+        run = Run(edit)
+        self.assertIn("| table_synthetic | robustness | 100% 10/10 [72-100] (43%) ** | 0% 0/10 [0-28] (67%) ** |",
+                      run.lines)
+        row = [c for c in run.cells if c["method"] == "fpfh" and c["measure"] == "robustness"][0]
+        self.assertEqual((row["significant_05"], row["significant_01"], row["within_15"]), ("true", "true", "false"))
+
+    def test_best_agrees_and_tau_rules(self):
+        def cell(ours, thesis):
+            return thesis_report.Cell("4.1", "e", "main", "s", "robustness", "m", round(10 * ours), 10, thesis=thesis,
+                                      thesis_n=30)
+        tie = [cell(0.5, 0.9), cell(0.5, 0.2), cell(0.1, 0.1)]
+        self.assertTrue(thesis_report.best_agrees(tie))  # ours tie includes the thesis's best
+        self.assertTrue(thesis_report.tau_positive(tie))
+        flat = [cell(1.0, 0.9), cell(1.0, 0.8)]
+        self.assertTrue(thesis_report.best_agrees(flat))
+        self.assertFalse(thesis_report.tau_positive(flat))  # all tied: tau undefined, not counted
+        self.assertFalse(thesis_report.best_agrees([cell(0.9, 0.1), cell(0.1, 0.9)]))
+
+
+class BadInput(unittest.TestCase):
+    def test_a_missing_thesis_value_names_file_and_field(self):
+        def blank(raw):
+            path = os.path.join(raw, "table_4_1", "report.csv")
+            with open(path) as f:
+                text = f.read()
+            with open(path, "w") as f:
+                f.write(text.replace("robustness,cvfh,0.5,0.43,", "robustness,cvfh,0.5,,"))
+        run = Run(blank)
+        self.assertEqual(run.code, 2, run.err)
+        self.assertIn("table_4_1/report.csv: no thesis value (field 'thesis') for scenario table_synthetic, measure "
+                      "robustness, method cvfh", run.err)
+        self.assertEqual(run.lines, [])
+
+    def test_a_thesis_value_not_a_number(self):
+        def garble(raw):
+            path = os.path.join(raw, "table_4_5", "report.csv")
+            with open(path) as f:
+                text = f.read()
+            with open(path, "w") as f:
+                f.write(text.replace("robustness,fpfh,0,0.16,", "robustness,fpfh,0,16%,"))
+        run = Run(garble)
+        self.assertEqual(run.code, 2, run.err)
+        self.assertIn("table_4_5/report.csv: line 3: field 'thesis' is not a number: '16%'", run.err)
+
+    def test_a_table_without_report_csv(self):
+        run = Run(lambda raw: os.remove(os.path.join(raw, "table_4_5", "report.csv")))
+        self.assertEqual(run.code, 2, run.err)
+        self.assertIn("table_4_5/report.csv: missing or empty", run.err)
 
 
 class Runs(unittest.TestCase):
@@ -185,7 +487,7 @@ class Runs(unittest.TestCase):
     def test_folder_without_runs_jsonl_shows_no_time_and_says_why(self):
         run = Run(lambda raw: os.remove(os.path.join(raw, "table_4_5", "runs.jsonl")))
         self.assertEqual(run.code, 0, run.err)
-        self.assertIn("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 4 | no_hypothesis 1, ok 3 | - | - |",
+        self.assertIn("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 2 | 4 | no_hypothesis 1, ok 3 | - | - |",
                       run.lines)
         self.assertIn("No `runs.jsonl` (nor the `run_seconds.txt` of older runs), so no wall time or load: "
                       "table_4_5.", run.lines)
@@ -198,7 +500,7 @@ class Runs(unittest.TestCase):
                 f.write("2026-11-22 10:00:00 61.4 3 2 3.7\n2026-11-22 11:00:00 58.9 1 2 1.2\n")
         run = Run(older)
         self.assertEqual(run.code, 0, run.err)
-        self.assertIn("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 4 | no_hypothesis 1, ok 3 | 2m00s | 3.7/1.2 |",
+        self.assertIn("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 2 | 4 | no_hypothesis 1, ok 3 | 2m00s | 3.7/1.2 |",
                       run.lines)
         self.assertFalse(any(line.startswith("No `runs.jsonl`") for line in run.lines))
 
@@ -207,7 +509,7 @@ class Runs(unittest.TestCase):
             with open(os.path.join(raw, "table_4_5", "run_seconds.txt"), "w") as f:
                 f.write("2026-11-22 10:00:00 999.0 3 2 9.9\n")
         run = Run(both)
-        self.assertIn("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 4 | no_hypothesis 1, ok 3 | 0m20s | 0.5 |",
+        self.assertIn("| Table 4.5 | `configs/thesis/table_4_5.yaml` | 2 | 2 | 4 | no_hypothesis 1, ok 3 | 0m20s | 0.5 |",
                       run.lines)
 
     def test_run_seconds_txt_sums_seconds_trials_and_loads(self):
@@ -319,7 +621,7 @@ class StrictRecords(unittest.TestCase):
             r.update(status="timeout", correct=False, message="trial timed out after 300 s")
         run = Run(edit_record("table_4_1", 1, crash))
         self.assertEqual(run.code, 0, run.err)
-        self.assertIn("| Table 4.1 | `configs/thesis/table_4_1.yaml` | 2 | 4 | ok 3, timeout 1 | 0m42s | 1.5/2.0 |",
+        self.assertIn("| Table 4.1 | `configs/thesis/table_4_1.yaml` | 2 | 2 | 4 | ok 3, timeout 1 | 0m42s | 1.5/2.0 |",
                       run.lines)
 
     def test_records_of_the_binary_read_back(self):

@@ -1,0 +1,90 @@
+"""Small statistics for comparing counts of correct trials (standard library only).
+
+wilson(k, n)            the 95% Wilson score interval of k of n
+fisher_exact(a, n, b, m) two-sided Fisher's exact test of a of n against b of m
+kendall_tau(x, y)       Kendall's tau-b of two equally long sequences (None when undefined)
+count_of(value, n)      the count k = round(value * n) behind a printed fraction
+printable_as_count(value, n)  whether a printed percentage can be some k/n
+fitting_n(values, n)    the largest n' <= n at which all of a row's percentages are k/n'
+
+Used by scripts/thesis_report.py and scripts/thesis_verdicts.py.
+"""
+import math
+
+Z95 = 1.959963984540054
+FISHER_REL_TOL = 1e-7  # as scipy.stats.fisher_exact: tables as probable as the observed one, within this
+
+
+def wilson(k, n, z=Z95):
+    """The Wilson score interval of k successes in n trials, as (lo, hi);
+    (0, 1) for n = 0 (scripts/plot.py and eval/stats.h compute the same)."""
+    if n <= 0:
+        return 0.0, 1.0
+    p = k / n
+    d = 1 + z * z / n
+    c = (p + z * z / (2 * n)) / d
+    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
+    # exactly 0 / 1 at the ends (c - h and c + h are 0 and 1 there but for rounding)
+    return (0.0 if k == 0 else max(0.0, c - h)), (1.0 if k == n else min(1.0, c + h))
+
+
+def fisher_exact(a, n, b, m):
+    """Two-sided p of Fisher's exact test of the 2x2 table (a, n - a; b, m - b):
+    the sum of the hypergeometric probabilities (margins fixed) of every table
+    at most as probable as the observed one, within a relative tolerance."""
+    if not (0 <= a <= n and 0 <= b <= m):
+        raise ValueError("counts out of range: %d of %d, %d of %d" % (a, n, b, m))
+    k, total = a + b, n + m
+    lo, hi = max(0, k - m), min(k, n)
+    # integer weights comb(n, x) comb(m, k - x); their sum is comb(n + m, k)
+    weights = [math.comb(n, x) * math.comb(m, k - x) for x in range(lo, hi + 1)]
+    observed = weights[a - lo]
+    p = sum(w for w in weights if w <= observed * (1 + FISHER_REL_TOL)) / math.comb(total, k)
+    return min(1.0, p)
+
+
+def _sign(v, tol=1e-12):
+    return 0 if abs(v) <= tol else (1 if v > 0 else -1)
+
+
+def kendall_tau(x, y):
+    """Kendall's tau-b of x and y (pairs tied in one of them count in its
+    denominator only); None when every pair is tied in x or in y."""
+    if len(x) != len(y):
+        raise ValueError("kendall_tau: sequences of different lengths")
+    concordant = discordant = untied_x = untied_y = 0
+    for i in range(len(x)):
+        for j in range(i + 1, len(x)):
+            sx, sy = _sign(x[i] - x[j]), _sign(y[i] - y[j])
+            untied_x += sx != 0
+            untied_y += sy != 0
+            if sx and sy:
+                concordant += sx == sy
+                discordant += sx != sy
+    if not untied_x or not untied_y:
+        return None
+    return (concordant - discordant) / math.sqrt(untied_x * untied_y)
+
+
+def count_of(value, n):
+    """The count behind a fraction printed for n trials: round(value * n), halves up."""
+    return int(math.floor(value * n + 0.5 + 1e-9))
+
+
+def printable_as_count(value, n):
+    """Whether the percentage `value` (as printed, whole percent) is k/n for
+    some whole k, rounded to a whole percent."""
+    pct = round(100 * value)
+    return any(abs(100 * k / n - pct) <= 0.5 + 1e-9 for k in range(n + 1))
+
+
+def fitting_n(values, n):
+    """The largest m from n down to n // 2 at which every printed fraction of
+    `values` is some k/m (whole percent), or None."""
+    return next((m for m in range(n, max(1, n // 2) - 1, -1) if all(printable_as_count(v, m) for v in values)),
+                None)
+
+
+def within_points(a, b, points):
+    """|a - b| at most `points` percentage points (fractions a, b)."""
+    return abs(a - b) <= points / 100 + 1e-9
