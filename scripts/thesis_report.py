@@ -686,7 +686,9 @@ def merged_plot(res, name, parts, title):
     series, xl = [], None
     for p in parts:
         for pl in res[p].plots:
-            series += [dict(s, label=s["label"] + ", " + p.split("_")[-1]) for s in pl["series"]]
+            family = p.split("_")[-1]  # fig_4_7_global -> global: a line style per family (plot.py)
+            series += [dict(s, family=family, label="%s, %s" % (s.get("method", s["label"]), family))
+                       for s in pl["series"]]
             xl = pl["x_label"]
     if not series:
         return None

@@ -36,6 +36,18 @@ class Plot(unittest.TestCase):
         self.assertEqual([x[1] for x in st], ["o", "s", "o", "s"])
         self.assertEqual(len(set(st)), 4)
 
+    def test_families_get_line_styles_and_scene_sets_panels(self):
+        s = [dict(series("cvfh", "warehouse", [1, 1]), family="global"),
+             dict(series("shot", "warehouse", [1, 1]), family="local"),
+             dict(series("cvfh", "table", [1, 1]), family="global"),
+             dict(series("shot", "table", [1, 1]), family="local")]
+        st = plot.styles(s)
+        self.assertEqual([x[0] for x in st], ["-", "--", "-", "--"])  # global solid, local dashed
+        self.assertEqual([x[1] for x in st], ["o", "s", "o", "s"])
+        self.assertEqual([(sc, [x["method"] for x in part]) for sc, part in plot.panels(s)],
+                         [("warehouse", ["cvfh", "shot"]), ("table", ["cvfh", "shot"])])
+        self.assertEqual(plot.panels(s[:1] and [series("a", "x", [1, 1])])[0][0], "")  # no family: one row
+
     def test_log_axis_only_across_a_decade(self):
         self.assertFalse(plot.log_time_axis([series("a", "s", [0.1, 0.9])]))
         self.assertTrue(plot.log_time_axis([series("a", "s", [0.1, 0.5]), series("b", "s", [2.0, None])]))
