@@ -48,6 +48,15 @@ KIND = {"astra": "structured_light", "kinect_one": "time_of_flight"}
 # converted with (src/render/sensor.cpp: Intrinsics::from_fov(640, 480, 59, 46)).
 ASTRA_FX = 320.0 / math.tan(math.radians(29.5))
 ASTRA_BASELINE_MM = 75.0
+# The models before the fit, given explicitly so that "before" does not depend
+# on the defaults of the binary that runs the fit.
+OLD_DEFAULTS = {
+    "astra": {"model": "structured_light", "baseline_mm": 75.0, "disparity_step_px": 0.125,
+              "disparity_sigma_px": 0.05, "smoothing_radius_px": 1, "smoothing_edge_px": 1.0,
+              "max_incidence_deg": 75.0, "shadows": True},
+    "kinect_one": {"model": "tof", "sigma_base_mm": 1.5, "sigma_per_m2_mm": 0.75, "edge_jump_mm": 30.0,
+                   "flying_fraction": 1.0, "max_incidence_deg": 80.0},
+}
 NOISE_BINS = (500.0, 4000.0)  # depth range the noise is fitted over
 QUANT_MIN_Z = 1500.0          # below, the real sensor's 1 mm output rounding hides the step
 
@@ -138,7 +147,7 @@ def fit_astra(real, posebench, quick):
     q = quant_per_z2(real)
     step = round(q * ASTRA_FX * ASTRA_BASELINE_MM, 4)
     print("real quantization: step = %.3g z^2 /mm -> disparity_step_px %.4f" % (q, step))
-    base = {"model": "structured_light", "disparity_step_px": step}
+    base = dict(OLD_DEFAULTS["astra"], disparity_step_px=step)
     evaluate = lambda c: simulate("astra", dict(base, **c), posebench, images)  # noqa: E731
     coarse = [{"disparity_sigma_px": s, "smoothing_radius_px": r}
               for r in (0, 1, 2, 3)
@@ -210,8 +219,10 @@ def main(argv=None):
               "measurement": {k: getattr(sensor_stats, k) for k in
                               ("P", "JUMP_REL", "JUMP_MM", "B", "EDGE_R", "EDGE_REL", "EDGE_MM", "MIN_LEVELS")}}
     final_images, final_seed = (8, 4242) if args.quick else (24, 4242)
-    before = simulate(args.sensor, None, args.posebench, final_images, final_seed)
-    report["simulated_old_defaults"] = before
+    report["old_defaults"] = OLD_DEFAULTS[args.sensor]
+    before = simulate(args.sensor, OLD_DEFAULTS[args.sensor], args.posebench, final_images, final_seed)
+    before_label = "old defaults" if sources else "current (uncalibrated) defaults"
+    report["simulated_" + before_label.split(" (")[0].replace(" ", "_")] = before
     real = None
     if not sources:
         report["status"] = ("not calibrated: no real %s depth frames were found (see README.md); the model "
@@ -238,7 +249,7 @@ def main(argv=None):
         json.dump(report, f, indent=1)
         f.write("\n")
     series = [(real, "real", "k", "o")] if real else []
-    series.append((before, "simulated, old defaults", "tab:red", "x"))
+    series.append((before, "simulated, " + before_label, "tab:red", "x"))
     if real:
         series.append((report["simulated_fitted"], "simulated, fitted", "tab:blue", "s"))
     plot(os.path.join(args.out, "fit_%s.png" % args.sensor), "%s: real vs simulated depth statistics" % args.sensor,
