@@ -42,18 +42,26 @@ struct GaussianNoise {
 // Structured light (Astra-like): depth from quantized disparity with a
 // projector baseline, so the error grows with z^2; local smoothing; no depth
 // in projector shadows and at grazing angles.
+// Defaults: fitted to real PrimeSense-class frames (Kinect v1 / Xtion, the
+// Astra's technology) by scripts/fit_sensors.py, results/sensors/fit_astra.json
+// (disparity_step_px from the measured depth steps, 2.87e-6 z^2 per mm, times
+// this profile's fx * baseline; disparity_sigma_px and smoothing_radius_px
+// from the plane-fit noise per depth bin, 0.5-4 m; max_incidence_deg from the
+// missing rate per incidence angle). Before the fit: 0.125, 0.05, 1, 75.
 struct StructuredLightNoise {
   double baseline_mm = 75.0;         // projector-camera baseline along +x
-  double disparity_step_px = 0.125;  // disparity quantization (1/8 px subpixel step)
-  double disparity_sigma_px = 0.05;  // Gaussian jitter on disparity before smoothing and quantization
-  int smoothing_radius_px = 1;       // box smoothing of disparity over (2r+1)^2 valid neighbours
+  double disparity_step_px = 0.1216; // disparity quantization (about the 1/8 px subpixel step)
+  double disparity_sigma_px = 0.3;   // Gaussian jitter on disparity before smoothing and quantization
+  int smoothing_radius_px = 2;       // box smoothing of disparity over (2r+1)^2 valid neighbours
   double smoothing_edge_px = 1.0;    // neighbours whose true disparity differs more are not averaged
-  double max_incidence_deg = 75.0;   // no depth beyond this angle between ray and normal
+  double max_incidence_deg = 80.0;   // no depth beyond this angle between ray and normal
   bool shadows = true;               // drop pixels the projector cannot see
 };
 
 // Time of flight (Kinect-One-like): distance-dependent noise, flying pixels
-// at depth edges, no depth at grazing angles.
+// at depth edges, no depth at grazing angles. Defaults from the literature,
+// NOT calibrated: no real time-of-flight frames could be had
+// (results/sensors/fit_kinect_one.json, results/sensors/README.md).
 struct TimeOfFlightNoise {
   double sigma_base_mm = 1.5;        // sigma = base + per_m2 * (z/1000)^2
   double sigma_per_m2_mm = 0.75;     // growth of sigma per squared metre of depth
