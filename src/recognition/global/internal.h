@@ -20,7 +20,7 @@ struct Signature {
   Vec3f centroid = Vec3f::Zero();  // centroid of the described region
   // Unit "viewing direction" fixing 2 rotational DoF: the negated mean
   // normal of a stable region (CVFH, CESF), or the direction from the camera
-  // to the centroid (whole-cluster ESF, CVFH without stable regions).
+  // to the centroid (whole-cluster ESF; CVFH and CESF without stable regions).
   Vec3f axis = Vec3f::UnitZ();
   bool from_normal = false;        // axis is a (negated) mean normal
   // OUR-CVFH: the semi-global reference frame, camera -> frame (mm).

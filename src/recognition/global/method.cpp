@@ -5,7 +5,8 @@
 // Online, per image (THESIS.md "Global pipeline"):
 //  1. describe: Euclidean clusters of the preprocessed scene, then the
 //     method's signatures per cluster (CVFH / OUR-CVFH / CESF: one per stable
-//     region; ESF: one per cluster);
+//     region, or, without one, one of the whole cluster; ESF: one per
+//     cluster);
 //  2. match: L2 distance of every scene signature to every model signature;
 //     the top_k pairs overall, ordered by distance, then view, then model
 //     signature, then scene signature (deterministic);
@@ -96,6 +97,10 @@ std::vector<Signature> describe(Kind kind, const PointSet& cloud, const GlobalSe
     }
     case Kind::kCesf: {
       const auto regions = global::stable_regions(cloud, g);
+      // No stable region large enough: as CVFH (pcl::CVFHEstimation falls
+      // back to the VFH of all the cloud's points), the ESF of the whole
+      // cloud, posed like ESF's (centroid, camera-to-centroid axis).
+      if (regions.empty()) return describe(Kind::kEsf, cloud, g, seed);
       for (size_t r = 0; r < regions.size(); ++r) {
         Rng rng(derive_seed(seed, {r + 1}));
         Signature s;
@@ -129,7 +134,9 @@ Mat3 nearest_rotation(const Mat3& M) {
 }
 
 constexpr char kMagic[8] = {'P', 'B', 'G', 'L', 'O', 'B', 'A', 'L'};
-constexpr uint32_t kVersion = 2;
+// 3: CESF falls back to the whole cloud's ESF when it has no stable region
+// (states of version 2 lack those signatures: retrained).
+constexpr uint32_t kVersion = 3;
 
 class GlobalMethod : public Method {
  public:
