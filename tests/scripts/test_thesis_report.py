@@ -525,6 +525,33 @@ class Runs(unittest.TestCase):
         self.assertIn("%s: line 2: not `DATE TIME WALL_SECONDS RAN JOBS LOAD15`" % path, str(c.exception))
 
 
+class Table49(unittest.TestCase):
+    """The thesis's protocol for Table 4.9: only images where some method is
+    correct; accuracy as the std over the correct trials, mean and max beside."""
+
+    @staticmethod
+    def rec(im, method, correct, t=1.0, q=1e-4):
+        return {"scene": "w", "scene_id": 1, "im_id": im, "refinement": method, "correct": correct,
+                "errors": {"translation_mm": t, "rotation_1mpq": q}}
+
+    def test_images_no_method_solves_are_left_out_elsewhere_kept(self):
+        recs = [self.rec(0, "icp", True), self.rec(0, "ndt", False), self.rec(1, "icp", False),
+                self.rec(1, "ndt", False)]
+        self.assertEqual([(r["im_id"], r["refinement"]) for r in thesis_report.thesis_protocol("4.9", recs)],
+                         [(0, "icp"), (0, "ndt")])
+        self.assertEqual(thesis_report.thesis_protocol("4.1", recs), recs)
+
+    def test_accuracy_is_the_std_over_correct_trials(self):
+        recs = [self.rec(0, "icp", True, 2.0), self.rec(1, "icp", True, 4.0), self.rec(2, "icp", False, 90.0),
+                self.rec(0, "icp_plane", True, 1.0), self.rec(1, "icp_plane", True, 1.0),
+                self.rec(2, "icp_plane", False), self.rec(3, "icp", False), self.rec(3, "icp_plane", False)]
+        x = thesis_report.Experiment("table_4_9", {"refinements": ["icp", "icp_plane"]}, recs)
+        text = thesis_report.registration_accuracy({"table_4_9": x}, "table_4_9")[0]
+        self.assertIn("Over the 2 images where at least one method is correct", text)
+        self.assertIn("icp (2 correct): translation std 1.00 mm (mean 3.00, max 4.00)", text)
+        self.assertIn("icp_plane (2 correct): translation std 0.00 mm (mean 1.00, max 1.00)", text)
+
+
 class Carton(unittest.TestCase):
     def test_records_without_judgements_give_a_dash_and_a_note(self):
         run = Run(lambda raw: write_records(raw, "table_4_5", [
