@@ -479,6 +479,11 @@ DIFFERENCES = [
     "4.5 for both judgments).",
     "ESF is the project's own seeded implementation (PCL's ESFEstimation reseeds the C generator from the clock); "
     "the thesis used PCL's.",
+    "CESF follows the thesis's definition (CVFH's stable regions after high-curvature removal, an ESF per region, "
+    "the CRH roll), and, as CVFH, describes a cloud without a stable region by the ESF of all of it. Why it trails "
+    "CVFH (an ESF of one smooth region looks like a smooth region of a distractor, so the right pair ranks below "
+    "the top 5) and why Table 4.9's accuracy order is inverted (reciprocal correspondences) is measured in "
+    "`results/thesis/FINDINGS.md`.",
     "Times are wall-clock seconds of the online computation of one image (training views excluded: they are "
     "rendered and described once and cached), single-threaded, on this shared machine.",
 ]
