@@ -10,25 +10,13 @@ local descriptors, as the thesis's Figures 4.7 and 4.11), a line style per
 family and one row of panels per scene set; the time axis is logarithmic
 when the times span more than a decade."""
 import json
-import math
 import os
 import sys
 
-Z95 = 1.959963984540054
+from thesis_stats import wilson  # the 95% band, as the tables' intervals
+
 LINE_STYLES = ["-", "--", ":", "-."]
 MARKERS = ["o", "s", "^", "D", "v", "P", "X", "*", "<", ">"]
-
-
-def wilson(k, n, z=Z95):
-    """The Wilson score interval of k successes in n trials, as (lo, hi);
-    (0, 1) for n = 0 (eval/stats.h computes the same)."""
-    if n <= 0:
-        return 0.0, 1.0
-    p = k / n
-    d = 1 + z * z / n
-    c = (p + z * z / (2 * n)) / d
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
-    return max(0.0, c - h), min(1.0, c + h)
 
 
 def styles(series):
