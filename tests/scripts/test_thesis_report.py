@@ -429,27 +429,26 @@ class Scorecard(unittest.TestCase):
 
 
 class BadInput(unittest.TestCase):
-    def test_a_missing_thesis_value_names_file_and_field(self):
-        def blank(raw):
-            path = os.path.join(raw, "table_4_1", "report.csv")
+    @staticmethod
+    def edit_report_csv(experiment, old, new):
+        """A fixture edit: `old` replaced by `new` in EXPERIMENT/report.csv."""
+        def edit(raw):
+            path = os.path.join(raw, experiment, "report.csv")
             with open(path) as f:
                 text = f.read()
             with open(path, "w") as f:
-                f.write(text.replace("robustness,cvfh,0.5,0.43,", "robustness,cvfh,0.5,,"))
-        run = Run(blank)
+                f.write(text.replace(old, new))
+        return edit
+
+    def test_a_missing_thesis_value_names_file_and_field(self):
+        run = Run(self.edit_report_csv("table_4_1", "robustness,cvfh,0.5,0.43,", "robustness,cvfh,0.5,,"))
         self.assertEqual(run.code, 2, run.err)
         self.assertIn("table_4_1/report.csv: no thesis value (field 'thesis') for scenario table_synthetic, measure "
                       "robustness, method cvfh", run.err)
         self.assertEqual(run.lines, [])
 
     def test_a_thesis_value_not_a_number(self):
-        def garble(raw):
-            path = os.path.join(raw, "table_4_5", "report.csv")
-            with open(path) as f:
-                text = f.read()
-            with open(path, "w") as f:
-                f.write(text.replace("robustness,fpfh,0,0.16,", "robustness,fpfh,0,16%,"))
-        run = Run(garble)
+        run = Run(self.edit_report_csv("table_4_5", "robustness,fpfh,0,0.16,", "robustness,fpfh,0,16%,"))
         self.assertEqual(run.code, 2, run.err)
         self.assertIn("table_4_5/report.csv: line 3: field 'thesis' is not a number: '16%'", run.err)
 
