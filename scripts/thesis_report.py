@@ -1107,6 +1107,25 @@ def scorecard(cells):
         ("tables", tables), ("total", total), ("variants", variants)])
 
 
+SCORECARD_BEFORE = "scorecard_before.json"
+BEFORE_TEXT = (
+    "The line \"before issue 10\" is the same scorecard of the run before the set-up changes (`%s` beside this "
+    "README: 10 images per cell, training views at 0 and 20 degrees, a floor and a wall in the warehouse, the "
+    "Astra before its calibration, occluded targets 40-90%% visible, CESF without its fallback).")
+
+
+def scorecard_before(res):
+    """The totals of OUT/scorecard_before.json (the run before issue 10's set-up changes), or None."""
+    path = os.path.join(os.path.dirname(res.raw.rstrip(os.sep)), SCORECARD_BEFORE)
+    try:
+        with open(path) as f:
+            total = json.load(f)["total"]
+        return total if all(k in total for k in ("cells", "within_15", "significant_05", "significant_01", "rows",
+                                                  "best_agrees", "tau_positive", "mean_ours", "mean_thesis")) else None
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
 def section_agreement(res, cells, card):
     if not card["tables"] and not card["variants"]:
         return []
@@ -1129,6 +1148,9 @@ def section_agreement(res, cells, card):
     t = card["total"]
     if t["cells"]:
         o.append(line("**total** (of the thesis's %d)" % t["of"], t))
+    before = scorecard_before(res)
+    if before and t["cells"]:
+        o.append(line("total before issue 10 (`%s`)" % os.path.basename(SCORECARD_BEFORE), before))
     if card["variants"]:
         o += ["", "Not counted above (the same comparison, against the thesis's values of the table named):\n",
               "| variant | cells | within 15 points | p < 0.05 | p < 0.01 | rows | best agrees | tau > 0 | mean, ours "
@@ -1136,6 +1158,8 @@ def section_agreement(res, cells, card):
         o += [line("Table %s: %s%s" % (v["table"], v["experiment"], ", judged faces on faces (the thesis's "
                                        "judgement)" if v["measure"] == FACES else ""), v) for v in card["variants"]]
     o += ["", inexact_text(cells), ""]
+    if scorecard_before(res) and t["cells"]:
+        o += [BEFORE_TEXT % SCORECARD_BEFORE, ""]
     return o
 
 

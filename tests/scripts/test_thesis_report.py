@@ -428,6 +428,21 @@ class Scorecard(unittest.TestCase):
         self.assertFalse(thesis_report.best_agrees([cell(0.9, 0.1), cell(0.1, 0.9)]))
 
 
+class ScorecardBefore(unittest.TestCase):
+    def test_the_before_totals_are_printed_beside_when_the_file_is_there(self):
+        before = {"of": 107, "cells": 107, "within_15": 33, "significant_05": 51, "significant_01": 42, "rows": 23,
+                  "best_agrees": 10, "tau_positive": 11, "mean_ours": 0.4075, "mean_thesis": 0.3698}
+
+        def put(raw):
+            with open(os.path.join(os.path.dirname(raw), "scorecard_before.json"), "w") as f:
+                json.dump({"total": before}, f)
+        run = Run(put)
+        self.assertEqual(run.code, 0, run.err)
+        self.assertIn("| total before issue 10 (`scorecard_before.json`) | 107 | 33 | 51 | 42 | 23 | 10 | 11 | 41% | "
+                      "37% |", run.lines)
+        self.assertFalse(any("total before issue 10" in line for line in Run().lines))
+
+
 class BadInput(unittest.TestCase):
     @staticmethod
     def edit_report_csv(experiment, old, new):
