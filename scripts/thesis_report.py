@@ -1040,6 +1040,22 @@ def inexact_text(cells):
             "test is approximate there." % (len(bad), len([c for c in cells if c.main]), "; ".join(fits)))
 
 
+def direction_text(cells):
+    """Of the main cells outside 15 points, how many lie above the thesis's
+    value and how many below, per method: which way the gaps go."""
+    out = [c for c in cells if c.main and c.within is False]
+    if not out:
+        return ""
+    above = [c for c in out if c.ours > c.thesis]
+    per = collections.OrderedDict()
+    for c in out:
+        per.setdefault(c.method, [0, 0])[0 if c.ours > c.thesis else 1] += 1
+    return ("Which way the gaps go: of the %d cells outside 15 points, %d are above the thesis's value (ours more "
+            "robust) and %d below; per method (above / below): %s." % (
+                len(out), len(above), len(out) - len(above),
+                ", ".join("%s %d / %d" % (m, a, b) for m, (a, b) in per.items())))
+
+
 # ---- the scorecard -----------------------------------------------------------------------
 
 def rows_of(cells):
@@ -1158,6 +1174,8 @@ def section_agreement(res, cells, card):
         o += [line("Table %s: %s%s" % (v["table"], v["experiment"], ", judged faces on faces (the thesis's "
                                        "judgement)" if v["measure"] == FACES else ""), v) for v in card["variants"]]
     o += ["", inexact_text(cells), ""]
+    if direction_text(cells):
+        o += [direction_text(cells), ""]
     if scorecard_before(res) and t["cells"]:
         o += [BEFORE_TEXT % SCORECARD_BEFORE, ""]
     return o

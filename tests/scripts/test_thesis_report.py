@@ -443,6 +443,19 @@ class ScorecardBefore(unittest.TestCase):
         self.assertFalse(any("total before issue 10" in line for line in Run().lines))
 
 
+class Direction(unittest.TestCase):
+    def test_cells_outside_15_points_are_counted_above_and_below(self):
+        def cell(method, k, thesis):
+            return thesis_report.Cell("4.1", "table_4_1", "main", "s", "robustness", method, k, 10, thesis=thesis,
+                                      thesis_n=30)
+        text = thesis_report.direction_text([cell("esf", 9, 0.0), cell("shot", 10, 0.1), cell("cvfh", 1, 0.73),
+                                             cell("cesf", 5, 0.55)])
+        self.assertEqual(text, "Which way the gaps go: of the 3 cells outside 15 points, 2 are above the thesis's "
+                               "value (ours more robust) and 1 below; per method (above / below): esf 1 / 0, shot 1 "
+                               "/ 0, cvfh 0 / 1.")
+        self.assertEqual(thesis_report.direction_text([cell("cesf", 5, 0.55)]), "")
+
+
 class BadInput(unittest.TestCase):
     @staticmethod
     def edit_report_csv(experiment, old, new):
