@@ -506,8 +506,10 @@ def experiment_row(res, e):
     st = {}
     for r in x.records:
         st[r["status"]] = st.get(r["status"], 0) + 1
-    return "| %s | `configs/thesis/%s.yaml` | %s | %s | %d | %s | %s | %s |" % (
-        short_title(e), e, res.images_of(e), trials_per_cell(res, e), len(x.records),
+    config = ("`configs/thesis/ablations.yaml` (derived: `raw/configs/%s.yaml`)" % e if e in res.ablation_only
+              else "`configs/thesis/%s.yaml`" % e)
+    return "| %s | %s | %s | %s | %d | %s | %s | %s |" % (
+        short_title(e), config, res.images_of(e), trials_per_cell(res, e), len(x.records),
         ", ".join("%s %d" % kv for kv in sorted(st.items())),
         fmt_dur(x.runs.seconds) if x.runs.seconds else "-", "/".join("%.1f" % l for l in x.runs.loads) or "-")
 
