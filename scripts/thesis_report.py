@@ -424,7 +424,8 @@ def section_reproduce():
     return [
         "## Reproduce\n",
         "```sh\ncmake -S . -B build -DCMAKE_BUILD_TYPE=Release && cmake --build build --target posebench\n"
-        "scripts/thesis.sh            # all experiments; resumable (re-running does only what is missing)\n"
+        "scripts/thesis.sh --ablations   # all experiments and the ablations; resumable (re-running does only what "
+        "is missing)\n"
         "scripts/thesis.sh --only table_4_1 --jobs 2    # one experiment\n"
         "scripts/thesis.sh --readme-only                # rewrite this file from the raw records\n"
         "scripts/thesis_report.py results/thesis EXPERIMENT... --scorecard-json FILE  # the scorecard and verdicts "
