@@ -429,9 +429,7 @@ std::vector<Trial> expand_trials(const ExperimentConfig& cfg) {
     for (size_t i = first; i < trials.size(); ++i) {
       const auto& v = trials[i].settings;
       if (v.contains("views") && v["views"].is_object() && v["views"].value("follow_scene", false)) {
-        ViewSettings probe;
-        probe.follow_scene = true;
-        views_for_scene_set(probe, src.dataset);
+        scene_set_elevation_deg(src.dataset);  // InputError naming the file and the field
         break;
       }
     }

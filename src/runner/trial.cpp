@@ -29,6 +29,7 @@ struct WorkerCache {
   std::map<std::string, std::unique_ptr<Mesh>> meshes;
   std::map<std::string, std::unique_ptr<DepthRenderer>> renderers;  // by intrinsics, for VSD
   std::map<std::string, DepthImage> first_depths;  // each scene's first image (the sensor's floor)
+  std::map<std::string, double> view_elevations;   // views.follow_scene: each scene set's, read once
 };
 WorkerCache& cache() {
   static WorkerCache c;
@@ -63,7 +64,12 @@ std::shared_ptr<const TrainedModel> trained(const BopDataset& ds, int obj_id, co
   // The views as rendered (views.follow_scene resolved for this scene set):
   // the training key and the cache name the elevations actually used.
   RecognitionSettings use = st;
-  use.views = views_for_scene_set(st.views, ds.root());
+  if (st.views.follow_scene) {
+    auto it = cache().view_elevations.find(ds.root());
+    if (it == cache().view_elevations.end())
+      it = cache().view_elevations.emplace(ds.root(), scene_set_elevation_deg(ds.root())).first;
+    use.views = views_at_elevation(st.views, it->second);
+  }
   const std::string train_key = ds.root() + "#" + std::to_string(obj_id) + "#" + settings_to_json(use);
   auto& model = cache().models[train_key];
   bool from_cache = model != nullptr;

@@ -44,8 +44,7 @@ std::vector<Vec3> view_directions(const ViewSettings& s) {
   return dirs;
 }
 
-ViewSettings views_for_scene_set(const ViewSettings& settings, const std::string& dataset_root) {
-  if (!settings.follow_scene) return settings;
+double scene_set_elevation_deg(const std::string& dataset_root) {
   const std::string path = (std::filesystem::path(dataset_root) / "posebench_scene.json").string();
   const std::string field = "settings.camera.elevation_deg";
   std::ifstream in(path);
@@ -68,10 +67,18 @@ ViewSettings views_for_scene_set(const ViewSettings& settings, const std::string
   const double lo = (*e)[0].get<double>(), hi = (*e)[1].get<double>();
   if (!(lo >= -90 && hi <= 90 && lo <= hi))
     throw InputError(path, field, "must be [low, high] within [-90, 90], got " + e->dump());
+  return 0.5 * (lo + hi);
+}
+
+ViewSettings views_at_elevation(const ViewSettings& settings, double elevation_deg) {
   ViewSettings out = settings;
-  out.elevation_deg = out.side_elevation_deg = 0.5 * (lo + hi);
+  out.elevation_deg = out.side_elevation_deg = elevation_deg;
   out.follow_scene = false;
   return out;
+}
+
+ViewSettings views_for_scene_set(const ViewSettings& settings, const std::string& dataset_root) {
+  return settings.follow_scene ? views_at_elevation(settings, scene_set_elevation_deg(dataset_root)) : settings;
 }
 
 std::vector<TrainingView> render_training_views(const Mesh& mesh, const ViewSettings& s) {

@@ -26,6 +26,11 @@ std::vector<TrainingView> render_training_views(const Mesh& mesh, const ViewSett
 // field when the set has no such file or range (e.g. a BOP data set not made
 // by `posebench generate`).
 ViewSettings views_for_scene_set(const ViewSettings& settings, const std::string& dataset_root);
+// Its two halves: the middle of the set's camera elevation range (reads
+// ROOT/posebench_scene.json; the same InputError), and `settings` with the
+// ring and the single view at `elevation_deg` and follow_scene cleared.
+double scene_set_elevation_deg(const std::string& dataset_root);
+ViewSettings views_at_elevation(const ViewSettings& settings, double elevation_deg);
 
 // The training views recognition learns from (train_model): rendered, or
 // none with the reason when the mesh is empty or degenerate.
