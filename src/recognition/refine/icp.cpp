@@ -23,7 +23,13 @@
 //                    squared correspondence distance changing by less than
 //                    fitness_epsilon (relative) or 1e-12 (absolute); fewer
 //                    than 3 correspondences ends it unconverged.
-// Both use icp_sample_points (a seeded random subset of the source points).
+// Both use icp_sample_points (a seeded random subset of the source points),
+// and, when the source has more than icp_coarse_points points, register in
+// two stages: a coarse one on a seeded random subset of icp_coarse_points of
+// them, until a stopping rule fires or all but icp_fine_iterations of the
+// iteration cap are used, then a fine one on all of them from there, for the
+// rest of the cap (the stopping rules start afresh). The total stays within
+// max_iterations.
 // Frame and units: internal.h (metres, local frame).
 #include <Eigen/Dense>
 #include <algorithm>
@@ -142,26 +148,26 @@ Mat4 step_plane(const std::vector<Vec3f>& src, const std::vector<Vec3f>& tgt, co
 
 enum class Metric { kPoint, kPlane };
 
-Outcome icp(const Problem& p, const RefineSettings& s, uint64_t seed, Metric metric) {
-  Outcome o;
-  std::vector<Vec3f> src;
-  for (size_t i : sample_indices(p.src.size(), s.icp_sample_points, seed)) src.push_back(p.src[i]);
-  if (src.size() < 3 || p.tgt.size() < 3) return o;
-  const KdTree3 tgt_tree(p.tgt);
+// Iterates from T until a stopping rule fires or `cap` iterations have run
+// (o.iterations counts every stage's iterations; o.converged is the last
+// stage's).
+void iterate(const std::vector<Vec3f>& src, const Problem& p, const KdTree3& tgt_tree, const RefineSettings& s,
+             Metric metric, int cap, Mat4& T, Outcome& o) {
+  o.converged = false;
+  if (cap <= 0 || src.size() < 3) return;
   const KdTree3 src_tree = s.reciprocal_correspondences ? KdTree3(src) : KdTree3();
   const double rot_cos = std::cos(s.rotation_epsilon_deg * M_PI / 180.0);
-  Mat4 T = Mat4::Identity();
   double prev_mse = std::numeric_limits<double>::max();
   std::vector<Pair> c;
   std::vector<int> last(src.size(), -1);
-  while (true) {
+  for (int it = 0; it < cap;) {
     correspond(src, src_tree, p.tgt, tgt_tree, T, s, last, c);
     if (c.size() < 3) break;  // unconverged, the transform so far stands
     const Mat4 D = metric == Metric::kPoint ? step_point(src, p.tgt, T, c) : step_plane(src, p.tgt, p.tgt_normals, T, c);
     if (!D.allFinite()) break;
     T = D * T;
     ++o.iterations;
-    if (o.iterations >= s.max_iterations) break;  // the cap: not converged
+    if (++it >= cap) break;  // the cap: not converged
     const double cos_angle = 0.5 * (D.block<3, 3>(0, 0).trace() - 1.0);
     if (cos_angle >= rot_cos && D.block<3, 1>(0, 3).squaredNorm() <= s.transformation_epsilon) {
       o.converged = true;
@@ -176,6 +182,26 @@ Outcome icp(const Problem& p, const RefineSettings& s, uint64_t seed, Metric met
     }
     prev_mse = mse;
   }
+}
+
+Outcome icp(const Problem& p, const RefineSettings& s, uint64_t seed, Metric metric) {
+  Outcome o;
+  std::vector<Vec3f> src;
+  for (size_t i : sample_indices(p.src.size(), s.icp_sample_points, seed)) src.push_back(p.src[i]);
+  if (src.size() < 3 || p.tgt.size() < 3) return o;
+  const KdTree3 tgt_tree(p.tgt);
+  Mat4 T = Mat4::Identity();
+  int cap = s.max_iterations;
+  // Coarse stage: a seeded random subset of the source points, leaving the
+  // fine stage at least icp_fine_iterations of the cap.
+  const size_t coarse = static_cast<size_t>(std::max(0, s.icp_coarse_points));
+  if (coarse >= 3 && src.size() > coarse && cap > s.icp_fine_iterations) {
+    std::vector<Vec3f> sub;
+    for (size_t i : sample_indices(src.size(), static_cast<int>(coarse), derive_seed(seed, {1}))) sub.push_back(src[i]);
+    iterate(sub, p, tgt_tree, s, metric, cap - s.icp_fine_iterations, T, o);
+    cap -= o.iterations;
+  }
+  iterate(src, p, tgt_tree, s, metric, cap, T, o);
   o.delta = T.cast<float>();
   return o;
 }

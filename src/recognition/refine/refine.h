@@ -28,6 +28,13 @@ struct RefineSettings {
                                            // them robust to surface seen in one cloud only
   int icp_sample_points = 0;               // icp, icp_plane (and icp_pcl): seeded random subset of
                                            // this many source points (0 = all)
+  int icp_coarse_points = 1000;            // icp, icp_plane: a source of more points is registered
+                                           // coarse to fine: first a seeded random subset of this
+                                           // many, then all of them from there (0 = one stage on
+                                           // all, as PCL)
+  int icp_fine_iterations = 10;            // ... of max_iterations, at least this many are left to
+                                           // the fine stage (the coarse one stops earlier on a
+                                           // stopping rule and leaves it the rest)
   double ndt_resolution_mm = 30.0;         // NDT grid cell, at least this (a planar cell needs about
                                            // 6 scene points: >= 2.5 x the scene voxel; 30 mm for the
                                            // table's 10 mm voxel)
@@ -63,6 +70,8 @@ struct RefineSettings {
     f("fitness_epsilon", s.fitness_epsilon, fields::nonnegative());
     f("reciprocal_correspondences", s.reciprocal_correspondences);
     f("icp_sample_points", s.icp_sample_points, fields::at_least(0));
+    f("icp_coarse_points", s.icp_coarse_points, fields::at_least(0));
+    f("icp_fine_iterations", s.icp_fine_iterations, fields::at_least(1));
     f("ndt_resolution_mm", s.ndt_resolution_mm, fields::length(fields::positive()));
     f("ndt_resolution_fraction", s.ndt_resolution_fraction, fields::nonnegative());
     f("ndt_step_size_mm", s.ndt_step_size_mm, fields::length(fields::positive()));
