@@ -137,6 +137,58 @@ TEST(Preprocess, MaxPlanesRemovesFloorAndWall) {
   EXPECT_GT(count_near(two, on_ball), 400);
 }
 
+// A table seen through heavy noise (Gaussian, sigma 20 mm along the view
+// axis, twice the 10 mm plane threshold) with a box standing on it: the fixed
+// threshold leaves most of the table (its points beyond 10 mm); widened to
+// plane_noise_factor x the noise measured behind the plane, the table goes
+// (2 sigma: about 5% of it left) and the box above that band stays. On a
+// clean table (sigma 1 mm) the widening changes nothing.
+TEST(Preprocess, PlaneNoiseFactorRemovesANoisyTableWhole) {
+  const auto scene = [](double sigma) {
+    pb::OrganizedCloud cloud;
+    pb::Rng rng(8);
+    for (int i = 0; i < 20000; ++i)  // table z = 1000 (seen from above), noise along z
+      cloud.points.emplace_back(rng.uniform(-400, 400), rng.uniform(-400, 400), 1000 + rng.normal(0, sigma));
+    for (int i = 0; i < 2000; ++i)  // a box 100 x 100 x 150 mm on it: its top and sides
+      cloud.points.emplace_back(rng.uniform(-50, 50), rng.uniform(-50, 50), rng.uniform(850, 1000));
+    cloud.width = static_cast<int>(cloud.points.size());
+    cloud.height = 1;
+    return cloud;
+  };
+  pb::PreprocessSettings s;
+  s.voxel_mm = 0;
+  s.plane_threshold_mm = 10;
+  s.normal_radius_mm = 30;
+  const auto table_left = [](const PointSet& ps) {
+    int n = 0;
+    for (const auto& p : ps.points) n += std::abs(p.x()) > 60 || std::abs(p.y()) > 60;
+    return n;
+  };
+  const auto box_top = [](const PointSet& ps) {  // box points more than 60 mm above the table
+    int n = 0;
+    for (const auto& p : ps.points) n += std::abs(p.x()) < 50 && std::abs(p.y()) < 50 && p.z() < 940;
+    return n;
+  };
+  const pb::OrganizedCloud noisy = scene(20);
+  // The noise measured behind the plane z = 1000 (normal toward the camera).
+  std::vector<Vec3f> table(noisy.points.begin(), noisy.points.begin() + 20000);
+  EXPECT_NEAR(pb::detail::plane_noise_sigma(table, Eigen::Vector4d(0, 0, -1, 1000), 100), 20, 1.5);
+  s.plane_noise_factor = 0;
+  const PointSet fixed = pb::preprocess_scene(noisy, s, 1);
+  s.plane_noise_factor = 2;
+  const PointSet wide = pb::preprocess_scene(noisy, s, 1);
+  EXPECT_GT(table_left(fixed), 10000);  // 62% of the table lies beyond 10 mm
+  EXPECT_LT(table_left(wide), 1500);    // 4.6% beyond 2 sigma, of about 19400
+  EXPECT_GT(box_top(wide), 700);        // 60 of the box's 150 mm
+  // A clean table: the measured 1 mm x 2 is below the threshold.
+  const pb::OrganizedCloud clean = scene(1);
+  s.plane_noise_factor = 0;
+  const PointSet a = pb::preprocess_scene(clean, s, 1);
+  s.plane_noise_factor = 2;
+  const PointSet b = pb::preprocess_scene(clean, s, 1);
+  EXPECT_EQ(a.points, b.points);
+}
+
 // Normals by PCA in a radius: exact on a plane (zero curvature) and on a
 // sphere (radial, curvature about r^2 / (8 R^2) of the neighbourhood),
 // toward the viewpoint; points without 3 neighbours are dropped.

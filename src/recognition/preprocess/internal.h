@@ -26,6 +26,14 @@ std::vector<char> ransac_plane(const std::vector<Vec3f>& points, double threshol
                                uint64_t seed, Eigen::Vector4d* plane = nullptr, int sample_points = 0,
                                double probability = 1.0);
 
+// The plane's noise seen from the camera at the origin: sigma estimated from
+// the points behind `plane` (on the far side from the origin) within `band`
+// of it, which only the plane's own noise puts there, as their median
+// distance / 0.6745 (a half-normal's). 0 when fewer than `min_points` lie
+// there.
+double plane_noise_sigma(const std::vector<Vec3f>& points, const Eigen::Vector4d& plane, double band,
+                         size_t min_points = 30);
+
 // Normals by PCA of the neighbours within `radius_mm` (the point included, as
 // pcl::NormalEstimation; the project's kd-tree, OpenMP threads per
 // omp_get_max_threads(), the same result for any count), flipped toward the

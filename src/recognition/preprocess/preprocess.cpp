@@ -146,6 +146,21 @@ std::vector<char> ransac_plane(const std::vector<Vec3f>& all, double thr, int it
   return flags;
 }
 
+double plane_noise_sigma(const std::vector<Vec3f>& pts, const Eigen::Vector4d& plane, double band,
+                         size_t min_points) {
+  // Signed distance, positive on the origin's side.
+  const double sign = plane[3] >= 0 ? 1.0 : -1.0;
+  std::vector<double> behind;
+  for (const auto& p : pts) {
+    const double d = sign * (plane.head<3>().dot(p.cast<double>()) + plane[3]);
+    if (d < 0 && d > -band) behind.push_back(-d);
+  }
+  if (behind.size() < min_points) return 0;
+  const auto mid = behind.begin() + static_cast<std::ptrdiff_t>(behind.size() / 2);
+  std::nth_element(behind.begin(), mid, behind.end());
+  return *mid / 0.6745;
+}
+
 }  // namespace detail
 
 namespace {
@@ -174,9 +189,18 @@ PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings&
   if (s.remove_plane) {
     const double min_count = s.min_plane_fraction * static_cast<double>(ps.size());
     for (int k = 0; k < s.max_planes && ps.size() >= 3; ++k) {
-      const std::vector<char> on_plane = detail::ransac_plane(ps.points, s.plane_threshold_mm, s.plane_iterations,
-                                                              k == 0 ? seed : derive_seed(seed, {static_cast<uint64_t>(k)}), nullptr,
-                                                              s.plane_sample_points, s.plane_probability);
+      Eigen::Vector4d plane;
+      std::vector<char> on_plane = detail::ransac_plane(ps.points, s.plane_threshold_mm, s.plane_iterations,
+                                                        k == 0 ? seed : derive_seed(seed, {static_cast<uint64_t>(k)}),
+                                                        &plane, s.plane_sample_points, s.plane_probability);
+      if (s.plane_noise_factor > 0 && std::count(on_plane.begin(), on_plane.end(), 1) >= 3) {
+        // A plane noisier than the threshold: widen it to factor x sigma.
+        const double band = kPlaneNoiseBand * s.plane_threshold_mm;
+        const double wide = s.plane_noise_factor * detail::plane_noise_sigma(ps.points, plane, band);
+        if (wide > s.plane_threshold_mm)
+          for (size_t i = 0; i < ps.size(); ++i)
+            on_plane[i] = std::abs(plane.head<3>().dot(ps.points[i].cast<double>()) + plane[3]) <= wide;
+      }
       const size_t cnt = static_cast<size_t>(std::count(on_plane.begin(), on_plane.end(), 1));
       if (cnt == 0 || static_cast<double>(cnt) < min_count) break;
       std::vector<char> keep(on_plane.size());
