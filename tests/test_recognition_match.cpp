@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "core/random.h"
 #include "recognition/local/internal.h"
@@ -133,6 +134,48 @@ TEST(DescriptorIndex, CappedChecksAreExactUntilTheCapBindsAndKeepAHighRecall) {
       EXPECT_LT(same, matched) << checks << " checks found every exact match";
     std::printf("[ recall   ] %d checks: %d of %d matched queries exact\n", checks, same, matched);
   }
+}
+
+
+
+// FPFH-sized rows (33, a FLANN kd-tree): the search bounded by the threshold
+// from the start gives what an unbounded k-nearest search gives once the rows
+// at or above the threshold are dropped (the k nearest under a threshold are
+// the k nearest overall that are under it), for several k and thresholds.
+TEST(DescriptorIndex, KdTreeSearchBoundedByTheThresholdEqualsTheUnboundedOne) {
+  constexpr int kFpfh = 33;
+  pb::Rng rng(11);
+  std::vector<float> data;
+  for (int r = 0; r < 3000; ++r)
+    for (int j = 0; j < kFpfh; ++j) data.push_back(static_cast<float>(rng.uniform(0, 30)));
+  pb::local::DescriptorIndex index;
+  index.build(data, kFpfh);
+  std::vector<float> queries;
+  for (int q = 0; q < 300; ++q) {
+    const int src = rng.uniform_int(0, 2999);
+    for (int j = 0; j < kFpfh; ++j)
+      queries.push_back(data[static_cast<size_t>(src) * kFpfh + j] + static_cast<float>(rng.normal(0, q % 2 ? 2 : 6)));
+  }
+  size_t found = 0, dropped = 0;
+  for (int k : {1, 3, 10}) {
+    for (float thr : {300.f, 1500.f, 4000.f}) {
+      for (int i = 0; i < 300; ++i) {
+        const float* q = queries.data() + static_cast<size_t>(i) * kFpfh;
+        std::vector<std::pair<int, float>> bounded, all;
+        index.knn(q, k, thr, bounded);
+        index.knn(q, k, std::numeric_limits<float>::infinity(), all);
+        ASSERT_EQ(all.size(), static_cast<size_t>(k));
+        std::vector<std::pair<int, float>> under;
+        for (const auto& e : all)
+          if (e.second < thr) under.push_back(e);
+        ASSERT_EQ(bounded, under) << "query " << i << " k " << k << " threshold " << thr;
+        found += under.size();
+        dropped += all.size() - under.size();
+      }
+    }
+  }
+  EXPECT_GT(found, 500u);    // not all empty
+  EXPECT_GT(dropped, 500u);  // and the threshold binds
 }
 
 }  // namespace

@@ -24,6 +24,7 @@
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 
 #include "recognition/local/internal.h"
 
@@ -234,7 +235,18 @@ void DescriptorIndex::knn(const float* query, int k, float max_sq_dist,
   flann::Matrix<float> md(dist.data(), 1, kk);
   flann::SearchParams params(-1, 0.0f, true);
   params.cores = 1;
-  const int found = impl_->index->knnSearch(q, mi, md, kk, params);
+  int found = 0;
+  if (std::isfinite(max_sq_dist)) {
+    // Bounded from the start by the threshold (KNNRadiusResultSet: the kk
+    // nearest strictly below it): the tree prunes every branch beyond it,
+    // where an unbounded k-nearest search narrows only as it finds rows (a
+    // scene keypoint with no model descriptor under the threshold visited
+    // most leaves). The same rows.
+    params.max_neighbors = static_cast<int>(kk);
+    found = impl_->index->radiusSearch(q, mi, md, max_sq_dist, params);
+  } else {
+    found = impl_->index->knnSearch(q, mi, md, kk, params);
+  }
   for (int i = 0; i < found && i < static_cast<int>(kk); ++i)
     if (dist[i] < max_sq_dist) out.emplace_back(static_cast<int>(idx[i]), dist[i]);
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
