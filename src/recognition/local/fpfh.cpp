@@ -16,7 +16,10 @@
 // chosen by comparing |cos| instead of the arccos of each, and the dot
 // products are summed over three coordinates instead of four.
 // A pair of needed points whose two directions give bit-identical features
-// is computed once (pair_features' `symmetric`). Each row depends on its own
+// is computed once (pair_features' `symmetric`). Each keypoint's
+// neighbourhood is searched once and serves three times: to find the points
+// that need an SPFH, as its own SPFH's list when it needs one, and for its
+// weighted sum (before: three searches). Each row depends on its own
 // neighbourhood only and SPFH bins are integer counts: the same result for
 // any thread count.
 #ifdef _OPENMP
@@ -108,9 +111,19 @@ inline void count_pair(float f1, float f2, float f3, uint32_t* c) {
 // order; every addition to a bin of point p adds the same 100 / (pairs of
 // p), so the float histogram is that value added count times, as PCL's loop
 // adds it.
+// Keypoints' neighbourhoods found before (Known): for a needed point that is
+// a keypoint its SPFH list is the keypoint's list without the point itself
+// (the same thinned set; SPFH counts do not depend on the order), so it is
+// not searched again.
+struct Known {
+  std::vector<int> slot;                                  // cloud index -> keypoint slot, or -1
+  std::vector<std::vector<std::pair<float, int>>> lists;  // per slot: thinned, sorted by distance
+  std::vector<size_t> found;                              // per slot: neighbours before thinning
+};
+
 std::vector<Hist> spfh_histograms(const PointSet& cloud, const CloudNeighbours& tree, float r2,
                                   const std::vector<int>& needed, const std::vector<int>& row_of, int max_support,
-                                  int nthreads) {
+                                  int nthreads, const Known& known) {
   const std::vector<Vec3f>& pts = cloud.points;
   const size_t rows = needed.size();
   std::vector<int> pairs_of(rows, 0);  // neighbours other than the point itself
@@ -119,8 +132,10 @@ std::vector<Hist> spfh_histograms(const PointSet& cloud, const CloudNeighbours& 
   // appended to `buf`; true when there were more than max_support.
   const auto spfh_neighbours = [&](size_t i, std::vector<std::pair<float, int>>& nn, std::vector<int>& buf) {
     const int p = needed[i];
-    const size_t found = tree.within(pts[p], r2, nn, false, max_support);
-    for (const auto& e : nn)
+    const int slot = known.slot[static_cast<size_t>(p)];
+    const auto& list = slot >= 0 ? known.lists[static_cast<size_t>(slot)] : nn;
+    const size_t found = slot >= 0 ? known.found[static_cast<size_t>(slot)] : tree.within(pts[p], r2, nn, false, max_support);
+    for (const auto& e : list)
       if (e.second != p) buf.push_back(e.second);
     return max_support > 0 && found > static_cast<size_t>(max_support);
   };
@@ -217,43 +232,57 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
   const int n = static_cast<int>(pts.size());
   const CloudNeighbours tree(pts);
   const float r2 = static_cast<float>(radius_mm * radius_mm);
-  // A keypoint's neighbours, thinned evenly in tree order to max_support as
-  // the SPFH rows are, then in order of distance (its weighted sum follows
-  // PCL's order).
-  const auto keypoint_neighbours = [&](int k, std::vector<std::pair<float, int>>& nn) {
-    tree.within(pts[k], r2, nn, true, max_support);
-  };
+  // A keypoint's neighbours are thinned evenly in tree order to max_support
+  // as the SPFH rows are, then put in order of distance (its weighted sum
+  // follows PCL's order).
   const int nthreads = omp_threads(threads);
 
-  // Which points need an SPFH: every (kept) neighbour of a (finite) keypoint.
+  // Every (finite) keypoint's neighbourhood, found once: it gives which
+  // points need an SPFH (every kept neighbour of a keypoint), the keypoint's
+  // own SPFH list and its weighted sum below.
+  Known known;
+  known.slot.assign(static_cast<size_t>(n), -1);
+  std::vector<int> slot_of_kp(keypoints.size(), -1), point_of_slot;
+  for (size_t i = 0; i < keypoints.size(); ++i) {
+    const int k = keypoints[i];
+    if (k < 0 || k >= n || !pts[k].allFinite()) continue;
+    int& slot = known.slot[static_cast<size_t>(k)];
+    if (slot < 0) {
+      slot = static_cast<int>(point_of_slot.size());
+      point_of_slot.push_back(k);
+    }
+    slot_of_kp[i] = slot;
+  }
+  known.lists.resize(point_of_slot.size());
+  known.found.assign(point_of_slot.size(), 0);
+#pragma omp parallel for schedule(dynamic, 16) num_threads(nthreads) if (point_of_slot.size() > 64)
+  for (long j = 0; j < static_cast<long>(point_of_slot.size()); ++j) {
+    const size_t slot = static_cast<size_t>(j);
+    known.found[slot] = tree.within(pts[point_of_slot[slot]], r2, known.lists[slot], true, max_support);
+  }
   std::vector<int> row_of(static_cast<size_t>(n), -1);
   std::vector<int> needed;
-  {
-    std::vector<std::pair<float, int>> nn;
-    for (int k : keypoints) {
-      if (k < 0 || k >= n || !pts[k].allFinite()) continue;
-      keypoint_neighbours(k, nn);
-      for (const auto& e : nn)
-        if (row_of[static_cast<size_t>(e.second)] < 0) {
-          row_of[static_cast<size_t>(e.second)] = static_cast<int>(needed.size());
-          needed.push_back(e.second);
-        }
-    }
+  for (size_t i = 0; i < keypoints.size(); ++i) {
+    if (slot_of_kp[i] < 0) continue;
+    for (const auto& e : known.lists[static_cast<size_t>(slot_of_kp[i])])
+      if (row_of[static_cast<size_t>(e.second)] < 0) {
+        row_of[static_cast<size_t>(e.second)] = static_cast<int>(needed.size());
+        needed.push_back(e.second);
+      }
   }
-  const std::vector<Hist> spfhs = spfh_histograms(cloud, tree, r2, needed, row_of, max_support, nthreads);
+  const std::vector<Hist> spfhs = spfh_histograms(cloud, tree, r2, needed, row_of, max_support, nthreads, known);
 
   // FPFH: the weighted SPFHs of each keypoint's neighbours.
 #pragma omp parallel num_threads(nthreads) if (keypoints.size() > 64)
   {
-    std::vector<std::pair<float, int>> nn;
 #pragma omp for schedule(dynamic, 16)
     for (long i = 0; i < static_cast<long>(keypoints.size()); ++i) {
-      const int k = keypoints[static_cast<size_t>(i)];
-      if (k < 0 || k >= n || !pts[k].allFinite()) continue;
-      keypoint_neighbours(k, nn);  // weighted sums: in order of distance, as PCL
+      const int slot = slot_of_kp[static_cast<size_t>(i)];
+      if (slot < 0) continue;
       Hist h{};
       std::array<double, 3> sum{0, 0, 0};
-      for (const auto& [d2, q] : nn) {
+      // weighted sums: in order of distance, as PCL
+      for (const auto& [d2, q] : known.lists[static_cast<size_t>(slot)]) {
         if (d2 == 0.f) continue;
         const float weight = 1.f / d2;
         const Hist& s = spfhs[static_cast<size_t>(row_of[static_cast<size_t>(q)])];
