@@ -26,13 +26,14 @@ std::vector<char> ransac_plane(const std::vector<Vec3f>& points, double threshol
                                uint64_t seed, Eigen::Vector4d* plane = nullptr, int sample_points = 0,
                                double probability = 1.0);
 
-// The plane's noise seen from the camera at the origin: sigma estimated from
-// the points behind `plane` (on the far side from the origin) within `band`
-// of it, which only the plane's own noise puts there, as their median
-// distance / 0.6745 (a half-normal's). 0 when fewer than `min_points` lie
-// there.
-double plane_noise_sigma(const std::vector<Vec3f>& points, const Eigen::Vector4d& plane, double band,
-                         size_t min_points = 30);
+// The depth noise of an organized cloud (mm, along the viewing ray): over
+// every triple of horizontally adjacent valid pixels of every `row_step`-th
+// row, the second difference e = z[i-1] - 2 z[i] + z[i+1] (6 sigma^2 for
+// independent noise on a smooth surface; edges are rare and the median
+// ignores them), sigma = median |e| / 0.6745 / sqrt(6). 0 with fewer than
+// 100 triples. A sensor whose noise is spatially correlated or quantized in
+// steps gives less than its noise (second differences mostly 0).
+double depth_noise_sigma(const OrganizedCloud& cloud, int row_step = 4);
 
 // Normals by PCA of the neighbours within `radius_mm` (the point included, as
 // pcl::NormalEstimation; the project's kd-tree, OpenMP threads per

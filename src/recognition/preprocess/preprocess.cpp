@@ -146,19 +146,21 @@ std::vector<char> ransac_plane(const std::vector<Vec3f>& all, double thr, int it
   return flags;
 }
 
-double plane_noise_sigma(const std::vector<Vec3f>& pts, const Eigen::Vector4d& plane, double band,
-                         size_t min_points) {
-  // Signed distance, positive on the origin's side.
-  const double sign = plane[3] >= 0 ? 1.0 : -1.0;
-  std::vector<double> behind;
-  for (const auto& p : pts) {
-    const double d = sign * (plane.head<3>().dot(p.cast<double>()) + plane[3]);
-    if (d < 0 && d > -band) behind.push_back(-d);
+double depth_noise_sigma(const OrganizedCloud& cloud, int row_step) {
+  std::vector<float> e;
+  const int w = cloud.width, h = cloud.height;
+  if (w < 3 || h < 1 || cloud.points.size() != static_cast<size_t>(w) * static_cast<size_t>(h)) return 0;
+  for (int y = 0; y < h; y += std::max(1, row_step)) {
+    const Vec3f* row = cloud.points.data() + static_cast<size_t>(y) * static_cast<size_t>(w);
+    for (int x = 1; x + 1 < w; ++x) {
+      const float a = row[x - 1].z(), b = row[x].z(), c = row[x + 1].z();
+      if (std::isfinite(a) && std::isfinite(b) && std::isfinite(c)) e.push_back(std::abs(a - 2 * b + c));
+    }
   }
-  if (behind.size() < min_points) return 0;
-  const auto mid = behind.begin() + static_cast<std::ptrdiff_t>(behind.size() / 2);
-  std::nth_element(behind.begin(), mid, behind.end());
-  return *mid / 0.6745;
+  if (e.size() < 100) return 0;
+  const auto mid = e.begin() + static_cast<std::ptrdiff_t>(e.size() / 2);
+  std::nth_element(e.begin(), mid, e.end());
+  return static_cast<double>(*mid) / 0.6745 / std::sqrt(6.0);
 }
 
 }  // namespace detail
@@ -188,18 +190,26 @@ PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings&
   ps = voxel_downsample(ps, {s.voxel_mm});
   if (s.remove_plane) {
     const double min_count = s.min_plane_fraction * static_cast<double>(ps.size());
+    const double depth_sigma = s.plane_noise_factor > 0 ? detail::depth_noise_sigma(cloud) : 0.0;
     for (int k = 0; k < s.max_planes && ps.size() >= 3; ++k) {
       Eigen::Vector4d plane;
       std::vector<char> on_plane = detail::ransac_plane(ps.points, s.plane_threshold_mm, s.plane_iterations,
                                                         k == 0 ? seed : derive_seed(seed, {static_cast<uint64_t>(k)}),
                                                         &plane, s.plane_sample_points, s.plane_probability);
-      if (s.plane_noise_factor > 0 && std::count(on_plane.begin(), on_plane.end(), 1) >= 3) {
-        // A plane noisier than the threshold: widen it to factor x sigma.
-        const double band = kPlaneNoiseBand * s.plane_threshold_mm;
-        const double wide = s.plane_noise_factor * detail::plane_noise_sigma(ps.points, plane, band);
-        if (wide > s.plane_threshold_mm)
-          for (size_t i = 0; i < ps.size(); ++i)
-            on_plane[i] = std::abs(plane.head<3>().dot(ps.points[i].cast<double>()) + plane[3]) <= wide;
+      if (depth_sigma * s.plane_noise_factor > s.plane_threshold_mm) {
+        // Depth noise along the rays, seen across the plane: x the median
+        // |cos| between the plane's normal and the rays to its points.
+        std::vector<double> cosines;
+        for (size_t i = 0; i < ps.size(); ++i)
+          if (on_plane[i]) cosines.push_back(std::abs(plane.head<3>().dot(ps.points[i].cast<double>().normalized())));
+        if (!cosines.empty()) {
+          const auto mid = cosines.begin() + static_cast<std::ptrdiff_t>(cosines.size() / 2);
+          std::nth_element(cosines.begin(), mid, cosines.end());
+          const double wide = s.plane_noise_factor * depth_sigma * *mid;
+          if (wide > s.plane_threshold_mm)
+            for (size_t i = 0; i < ps.size(); ++i)
+              on_plane[i] = std::abs(plane.head<3>().dot(ps.points[i].cast<double>()) + plane[3]) <= wide;
+        }
       }
       const size_t cnt = static_cast<size_t>(std::count(on_plane.begin(), on_plane.end(), 1));
       if (cnt == 0 || static_cast<double>(cnt) < min_count) break;

@@ -9,10 +9,6 @@
 
 namespace pb {
 
-// The band behind a plane, in plane thresholds, where its noise is measured
-// (PreprocessSettings::plane_noise_factor).
-constexpr double kPlaneNoiseBand = 10.0;
-
 struct PreprocessSettings {
   double min_range_mm = 100.0;      // points closer than this are dropped
   double max_range_mm = 3000.0;     // far points cut (thesis: "cut by range")
@@ -20,12 +16,11 @@ struct PreprocessSettings {
   bool remove_plane = true;         // remove the dominant plane (floor / table)
   double plane_threshold_mm = 10.0; // RANSAC inlier distance for the plane
   double plane_noise_factor = 1.5;  // the plane's points are those within max(plane_threshold_mm,
-                                    // this x sigma), sigma the plane's noise measured behind it
-                                    // (points on its far side within 10 x plane_threshold_mm,
-                                    // which only noise puts there: median distance / 0.6745).
-                                    // Removes a noisy table whole (25 mm of added noise: 85% of a
-                                    // statue scene's points were table left over); 0 = the fixed
-                                    // threshold alone
+                                    // this x sigma), sigma the depth noise measured in the image
+                                    // (second differences along rows: depth_noise_sigma) times the
+                                    // median |cos| of the plane's normal to the rays. Removes a noisy
+                                    // table whole (25 mm of added noise: 85% of a statue scene's
+                                    // points were table left over); 0 = the fixed threshold alone
   int plane_iterations = 200;       // RANSAC iterations, at most
   double plane_probability = 1.0;   // < 1: RANSAC stops once a sample of three inliers of the best
                                     // plane so far was drawn with this probability (PCL's
