@@ -15,7 +15,7 @@ struct PreprocessSettings {
   double voxel_mm = 10.0;           // downsampling voxel (Table 4.2: 20 warehouse, 10 table)
   bool remove_plane = true;         // remove the dominant plane (floor / table)
   double plane_threshold_mm = 10.0; // RANSAC inlier distance for the plane
-  double plane_noise_factor = 1.5;  // the plane's points are those within max(plane_threshold_mm,
+  double plane_noise_factor = 2.0;  // the plane's points are those within max(plane_threshold_mm,
                                     // this x sigma), sigma the depth noise measured in the image
                                     // (second differences along rows: depth_noise_sigma) times the
                                     // median |cos| of the plane's normal to the rays. Removes a noisy
