@@ -1,0 +1,115 @@
+#!/usr/bin/python3
+"""Robustness of two runs of the same experiments, cell by cell.
+
+    scripts/compare_runs.py BEFORE AFTER [--json FILE]
+
+BEFORE and AFTER are results folders of `posebench run` (one experiment, with
+records.jsonl) or folders holding several of them (e.g. results/thesis/raw).
+A cell is (experiment, scene set, descriptor, refinement, added noise, the
+trial's params); its count is the correct records of k/n. Per cell, Fisher's
+exact test (two-sided) of the two counts. Prints the totals (cells, equal,
+up, down, p < 0.05), the significant cells, the cells that moved most, and
+the worker seconds (records' wall_s) per experiment. Exit 2 when a folder
+has no records. Cells found in one run only are counted as unmatched.
+"""
+import argparse
+import collections
+import glob
+import json
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from thesis_stats import fisher_exact  # noqa: E402
+
+
+def record_files(folder):
+    """{experiment: records.jsonl path} of a run folder or a folder of runs."""
+    own = os.path.join(folder, "records.jsonl")
+    if os.path.isfile(own):
+        return {os.path.basename(os.path.normpath(folder)): own}
+    return {os.path.basename(os.path.dirname(p)): p for p in sorted(glob.glob(os.path.join(folder, "*", "records.jsonl")))}
+
+
+def cells(folder):
+    """({cell: [k, n]}, {experiment: worker seconds}) of a folder's records."""
+    counts = collections.defaultdict(lambda: [0, 0])
+    seconds = collections.Counter()
+    for exp, path in record_files(folder).items():
+        with open(path) as f:
+            for line in f:
+                if not line.strip():
+                    continue
+                r = json.loads(line)
+                key = (exp, r["scene"], r["descriptor"], r["refinement"], r.get("added_noise_mm"),
+                       json.dumps(r.get("params", {}), sort_keys=True))
+                counts[key][0] += bool(r.get("correct"))
+                counts[key][1] += 1
+                seconds[exp] += r.get("wall_s", 0.0)
+    return dict(counts), dict(seconds)
+
+
+def compare(before, after):
+    """The comparison as a dict (see the module doc)."""
+    out = {"cells": 0, "equal": 0, "up": 0, "down": 0, "unmatched": 0, "correct_before": 0,
+           "correct_after": 0, "trials": 0, "significant": [], "moved": []}
+    for key in sorted(set(before) | set(after), key=str):
+        if key not in before or key not in after:
+            out["unmatched"] += 1
+            continue
+        (ka, na), (kb, nb) = before[key], after[key]
+        out["cells"] += 1
+        out["correct_before"] += ka
+        out["correct_after"] += kb
+        out["trials"] += na
+        out["equal" if ka == kb else "up" if kb > ka else "down"] += 1
+        cell = {"cell": list(key), "before": [ka, na], "after": [kb, nb], "p": fisher_exact(ka, na, kb, nb)}
+        if ka != kb:
+            out["moved"].append(cell)
+        if cell["p"] < 0.05:
+            out["significant"].append(cell)
+    out["moved"].sort(key=lambda c: (-abs(c["after"][0] - c["before"][0]), str(c["cell"])))
+    return out
+
+
+def name(cell):
+    exp, scene, desc, ref, noise, params = cell
+    extra = ("" if noise is None else f" noise {noise:g}") + ("" if params == "{}" else f" {params}")
+    return f"{exp} {scene} {desc}+{ref}{extra}"
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("before")
+    ap.add_argument("after")
+    ap.add_argument("--json", help="also write the comparison as JSON to this file")
+    ap.add_argument("--moved", type=int, default=15, help="list this many of the cells that moved most")
+    a = ap.parse_args(argv)
+    runs = []
+    for folder in (a.before, a.after):
+        c, s = cells(folder)
+        if not c:
+            print(f"compare_runs.py: {folder}: no records.jsonl in it or in its subfolders", file=sys.stderr)
+            return 2
+        runs.append((c, s))
+    r = compare(runs[0][0], runs[1][0])
+    print(f"{r['cells']} cells, {r['trials']} trials: correct {r['correct_before']} -> {r['correct_after']}; "
+          f"{r['equal']} equal, {r['up']} up, {r['down']} down, {len(r['significant'])} at p < 0.05 "
+          f"(Fisher's exact test per cell); {r['unmatched']} in one run only")
+    for c in r["significant"]:
+        print(f"  p = {c['p']:.3g}: {name(c['cell'])} {c['before'][0]}/{c['before'][1]} -> {c['after'][0]}/{c['after'][1]}")
+    for c in r["moved"][:a.moved]:
+        print(f"  moved: {name(c['cell'])} {c['before'][0]}/{c['before'][1]} -> {c['after'][0]}/{c['after'][1]}")
+    sb, sa = runs[0][1], runs[1][1]
+    print("worker seconds (records' wall_s), before -> after:")
+    for exp in sorted(set(sb) | set(sa)):
+        print(f"  {exp}: {sb.get(exp, 0):.0f} -> {sa.get(exp, 0):.0f}")
+    print(f"  total: {sum(sb.values()):.0f} -> {sum(sa.values()):.0f}")
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump({**r, "seconds_before": sb, "seconds_after": sa}, f, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
