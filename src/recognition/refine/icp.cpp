@@ -60,6 +60,11 @@ std::vector<size_t> sample_indices(size_t n, int k, uint64_t seed) {
 
 namespace {
 
+// Leaf size of ICP's kd-trees: nearest-neighbour queries only, whose answer
+// does not depend on it (ties go to the lower index); on the warehouse, 24
+// points per leaf made refinement about 8% faster than the default 8.
+constexpr int kIcpLeafSize = 24;
+
 struct Pair {
   int src, tgt;
   float sq_dist;
@@ -155,7 +160,7 @@ void iterate(const std::vector<Vec3f>& src, const Problem& p, const KdTree3& tgt
              Metric metric, int cap, Mat4& T, Outcome& o) {
   o.converged = false;
   if (cap <= 0 || src.size() < 3) return;
-  const KdTree3 src_tree = s.reciprocal_correspondences ? KdTree3(src) : KdTree3();
+  const KdTree3 src_tree = s.reciprocal_correspondences ? KdTree3(src, kIcpLeafSize) : KdTree3();
   const double rot_cos = std::cos(s.rotation_epsilon_deg * M_PI / 180.0);
   double prev_mse = std::numeric_limits<double>::max();
   std::vector<Pair> c;
@@ -189,7 +194,7 @@ Outcome icp(const Problem& p, const RefineSettings& s, uint64_t seed, Metric met
   std::vector<Vec3f> src;
   for (size_t i : sample_indices(p.src.size(), s.icp_sample_points, seed)) src.push_back(p.src[i]);
   if (src.size() < 3 || p.tgt.size() < 3) return o;
-  const KdTree3 tgt_tree(p.tgt);
+  const KdTree3 tgt_tree(p.tgt, kIcpLeafSize);
   Mat4 T = Mat4::Identity();
   int cap = s.max_iterations;
   // Coarse stage: a seeded random subset of the source points, leaving the
