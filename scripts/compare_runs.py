@@ -1,4 +1,4 @@
-#!/usr/bin/python3
+#!/usr/bin/env python3
 """Robustness of two runs of the same experiments, cell by cell.
 
     scripts/compare_runs.py BEFORE AFTER [--json FILE]
