@@ -9,8 +9,11 @@ A cell is (experiment, scene set, descriptor, refinement, added noise, the
 trial's params); its count is the correct records of k/n. Per cell, Fisher's
 exact test (two-sided) of the two counts. Prints the totals (cells, equal,
 up, down, p < 0.05), the significant cells, the cells that moved most, and
-the worker seconds (records' wall_s) per experiment. Exit 2 when a folder
-has no records. Cells found in one run only are counted as unmatched.
+the worker seconds (records' wall_s) per experiment. Records are read with
+thesis_report.py's loader (checked against the trial record's schema). Exit
+2, naming the file, line and key, for a record that does not fit, and for a
+folder without records. Cells found in one run only are counted as
+unmatched.
 """
 import argparse
 import collections
@@ -20,6 +23,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from thesis_report import RECORD_SCHEMA, InputError, load_records  # noqa: E402
 from thesis_stats import fisher_exact  # noqa: E402
 
 
@@ -36,16 +40,12 @@ def cells(folder):
     counts = collections.defaultdict(lambda: [0, 0])
     seconds = collections.Counter()
     for exp, path in record_files(folder).items():
-        with open(path) as f:
-            for line in f:
-                if not line.strip():
-                    continue
-                r = json.loads(line)
-                key = (exp, r["scene"], r["descriptor"], r["refinement"], r.get("added_noise_mm"),
-                       json.dumps(r.get("params", {}), sort_keys=True))
-                counts[key][0] += bool(r.get("correct"))
-                counts[key][1] += 1
-                seconds[exp] += r.get("wall_s", 0.0)
+        for r in load_records(path, RECORD_SCHEMA):
+            key = (exp, r["scene"], r["descriptor"], r["refinement"], r["added_noise_mm"],
+                   json.dumps(r["params"], sort_keys=True))
+            counts[key][0] += bool(r.get("correct"))
+            counts[key][1] += 1
+            seconds[exp] += r.get("wall_s", 0.0)
     return dict(counts), dict(seconds)
 
 
@@ -74,8 +74,7 @@ def compare(before, after):
 
 def name(cell):
     exp, scene, desc, ref, noise, params = cell
-    extra = ("" if noise is None else f" noise {noise:g}") + ("" if params == "{}" else f" {params}")
-    return f"{exp} {scene} {desc}+{ref}{extra}"
+    return f"{exp} {scene} {desc}+{ref} noise {noise:g}" + ("" if params == "{}" else f" {params}")
 
 
 def main(argv=None):
@@ -87,7 +86,11 @@ def main(argv=None):
     a = ap.parse_args(argv)
     runs = []
     for folder in (a.before, a.after):
-        c, s = cells(folder)
+        try:
+            c, s = cells(folder)
+        except InputError as e:
+            print(f"compare_runs.py: {e}", file=sys.stderr)
+            return 2
         if not c:
             print(f"compare_runs.py: {folder}: no records.jsonl in it or in its subfolders", file=sys.stderr)
             return 2

@@ -493,7 +493,8 @@ DIFFERENCES = [
     "the top 5) and why Table 4.9's accuracy order is inverted (reciprocal correspondences) is measured in "
     "`results/thesis/FINDINGS.md`.",
     "Times are wall-clock seconds of the online computation of one image (training views excluded: they are "
-    "rendered and described once and cached), single-threaded, on this shared machine.",
+    "rendered and described once and cached), single-threaded; the load column of the experiments table says "
+    "what else ran on the machine.",
 ]
 
 

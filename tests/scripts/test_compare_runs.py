@@ -1,67 +1,95 @@
-"""scripts/compare_runs.py on small record folders: the counts per cell, the
-verdict per cell (equal, up, down, significant), cells of one run only, and
-exit 2 with the folder named when there are no records."""
+"""scripts/compare_runs.py: the counts per cell read from the fixture results
+folders (records checked against the record schema), the verdict per cell
+(equal, up, down, significant, in one run only), and exit 2 naming the file,
+line and key for a broken record, or the folder when it has no records."""
 import contextlib
 import io
 import json
 import os
+import shutil
 import sys
 import tempfile
 import unittest
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+RAW = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fixtures", "raw")
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 import compare_runs as cr  # noqa: E402
 
 
-def write(folder, exp, rows):
-    os.makedirs(os.path.join(folder, exp), exist_ok=True)
-    with open(os.path.join(folder, exp, "records.jsonl"), "w") as f:
-        for scene, desc, noise, correct, wall in rows:
-            f.write(json.dumps({"scene": scene, "descriptor": desc, "refinement": "icp", "added_noise_mm": noise,
-                                "params": {}, "correct": correct, "wall_s": wall}) + "\n")
+def run(*argv):
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = cr.main(list(argv))
+    return code, out.getvalue(), err.getvalue()
 
 
 class CompareRuns(unittest.TestCase):
     def setUp(self):
         self.tmp = tempfile.TemporaryDirectory()
-        self.before, self.after = (os.path.join(self.tmp.name, d) for d in ("before", "after"))
-        # cell A: 10/10 -> 0/10 (significant), cell B: 5/10 -> 6/10, cell C equal, cell D only before
-        write(self.before, "exp", [("t", "fpfh", 0.0, True, 2.0)] * 10 + [("t", "shot", 0.0, i < 5, 1.0) for i in range(10)]
-              + [("w", "cvfh", 2.0, i < 3, 1.0) for i in range(4)] + [("w", "esf", 2.0, True, 1.0)])
-        write(self.after, "exp", [("t", "fpfh", 0.0, False, 1.0)] * 10 + [("t", "shot", 0.0, i < 6, 1.0) for i in range(10)]
-              + [("w", "cvfh", 2.0, i < 3, 0.5) for i in range(4)])
+        self.before = os.path.join(self.tmp.name, "before")
+        self.after = os.path.join(self.tmp.name, "after")
+        shutil.copytree(RAW, self.before)
+        shutil.copytree(RAW, self.after)
 
     def tearDown(self):
         self.tmp.cleanup()
 
-    def test_counts_and_verdicts(self):
-        b, sb = cr.cells(self.before)
-        a, sa = cr.cells(self.after)
-        self.assertEqual(b[("exp", "t", "fpfh", "icp", 0.0, "{}")], [10, 10])
-        self.assertEqual(sb, {"exp": 35.0})
-        self.assertEqual(sa, {"exp": 22.0})
-        r = cr.compare(b, a)
+    def edit(self, folder, exp, change):
+        """Rewrites every record of `exp` in `folder` by change(record) (None drops it)."""
+        path = os.path.join(folder, exp, "records.jsonl")
+        with open(path) as f:
+            records = [json.loads(line) for line in f if line.strip()]
+        with open(path, "w") as f:
+            for r in records:
+                r = change(r)
+                if r is not None:
+                    f.write(json.dumps(r) + "\n")
+
+    def test_cells_of_the_fixture_records(self):
+        counts, seconds = cr.cells(self.before)
+        self.assertEqual(counts[("table_4_1", "table_synthetic", "fpfh", "icp", 0.0, "{}")], [2, 2])
+        self.assertEqual(counts[("table_4_1", "table_synthetic", "cvfh", "icp", 0.0, "{}")], [1, 2])
+        self.assertEqual(counts[("fig_4_12", "warehouse_synthetic", "none", "icp_plane", 2.0, "{}")], [1, 2])
+        self.assertEqual(set(seconds), {"table_4_1", "table_4_5", "fig_4_12"})
+        # One run's folder alone: named by its folder.
+        one, _ = cr.cells(os.path.join(self.before, "table_4_1"))
+        self.assertEqual({k[0] for k in one}, {"table_4_1"})
+
+    def test_verdicts(self):
+        before = {("e", "s", "a", "icp", 0.0, "{}"): [10, 10], ("e", "s", "b", "icp", 0.0, "{}"): [5, 10],
+                  ("e", "s", "c", "icp", 0.0, "{}"): [3, 4], ("e", "s", "d", "icp", 0.0, "{}"): [1, 1]}
+        after = {("e", "s", "a", "icp", 0.0, "{}"): [0, 10], ("e", "s", "b", "icp", 0.0, "{}"): [6, 10],
+                 ("e", "s", "c", "icp", 0.0, "{}"): [3, 4]}
+        r = cr.compare(before, after)
         self.assertEqual((r["cells"], r["equal"], r["up"], r["down"], r["unmatched"]), (3, 1, 1, 1, 1))
         self.assertEqual((r["correct_before"], r["correct_after"], r["trials"]), (18, 9, 24))
-        self.assertEqual([c["cell"][2] for c in r["significant"]], ["fpfh"])
+        self.assertEqual([c["cell"][2] for c in r["significant"]], ["a"])
         self.assertAlmostEqual(r["significant"][0]["p"], 2 / 184756, places=12)
-        self.assertEqual([c["cell"][2] for c in r["moved"]], ["fpfh", "shot"])
+        self.assertEqual([c["cell"][2] for c in r["moved"]], ["a", "b"])
 
-    def test_one_run_folder_and_exit_codes(self):
-        out = io.StringIO()
-        with contextlib.redirect_stdout(out):
-            code = cr.main([os.path.join(self.before, "exp"), os.path.join(self.after, "exp")])
+    def test_printed_totals(self):
+        # The after run loses every correct fpfh record of table_4_1.
+        self.edit(self.after, "table_4_1",
+                  lambda r: dict(r, correct=False) if r["descriptor"] == "fpfh" and "correct" in r else r)
+        code, out, _ = run(self.before, self.after)
         self.assertEqual(code, 0)
-        self.assertIn("3 cells, 24 trials: correct 18 -> 9; 1 equal, 1 up, 1 down, 1 at p < 0.05", out.getvalue())
+        self.assertIn("1 down", out)
+        self.assertIn("moved: table_4_1 table_synthetic fpfh+icp noise 0 2/2 -> 0/2", out)
+
+    def test_broken_record_and_empty_folder_are_exit_2(self):
+        self.edit(self.after, "fig_4_12", lambda r: {k: v for k, v in r.items() if k != "scene"})
+        code, _, err = run(self.before, self.after)
+        self.assertEqual(code, 2)
+        self.assertIn(os.path.join(self.after, "fig_4_12", "records.jsonl"), err)
+        self.assertIn("line 1", err)
+        self.assertIn("scene", err)
         empty = os.path.join(self.tmp.name, "empty")
         os.makedirs(empty)
-        err = io.StringIO()
-        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
-            code = cr.main([self.before, empty])
+        code, _, err = run(self.before, empty)
         self.assertEqual(code, 2)
-        self.assertIn(empty, err.getvalue())
-        self.assertIn("no records.jsonl", err.getvalue())
+        self.assertIn(empty, err)
+        self.assertIn("no records.jsonl", err)
 
 
 if __name__ == "__main__":

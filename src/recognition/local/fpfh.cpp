@@ -133,9 +133,15 @@ std::vector<Hist> spfh_histograms(const PointSet& cloud, const CloudNeighbours& 
   const auto spfh_neighbours = [&](size_t i, std::vector<std::pair<float, int>>& nn, std::vector<int>& buf) {
     const int p = needed[i];
     const int slot = known.slot[static_cast<size_t>(p)];
-    const auto& list = slot >= 0 ? known.lists[static_cast<size_t>(slot)] : nn;
-    const size_t found = slot >= 0 ? known.found[static_cast<size_t>(slot)] : tree.within(pts[p], r2, nn, false, max_support);
-    for (const auto& e : list)
+    const std::vector<std::pair<float, int>>* list = &nn;
+    size_t found = 0;
+    if (slot >= 0) {
+      list = &known.lists[static_cast<size_t>(slot)];
+      found = known.found[static_cast<size_t>(slot)];
+    } else {
+      found = tree.within(pts[p], r2, nn, false, max_support);
+    }
+    for (const auto& e : *list)
       if (e.second != p) buf.push_back(e.second);
     return max_support > 0 && found > static_cast<size_t>(max_support);
   };
@@ -232,27 +238,26 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
   const int n = static_cast<int>(pts.size());
   const CloudNeighbours tree(pts);
   const float r2 = static_cast<float>(radius_mm * radius_mm);
-  // A keypoint's neighbours are thinned evenly in tree order to max_support
-  // as the SPFH rows are, then put in order of distance (its weighted sum
-  // follows PCL's order).
   const int nthreads = omp_threads(threads);
 
   // Every (finite) keypoint's neighbourhood, found once: it gives which
   // points need an SPFH (every kept neighbour of a keypoint), the keypoint's
-  // own SPFH list and its weighted sum below.
+  // own SPFH list and its weighted sum below. Thinned evenly in tree order
+  // to max_support as the SPFH rows are, then put in order of distance (the
+  // weighted sum follows PCL's order).
   Known known;
   known.slot.assign(static_cast<size_t>(n), -1);
-  std::vector<int> slot_of_kp(keypoints.size(), -1), point_of_slot;
-  for (size_t i = 0; i < keypoints.size(); ++i) {
-    const int k = keypoints[i];
-    if (k < 0 || k >= n || !pts[k].allFinite()) continue;
-    int& slot = known.slot[static_cast<size_t>(k)];
-    if (slot < 0) {
-      slot = static_cast<int>(point_of_slot.size());
-      point_of_slot.push_back(k);
-    }
-    slot_of_kp[i] = slot;
+  std::vector<int> point_of_slot;
+  for (const int k : keypoints) {
+    if (k < 0 || k >= n || !pts[k].allFinite() || known.slot[static_cast<size_t>(k)] >= 0) continue;
+    known.slot[static_cast<size_t>(k)] = static_cast<int>(point_of_slot.size());
+    point_of_slot.push_back(k);
   }
+  // The slot of keypoint i, or -1 (out of range or not finite).
+  const auto slot_of = [&](size_t i) {
+    const int k = keypoints[i];
+    return k < 0 || k >= n ? -1 : known.slot[static_cast<size_t>(k)];
+  };
   known.lists.resize(point_of_slot.size());
   known.found.assign(point_of_slot.size(), 0);
 #pragma omp parallel for schedule(dynamic, 16) num_threads(nthreads) if (point_of_slot.size() > 64)
@@ -263,8 +268,9 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
   std::vector<int> row_of(static_cast<size_t>(n), -1);
   std::vector<int> needed;
   for (size_t i = 0; i < keypoints.size(); ++i) {
-    if (slot_of_kp[i] < 0) continue;
-    for (const auto& e : known.lists[static_cast<size_t>(slot_of_kp[i])])
+    const int slot = slot_of(i);
+    if (slot < 0) continue;
+    for (const auto& e : known.lists[static_cast<size_t>(slot)])
       if (row_of[static_cast<size_t>(e.second)] < 0) {
         row_of[static_cast<size_t>(e.second)] = static_cast<int>(needed.size());
         needed.push_back(e.second);
@@ -277,7 +283,7 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
   {
 #pragma omp for schedule(dynamic, 16)
     for (long i = 0; i < static_cast<long>(keypoints.size()); ++i) {
-      const int slot = slot_of_kp[static_cast<size_t>(i)];
+      const int slot = slot_of(static_cast<size_t>(i));
       if (slot < 0) continue;
       Hist h{};
       std::array<double, 3> sum{0, 0, 0};

@@ -189,10 +189,16 @@ void iterate(const std::vector<Vec3f>& src, const Problem& p, const KdTree3& tgt
   }
 }
 
+// The points sample_indices picks (all of them when k is 0 or not below n).
+std::vector<Vec3f> sampled(const std::vector<Vec3f>& pts, int k, uint64_t seed) {
+  std::vector<Vec3f> out;
+  for (size_t i : sample_indices(pts.size(), k, seed)) out.push_back(pts[i]);
+  return out;
+}
+
 Outcome icp(const Problem& p, const RefineSettings& s, uint64_t seed, Metric metric) {
   Outcome o;
-  std::vector<Vec3f> src;
-  for (size_t i : sample_indices(p.src.size(), s.icp_sample_points, seed)) src.push_back(p.src[i]);
+  const std::vector<Vec3f> src = sampled(p.src, s.icp_sample_points, seed);
   if (src.size() < 3 || p.tgt.size() < 3) return o;
   const KdTree3 tgt_tree(p.tgt, kIcpLeafSize);
   Mat4 T = Mat4::Identity();
@@ -201,8 +207,7 @@ Outcome icp(const Problem& p, const RefineSettings& s, uint64_t seed, Metric met
   // fine stage at least icp_fine_iterations of the cap.
   const size_t coarse = static_cast<size_t>(std::max(0, s.icp_coarse_points));
   if (coarse >= 3 && src.size() > coarse && cap > s.icp_fine_iterations) {
-    std::vector<Vec3f> sub;
-    for (size_t i : sample_indices(src.size(), static_cast<int>(coarse), derive_seed(seed, {1}))) sub.push_back(src[i]);
+    const std::vector<Vec3f> sub = sampled(src, static_cast<int>(coarse), derive_seed(seed, {1}));
     iterate(sub, p, tgt_tree, s, metric, cap - s.icp_fine_iterations, T, o);
     cap -= o.iterations;
   }
