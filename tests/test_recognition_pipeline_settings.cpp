@@ -275,3 +275,23 @@ TEST(Settings, NamesAreTheIssuesList) {
 }
 
 }  // namespace
+
+// The relative inlier threshold is capped at verify.inlier_threshold_max_voxels
+// preprocess voxels: the warehouse's 0.05 d (1.8 m LS5, 20 mm voxel) was 4.5
+// voxels and counted the LS5's 180-degree flip as inliers.
+TEST(RelativeLengths, TheInlierThresholdIsAtMostTwoVoxels) {
+  const auto warehouse = pb::resolve_lengths(parse("preprocess: {voxel_mm: 20}\n"), 1800);
+  EXPECT_DOUBLE_EQ(warehouse.verify.inlier_threshold_mm, 40);  // not 0.05 d = 90
+  const auto table = pb::resolve_lengths(parse("preprocess: {voxel_mm: 10}\n"), 180);
+  EXPECT_DOUBLE_EQ(table.verify.inlier_threshold_mm, 9);  // 0.05 d: below the cap
+  // No cap, a threshold given in mm, or a sensor floor above the cap.
+  const auto uncapped =
+      pb::resolve_lengths(parse("preprocess: {voxel_mm: 20}\nverify: {inlier_threshold_max_voxels: 0}\n"), 1800);
+  EXPECT_DOUBLE_EQ(uncapped.verify.inlier_threshold_mm, 90);
+  const auto given = pb::resolve_lengths(parse("preprocess: {voxel_mm: 20}\nverify: {inlier_threshold_mm: 70}\n"), 1800);
+  EXPECT_DOUBLE_EQ(given.verify.inlier_threshold_mm, 70);
+  const auto floored = pb::resolve_lengths(parse("preprocess: {voxel_mm: 20}\nscale: {min_length_mm: 50}\n"), 1800);
+  EXPECT_DOUBLE_EQ(floored.verify.inlier_threshold_mm, 50);
+  // The default profile at 200 mm: voxel 10 mm, threshold 10 mm (1 voxel).
+  EXPECT_DOUBLE_EQ(pb::resolve_lengths(pb::RecognitionSettings{}, 200).verify.inlier_threshold_mm, 10);
+}

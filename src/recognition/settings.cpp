@@ -166,6 +166,10 @@ RecognitionSettings resolve_lengths(const RecognitionSettings& in, double model_
     Resolver r{s.relative, std::string(name) + ".", d * s.scale.length_factor, s.scale.min_length_mm};
     std::decay_t<decltype(section)>::fields(section, r);
   });
+  if (s.relative.count("verify.inlier_threshold_mm") && s.verify.inlier_threshold_max_voxels > 0)
+    s.verify.inlier_threshold_mm =
+        std::max(s.scale.min_length_mm,
+                 std::min(s.verify.inlier_threshold_mm, s.verify.inlier_threshold_max_voxels * s.preprocess.voxel_mm));
   s.relative.clear();
   return s;
 }

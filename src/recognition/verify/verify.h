@@ -24,6 +24,15 @@ namespace pb {
 
 struct VerifySettings {
   double inlier_threshold_mm = 10.0;  // model point -> nearest scene point distance
+  // A threshold left relative to the object's diameter (the default 0.05 d)
+  // is at most this many preprocess voxels (0 = no cap; a threshold given in
+  // mm is taken as given; the sensor floor, scale.min_length_mm, still
+  // applies). A voxelized scene has a point within about one voxel of every
+  // surface point it saw, so a band several voxels wide also counts points
+  // of a wrong pose near the surface: in the warehouse (d 1.8 m, voxel
+  // 20 mm) 0.05 d is 4.5 voxels and the LS5 flipped by 180 degrees scored
+  // as many inliers as the right pose. The tables' 0.05 d is 0.9-1.5 voxels.
+  double inlier_threshold_max_voxels = 2.0;
   // The best hypothesis is accepted only if at least this fraction of its
   // model points are inliers (0 = the thesis: the most inliers wins, as long
   // as it has one); below it the result is "no_hypothesis".
@@ -56,6 +65,7 @@ struct VerifySettings {
   template <class S, class F>
   static void fields(S& s, F& f) {
     f("inlier_threshold_mm", s.inlier_threshold_mm, fields::length(fields::positive()));
+    f("inlier_threshold_max_voxels", s.inlier_threshold_max_voxels, fields::nonnegative());
     f("min_inlier_fraction", s.min_inlier_fraction, fields::in_range(0, 1));
     f("inlier_model", s.inlier_model, fields::one_of({"view", "merged"}));
     f("score", s.score, fields::one_of({"inliers", "visibility"}));
