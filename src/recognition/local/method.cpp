@@ -128,41 +128,61 @@ class LocalMethod : public Method {
     if (scene.empty() || !scene.has_normals() || index_.size() == 0) return out;
     const int dim = dim_of(kind_);
 
-    // Describe: keypoints + descriptors.
+    // Describe: keypoints + descriptors; only keypoints with a valid
+    // descriptor are matched.
     Timer timer;
     const std::vector<int> idx = voxel_keypoints(scene, s.keypoint_voxel_mm);
     const std::vector<float> desc = descriptors(kind_, scene, idx, s);
+    std::vector<int> described;  // positions in idx
+    for (size_t i = 0; i < idx.size(); ++i)
+      if (finite_row(desc.data() + i * dim, dim)) described.push_back(static_cast<int>(i));
     times.describe += timer.seconds();
-
-    // Scene reference frames (needed for voting): part of grouping.
-    timer.reset();
-    const std::vector<float> lrf = compute_board_lrf(scene, idx, s.lrf_radius_mm);
-    const Described sc = keep_valid(scene, idx, desc, lrf, dim);
-    times.group += timer.seconds();
 
     // Match: k nearest model descriptors under the threshold, per view.
     timer.reset();
     const float thr = static_cast<float>(kind_ == Kind::Fpfh ? s.fpfh_match_threshold : s.match_threshold);
-    // One result slot per scene keypoint, merged in keypoint order: the same
-    // matches for any thread count.
+    std::vector<float> query(described.size() * static_cast<size_t>(dim));
+    for (size_t i = 0; i < described.size(); ++i)
+      std::copy_n(desc.data() + static_cast<size_t>(described[i]) * dim, dim, query.data() + i * dim);
+    // One result slot per described keypoint, merged in keypoint order: the
+    // same matches for any thread count.
     // Blocks of kMatchBlock queries: each indexed row is read once per block.
     constexpr int kMatchBlock = 32;
-    std::vector<std::vector<std::pair<int, float>>> nn(sc.kp.size());
-    const int nkp = static_cast<int>(sc.kp.size());
+    std::vector<std::vector<std::pair<int, float>>> nn(described.size());
+    const int nkp = static_cast<int>(described.size());
     const int nblocks = (nkp + kMatchBlock - 1) / kMatchBlock;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(omp_threads(s.threads)) if (nblocks > 1)
     for (int b = 0; b < nblocks; ++b) {
       const int first = b * kMatchBlock, count = std::min(kMatchBlock, nkp - first);
-      index_.knn_block(sc.desc.data() + static_cast<size_t>(first) * dim, count, s.matches_per_keypoint, thr,
+      index_.knn_block(query.data() + static_cast<size_t>(first) * dim, count, s.matches_per_keypoint, thr,
                        nn.data() + first, s.match_max_checks);
     }
-    std::vector<std::vector<Match>> per_view(views_.size());
+    times.match += timer.seconds();
+
+    // Scene reference frames, needed for voting (part of grouping): only of
+    // the matched keypoints, the only ones that vote; a match whose keypoint
+    // has no valid frame is dropped. Each keypoint is matched on its own, so
+    // the matches are those of describing every keypoint's frame first.
+    timer.reset();
+    std::vector<int> matched;  // scene point indices
     for (size_t i = 0; i < nn.size(); ++i)
+      if (!nn[i].empty()) matched.push_back(idx[static_cast<size_t>(described[i])]);
+    const std::vector<float> lrf = compute_board_lrf(scene, matched, s.lrf_radius_mm);
+    Described sc;  // the voting keypoints (no descriptors)
+    std::vector<std::vector<Match>> per_view(views_.size());
+    for (size_t i = 0, m = 0; i < nn.size(); ++i) {
+      if (nn[i].empty()) continue;
+      const float* lr = lrf.data() + (m++) * kLrfDim;
+      if (!finite_row(lr, kLrfDim)) continue;
+      const int slot = static_cast<int>(sc.kp.size());
+      sc.kp.push_back(scene.points[static_cast<size_t>(idx[static_cast<size_t>(described[i])])]);
+      sc.lrf.insert(sc.lrf.end(), lr, lr + kLrfDim);
       for (const auto& [row, d2] : nn[i]) {
         const auto& [v, k] = row_owner_[row];
-        per_view[v].push_back({k, static_cast<int>(i), d2});
+        per_view[v].push_back({k, slot, d2});
       }
-    times.match += timer.seconds();
+    }
+    times.group += timer.seconds();
 
     // Group: 3D Hough voting per training view.
     timer.reset();
