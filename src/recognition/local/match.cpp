@@ -25,6 +25,10 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 #include "recognition/local/internal.h"
 
@@ -125,6 +129,48 @@ inline float sq_dist(const float* a, const float* b, size_t dim) {
   return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
 }
 
+// The first index of the smallest of v[0..n) (n > 0; as the scan `if (v[r] <
+// v[arg]) arg = r`, for finite values). Four lanes of SSE minima find the
+// value (a minimum is exact in any order), a scan its first index.
+inline size_t first_argmin(const float* v, size_t n) {
+  float m = std::numeric_limits<float>::infinity();
+  size_t r = 0;
+#ifdef __SSE2__
+  __m128 m0 = _mm_set1_ps(m), m1 = m0;
+  for (; r + 8 <= n; r += 8) {
+    m0 = _mm_min_ps(m0, _mm_loadu_ps(v + r));
+    m1 = _mm_min_ps(m1, _mm_loadu_ps(v + r + 4));
+  }
+  alignas(16) float lanes[4];
+  _mm_store_ps(lanes, _mm_min_ps(m0, m1));
+  for (const float l : lanes) m = std::min(m, l);
+#endif
+  for (; r < n; ++r) m = std::min(m, v[r]);
+  for (size_t i = 0; i < n; ++i)
+    if (v[i] == m) return i;
+  size_t arg = 0;  // no finite value equals the minimum (NaN or infinity): the plain scan
+  for (size_t i = 1; i < n; ++i)
+    if (v[i] < v[arg]) arg = i;
+  return arg;
+}
+
+// Appends (v[r], r) for every r < n with v[r] <= limit, in ascending r
+// (SSE: four values compared at once, most blocks have none).
+inline void append_at_most(const float* v, size_t n, float limit, std::vector<std::pair<float, int>>& out) {
+  size_t r = 0;
+#ifdef __SSE2__
+  const __m128 l4 = _mm_set1_ps(limit);
+  for (; r + 4 <= n; r += 4) {
+    const int mask = _mm_movemask_ps(_mm_cmple_ps(_mm_loadu_ps(v + r), l4));
+    if (mask == 0) continue;
+    for (int k = 0; k < 4; ++k)
+      if (mask & (1 << k)) out.emplace_back(v[r + k], static_cast<int>(r + k));
+  }
+#endif
+  for (; r < n; ++r)
+    if (v[r] <= limit) out.emplace_back(v[r], static_cast<int>(r));
+}
+
 // Keeps the kk smallest (distance, then row) of the candidates offered, in
 // ascending order; rows arrive ascending, so equal distances keep the lower row.
 inline void offer(std::vector<std::pair<int, float>>& out, size_t kk, int row, float s) {
@@ -172,9 +218,7 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
     for (size_t r = 0; r < m.rows; ++r) lbs[r] = zn + psq[r] - 2.f * lbs[r];  // branch-free: vectorized
     cand.clear();
     if (kk == 1) {  // the smallest bound, the lowest row among equal ones
-      size_t arg = 0;
-      for (size_t r = 1; r < m.rows; ++r)
-        if (lbs[r] < lbs[arg]) arg = r;
+      const size_t arg = first_argmin(lbs, m.rows);
       cand.emplace_back(lbs[arg], static_cast<int>(arg));
     } else {
       for (size_t r = 0; r < m.rows; ++r) {
@@ -191,8 +235,7 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
     const float limit = std::min(tau0, max_sq_dist) + margin;
     // Second pass: the candidates, measured in the order of their bounds.
     cand.clear();
-    for (size_t r = 0; r < m.rows; ++r)
-      if (lbs[r] <= limit) cand.emplace_back(lbs[r], static_cast<int>(r));
+    append_at_most(lbs, m.rows, limit, cand);
     if (max_checks > 0 && cand.size() > static_cast<size_t>(max_checks)) {  // approximate: the lowest bounds
       std::nth_element(cand.begin(), cand.begin() + max_checks, cand.end());
       cand.resize(static_cast<size_t>(max_checks));
