@@ -274,8 +274,6 @@ TEST(Settings, NamesAreTheIssuesList) {
   EXPECT_EQ(pb::refinement_names(), (std::vector<std::string>{"none", "icp", "icp_lm", "icp_plane", "icp_pcl", "icp_plane_pcl", "gicp", "ndt"}));
 }
 
-}  // namespace
-
 // The relative inlier threshold is capped at verify.inlier_threshold_max_voxels
 // preprocess voxels: the warehouse's 0.05 d (1.8 m LS5, 20 mm voxel) was 4.5
 // voxels and counted the LS5's 180-degree flip as inliers.
@@ -295,3 +293,5 @@ TEST(RelativeLengths, TheInlierThresholdIsAtMostTwoVoxels) {
   // The default profile at 200 mm: voxel 10 mm, threshold 10 mm (1 voxel).
   EXPECT_DOUBLE_EQ(pb::resolve_lengths(pb::RecognitionSettings{}, 200).verify.inlier_threshold_mm, 10);
 }
+
+}  // namespace
