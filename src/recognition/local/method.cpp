@@ -38,7 +38,9 @@ enum class Kind : uint32_t { Fpfh = 1, Shot = 2 };
 int dim_of(Kind k) { return k == Kind::Fpfh ? kFpfhDim : kShotDim; }
 
 // Described keypoints of one cloud: only those with a valid descriptor AND a
-// valid reference frame (others can neither match nor vote).
+// valid reference frame (others can neither match nor vote). A training
+// view keeps all three; the scene's voting keypoints (the matched ones with
+// a valid frame) leave `desc` empty.
 struct Described {
   std::vector<Vec3f> kp;
   std::vector<float> desc;  // kp.size() x dim
