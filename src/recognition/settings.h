@@ -110,7 +110,8 @@ double sensor_length_floor_mm(const ScaleSettings& scale, const DepthImage& imag
 // surface and leaves noise of variance 6 sigma^2; differences above 2% of
 // the depth (edges, steep surfaces) are left out; sigma = sqrt(mean(d^2) /
 // 6). Catches a real sensor's noise and its depth quantization; 0 without
-// three valid neighbours in a row.
+// three valid neighbours in a row. (The plane band of preprocessing uses
+// its own, median-based estimate: preprocess/internal.h's depth_noise_sigma.)
 double depth_noise_sigma_mm(const DepthImage& image);
 
 // resolve_lengths with the sensor's floor: when scale.min_length_mm is 0 it

@@ -143,9 +143,15 @@ class LocalMethod : public Method {
     // Match: k nearest model descriptors under the threshold, per view.
     timer.reset();
     const float thr = static_cast<float>(kind_ == Kind::Fpfh ? s.fpfh_match_threshold : s.match_threshold);
-    std::vector<float> query(described.size() * static_cast<size_t>(dim));
-    for (size_t i = 0; i < described.size(); ++i)
-      std::copy_n(desc.data() + static_cast<size_t>(described[i]) * dim, dim, query.data() + i * dim);
+    // The described keypoints' rows: the descriptors as they are when every
+    // one is valid (the usual case), else a compacted copy.
+    std::vector<float> compacted;
+    if (described.size() < idx.size()) {
+      compacted.resize(described.size() * static_cast<size_t>(dim));
+      for (size_t i = 0; i < described.size(); ++i)
+        std::copy_n(desc.data() + static_cast<size_t>(described[i]) * dim, dim, compacted.data() + i * dim);
+    }
+    const float* query = compacted.empty() ? desc.data() : compacted.data();
     // One result slot per described keypoint, merged in keypoint order: the
     // same matches for any thread count.
     // Blocks of kMatchBlock queries: each indexed row is read once per block.
@@ -156,7 +162,7 @@ class LocalMethod : public Method {
 #pragma omp parallel for schedule(dynamic, 1) num_threads(omp_threads(s.threads)) if (nblocks > 1)
     for (int b = 0; b < nblocks; ++b) {
       const int first = b * kMatchBlock, count = std::min(kMatchBlock, nkp - first);
-      index_.knn_block(query.data() + static_cast<size_t>(first) * dim, count, s.matches_per_keypoint, thr,
+      index_.knn_block(query + static_cast<size_t>(first) * dim, count, s.matches_per_keypoint, thr,
                        nn.data() + first, s.match_max_checks);
     }
     times.match += timer.seconds();

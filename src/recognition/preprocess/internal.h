@@ -33,6 +33,11 @@ std::vector<char> ransac_plane(const std::vector<Vec3f>& points, double threshol
 // ignores them), sigma = median |e| / 0.6745 / sqrt(6). 0 with fewer than
 // 100 triples. A sensor whose noise is spatially correlated or quantized in
 // steps gives less than its noise (second differences mostly 0).
+// settings.h's depth_noise_sigma_mm (the sensor floor of relative lengths)
+// estimates the same noise differently (the RMS of the second differences
+// below 2% of the depth, every row of the depth image); the two are kept
+// apart because each set of results was measured with its own, and either
+// one replacing the other would move them.
 double depth_noise_sigma(const OrganizedCloud& cloud, int row_step = 4);
 
 // Normals by PCA of the neighbours within `radius_mm` (the point included, as
