@@ -168,16 +168,27 @@ TEST(RenderNoise, ProjectorShadowsLieLeftOfTheBox) {
   EXPECT_EQ(right_max, 0);
 }
 
-TEST(RenderNoise, TimeOfFlightFlyingPixelsOnlyAtDepthEdges) {
+// Time-of-flight pixels of the box-before-wall scene (a 450 mm jump), counted
+// against the noise-free depth.
+struct TofCounts {
+  size_t edge_pixels = 0;  // an 8-neighbour across a jump larger than edge_jump_mm
+  size_t flying = 0;       // valid, farther than 6 sigma from every true surface within 2 px
+  size_t flying_far = 0;   // of those, farther than 1 px from an edge
+  size_t flying_mid = 0;   // of those, more than edge_filter_close_mm + 6 sigma from the nearest and more than
+                           // edge_filter_far_mm + 6 sigma from the farthest true depth within 2 px
+  size_t interior = 0;     // true depth, farther than 3 px from an edge
+  size_t interior_missing = 0;
+  double normalized_std = 0;  // interior error / sigma
+};
+
+TofCounts count_tof(const NoiseSettings& noise) {
   const SensorProfile kin = sensor_profile("kinect_one");
-  ASSERT_EQ(kin.noise.model, "tof");
   const Intrinsics& K = kin.K;
-  const TimeOfFlightNoise& t = kin.noise.tof;
+  const TimeOfFlightNoise& t = noise.tof;
   const RenderOutput out = render_box_wall(K);
   const DepthImage& truth = out.depth;
-  const DepthImage d = noisy(out, kin, kin.noise, 11);
+  const DepthImage d = noisy(out, kin, noise, 11);
   auto sigma = [&](double z) { return t.sigma_base_mm + t.sigma_per_m2_mm * (z / 1000) * (z / 1000); };
-  // An edge pixel has an 8-neighbour across a jump larger than edge_jump_mm.
   auto edge_distance = [&](int u, int v) {
     int best = 1000;
     for (int dv = -3; dv <= 3; ++dv)
@@ -191,42 +202,77 @@ TEST(RenderNoise, TimeOfFlightFlyingPixelsOnlyAtDepthEdges) {
       }
     return best;
   };
-  size_t flying = 0, flying_far = 0, edge_pixels = 0;
+  TofCounts c;
   double sum2 = 0;
-  size_t interior = 0;
+  size_t n2 = 0;
   for (int v = 0; v < K.height; ++v)
     for (int u = 0; u < K.width; ++u) {
       const float z = d.at(u, v);
       const float z0 = truth.at(u, v);
-      if (edge_distance(u, v) == 0) ++edge_pixels;
+      const int e = edge_distance(u, v);
+      if (e == 0) ++c.edge_pixels;
+      if (e > 3 && z0 > 0) {
+        ++c.interior;
+        if (z <= 0) ++c.interior_missing;
+      }
       if (z <= 0) continue;
-      // Flying: far (> 6 sigma) from every true surface around it.
       bool far_from_all = true;
-      for (int dv = -2; dv <= 2 && far_from_all; ++dv)
+      float lo = 1e9f, hi = 0.f;
+      for (int dv = -2; dv <= 2; ++dv)
         for (int du = -2; du <= 2; ++du) {
           const int uu = std::clamp(u + du, 0, K.width - 1), vv = std::clamp(v + dv, 0, K.height - 1);
           const float zt = truth.at(uu, vv);
-          if (zt > 0 && std::abs(z - zt) <= 6 * sigma(zt)) {
-            far_from_all = false;
-            break;
-          }
+          if (zt <= 0) continue;
+          lo = std::min(lo, zt);
+          hi = std::max(hi, zt);
+          if (std::abs(z - zt) <= 6 * sigma(zt)) far_from_all = false;
         }
       if (far_from_all) {
-        ++flying;
-        if (edge_distance(u, v) > 1) ++flying_far;
-      } else if (edge_distance(u, v) > 3) {
-        const double e = z - z0;
-        sum2 += e * e / (sigma(z0) * sigma(z0));
-        ++interior;
+        ++c.flying;
+        if (e > 1) ++c.flying_far;
+        if (z - lo > t.edge_filter_close_mm + 6 * sigma(lo) && hi - z > t.edge_filter_far_mm + 6 * sigma(hi)) ++c.flying_mid;
+      } else if (e > 3) {
+        const double err = z - z0;
+        sum2 += err * err / (sigma(z0) * sigma(z0));
+        ++n2;
       }
     }
-  const double normalized_std = std::sqrt(sum2 / interior);
-  std::printf("tof: %zu edge pixels, %zu flying pixels, %zu farther than 1 px from an edge; interior error / "
-              "sigma = %.4f over %zu pixels\n",
-              edge_pixels, flying, flying_far, normalized_std, interior);
-  EXPECT_EQ(flying_far, 0u);
-  EXPECT_GT(flying, edge_pixels / 2);  // most edge pixels fly (flying_fraction 1, a 450 mm jump)
-  EXPECT_NEAR(normalized_std, 1.0, 0.05);
+  c.normalized_std = std::sqrt(sum2 / n2);
+  std::printf("tof (driver edge filter %s): %zu edge pixels, %zu flying pixels, %zu farther than 1 px from an edge, "
+              "%zu in the middle of the jump; interior: %zu of %zu missing, error / sigma = %.4f\n",
+              t.driver_edge_filter ? "on" : "off", c.edge_pixels, c.flying, c.flying_far, c.flying_mid,
+              c.interior_missing, c.interior, c.normalized_std);
+  return c;
+}
+
+TEST(RenderNoise, TimeOfFlightFlyingPixelsOnlyAtDepthEdges) {
+  // The raw time-of-flight frame: the driver's edge filter off.
+  NoiseSettings raw = sensor_profile("kinect_one").noise;
+  ASSERT_EQ(raw.model, "tof");
+  raw.tof.driver_edge_filter = false;
+  const TofCounts c = count_tof(raw);
+  EXPECT_EQ(c.flying_far, 0u);
+  EXPECT_GT(c.flying, c.edge_pixels / 2);  // most edge pixels fly (flying_fraction 1, a 450 mm jump)
+  EXPECT_EQ(c.interior_missing, 0u);
+  EXPECT_NEAR(c.normalized_std, 1.0, 0.05);
+}
+
+TEST(RenderNoise, TimeOfFlightDriverEdgeFilterDropsTheFlyingPixelsInTheMiddleOfAJump) {
+  // The kinect_one profile as a user gets its frames: the driver's edge
+  // filter on (its default). Of the flying pixels in the middle of the
+  // 450 mm jump, few survive (their 3x3 window saw other flying pixels, not
+  // both surfaces); no pixel away from the edges is lost.
+  const NoiseSettings on = sensor_profile("kinect_one").noise;
+  ASSERT_TRUE(on.tof.driver_edge_filter);
+  NoiseSettings off = on;
+  off.tof.driver_edge_filter = false;
+  const TofCounts a = count_tof(off), b = count_tof(on);
+  EXPECT_GT(a.flying_mid, a.edge_pixels / 4);
+  EXPECT_LT(b.flying_mid, a.flying_mid / 5);
+  EXPECT_LT(b.flying, a.flying / 2);
+  EXPECT_EQ(b.flying_far, 0u);
+  EXPECT_EQ(b.interior_missing, 0u);
+  EXPECT_NEAR(b.normalized_std, 1.0, 0.05);
 }
 
 TEST(RenderNoise, GrazingAnglesHaveNoDepth) {

@@ -106,6 +106,12 @@ TEST(RenderSensorYaml, NoiseSettingsParse) {
   EXPECT_DOUBLE_EQ(n.tof.sigma_base_mm, 1);
   EXPECT_DOUBLE_EQ(n.tof.flying_fraction, 0.5);
   EXPECT_DOUBLE_EQ(n.tof.sigma_per_m2_mm, TimeOfFlightNoise{}.sigma_per_m2_mm);
+  EXPECT_TRUE(n.tof.driver_edge_filter);
+  n = noise_from("noise: {model: tof, driver_edge_filter: false, edge_filter_close_mm: 40, edge_filter_far_mm: 20, edge_filter_span_mm: 80}");
+  EXPECT_FALSE(n.tof.driver_edge_filter);
+  EXPECT_DOUBLE_EQ(n.tof.edge_filter_close_mm, 40);
+  EXPECT_DOUBLE_EQ(n.tof.edge_filter_far_mm, 20);
+  EXPECT_DOUBLE_EQ(n.tof.edge_filter_span_mm, 80);
   // Absent: the base.
   n = noise_from("other: 1", sensor_profile("kinect_one").noise);
   EXPECT_EQ(n.model, "tof");

@@ -184,11 +184,11 @@ warehouse: {wall_yaw_deg: 0, floor_thickness_mm: 50}
 TEST(SceneConfig, LayoutDetailsInJsonOnlyWhenChanged) {
   const std::string base = "scenario: table\nocclusion: {visib_fract: [0.4, 0.9]}\n";
   const std::string def = scene_settings_json(parse(base));
-  EXPECT_EQ(def.find("near_mm"), std::string::npos) << def;
+  EXPECT_EQ(def.find("\"near_mm\""), std::string::npos) << def;
   EXPECT_EQ(def.find("box_probability"), std::string::npos) << def;
   const std::string changed = scene_settings_json(
       parse("scenario: table\nocclusion: {visib_fract: [0.4, 0.9], box_probability: 0.5}\ncamera: {near_mm: 60}\n"));
   EXPECT_NE(changed.find("\"box_probability\": 0.5"), std::string::npos) << changed;
   EXPECT_NE(changed.find("\"near_mm\": 60"), std::string::npos) << changed;
-  EXPECT_EQ(changed.find("far_mm"), std::string::npos) << changed;
+  EXPECT_EQ(changed.find("\"far_mm\""), std::string::npos) << changed;
 }

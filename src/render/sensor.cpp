@@ -94,6 +94,32 @@ void apply_structured_light(DepthImage& depth, const std::vector<Vec3f>& normals
     }
 }
 
+// The driver's edge filter (TimeOfFlightNoise::driver_edge_filter): judges
+// every pixel against the nearest and farthest valid depth of its 3x3
+// window in the unfiltered image, so the result does not depend on the
+// scan order. Border pixels are kept (no full window).
+void drop_flying_pixels(DepthImage& depth, const TimeOfFlightNoise& t) {
+  const int W = depth.width, H = depth.height;
+  const DepthImage raw = depth;
+  for (int v = 1; v + 1 < H; ++v)
+    for (int u = 1; u + 1 < W; ++u) {
+      const float z = raw.at(u, v);
+      if (!valid_depth(z)) continue;
+      float lo = z, hi = z;
+      for (int dv = -1; dv <= 1; ++dv)
+        for (int du = -1; du <= 1; ++du) {
+          const float zq = raw.at(u + du, v + dv);
+          if (!valid_depth(zq)) continue;
+          lo = std::min(lo, zq);
+          hi = std::max(hi, zq);
+        }
+      const double behind_nearest = z - lo, before_farthest = hi - z;
+      if (behind_nearest > t.edge_filter_close_mm && before_farthest > t.edge_filter_far_mm &&
+          std::max(behind_nearest, before_farthest) > t.edge_filter_span_mm)
+        depth.z[static_cast<size_t>(v) * W + u] = 0.f;
+    }
+}
+
 void apply_tof(DepthImage& depth, const std::vector<Vec3f>& normals, const Intrinsics& K,
                const TimeOfFlightNoise& t, Rng& rng) {
   const int W = depth.width, H = depth.height;
@@ -125,6 +151,7 @@ void apply_tof(DepthImage& depth, const std::vector<Vec3f>& normals, const Intri
       z += rng.normal(0.0, t.sigma_base_mm + t.sigma_per_m2_mm * zm * zm);
       depth.z[px] = z > 0 ? static_cast<float>(z) : 0.f;
     }
+  if (t.driver_edge_filter) drop_flying_pixels(depth, t);
 }
 
 void check_intrinsics(const YamlNode& node, const Intrinsics& K) {
@@ -257,8 +284,9 @@ NoiseSettings parse_noise(const YamlNode& node, const NoiseSettings& base) {
   const std::set<std::string> sl_keys = {"baseline_mm",         "disparity_step_px", "disparity_sigma_px",
                                          "smoothing_radius_px", "smoothing_edge_px", "max_incidence_deg",
                                          "shadows"};
-  const std::set<std::string> tof_keys = {"sigma_base_mm", "sigma_per_m2_mm", "edge_jump_mm", "flying_fraction",
-                                          "max_incidence_deg"};
+  const std::set<std::string> tof_keys = {"sigma_base_mm",        "sigma_per_m2_mm",    "edge_jump_mm",
+                                          "flying_fraction",      "max_incidence_deg",  "driver_edge_filter",
+                                          "edge_filter_close_mm", "edge_filter_far_mm", "edge_filter_span_mm"};
   std::set<std::string> all = {"model"};
   all.insert(gaussian_keys.begin(), gaussian_keys.end());
   all.insert(sl_keys.begin(), sl_keys.end());
@@ -300,6 +328,10 @@ NoiseSettings parse_noise(const YamlNode& node, const NoiseSettings& base) {
     t.flying_fraction = node.get_nonnegative("flying_fraction", t.flying_fraction);
     if (t.flying_fraction > 1) node["flying_fraction"].fail("must be in [0, 1]");
     t.max_incidence_deg = incidence(t.max_incidence_deg);
+    node.read("driver_edge_filter", t.driver_edge_filter);
+    t.edge_filter_close_mm = node.get_nonnegative("edge_filter_close_mm", t.edge_filter_close_mm);
+    t.edge_filter_far_mm = node.get_nonnegative("edge_filter_far_mm", t.edge_filter_far_mm);
+    t.edge_filter_span_mm = node.get_nonnegative("edge_filter_span_mm", t.edge_filter_span_mm);
   }
   return n;
 }

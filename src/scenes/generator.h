@@ -105,8 +105,9 @@ struct GenerateSummary {
 // the renderer), so that `posebench run`, which keeps one scene set per
 // config in its --scenes folder, generates the set again instead of reusing
 // an old one. 1 = the sets made before it existed; 2 = the astra sensor
-// calibrated on real frames (results/sensors/fit_astra.json).
-constexpr int kSceneSetVersion = 2;
+// calibrated on real frames (results/sensors/fit_astra.json); 3 = the
+// kinect_one sensor's driver edge filter (TimeOfFlightNoise).
+constexpr int kSceneSetVersion = 3;
 
 // Generates the whole scene set into `out_dir` (BOP layout, see README):
 // written to `out_dir.partial` and renamed into place at the end, so an

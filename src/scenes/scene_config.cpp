@@ -324,7 +324,11 @@ std::string scene_settings_json(const SceneSettings& s) {
         {"sigma_per_m2_mm", n.tof.sigma_per_m2_mm},
         {"edge_jump_mm", n.tof.edge_jump_mm},
         {"flying_fraction", n.tof.flying_fraction},
-        {"max_incidence_deg", n.tof.max_incidence_deg}}}};
+        {"max_incidence_deg", n.tof.max_incidence_deg},
+        {"driver_edge_filter", n.tof.driver_edge_filter},
+        {"edge_filter_close_mm", n.tof.edge_filter_close_mm},
+        {"edge_filter_far_mm", n.tof.edge_filter_far_mm},
+        {"edge_filter_span_mm", n.tof.edge_filter_span_mm}}}};
   j["depth_scale"] = s.depth_scale;
   j["registry"] = s.registry.empty() ? "(default)" : s.registry;
   j["target"] = s.target;
