@@ -11,7 +11,9 @@ that cause moves.
 An ablation names the experiments it copies and what it switches: `scenes`
 (the scene sets kept; default all), `generator` (merged into each kept
 scene's generator overrides, JSON merge patch: {warehouse: {wall: true}}),
-`settings` (merged into the experiment's settings). The copy of experiment
+`settings` (merged into the experiment's settings), `config` (other
+top-level keys of the experiment replaced, e.g. perturb_deg; not name,
+seed, scenes, settings, report or description). The copy of experiment
 E is named ablation_NAME_E, keeps E's report reference, and differs from E
 only by the switch. Exit 2 with the file and field on a bad spec."""
 import copy
@@ -37,6 +39,11 @@ def merge_patch(base, patch):
         else:
             out[k] = merge_patch(out.get(k), v)
     return out
+
+
+# Top-level keys of an experiment an ablation's `config` may not replace:
+# the copy keeps the experiment's identity, trial seeds and report.
+FIXED_KEYS = ("name", "seed", "scenes", "settings", "report", "description")
 
 
 def ablation_name(ablation, experiment):
@@ -67,13 +74,16 @@ def load_spec(path):
         seen.add(a["name"])
         if not isinstance(a.get("experiments"), list) or not a["experiments"]:
             raise SpecError(path, where + ".experiments", "must be a non-empty list of experiment names")
-        for key in ("generator", "settings"):
+        for key in ("generator", "settings", "config"):
             if key in a and not isinstance(a[key], dict):
                 raise SpecError(path, where + "." + key, "must be a mapping")
+        for key in a.get("config", {}):
+            if key in FIXED_KEYS:
+                raise SpecError(path, where + ".config." + key, "cannot be switched (use scenes, generator or settings)")
         if "scenes" in a and not (isinstance(a["scenes"], list) and a["scenes"]):
             raise SpecError(path, where + ".scenes", "must be a non-empty list of scene names")
-        if not any(k in a for k in ("generator", "settings")):
-            raise SpecError(path, where, "switches nothing (give 'generator' or 'settings')")
+        if not any(k in a for k in ("generator", "settings", "config")):
+            raise SpecError(path, where, "switches nothing (give 'generator', 'settings' or 'config')")
     return spec["ablations"]
 
 
@@ -96,6 +106,8 @@ def derive(ablation, experiment, config, config_path="experiment"):
     out["scenes"] = scenes
     if "settings" in ablation:
         out["settings"] = merge_patch(out.get("settings", {}), ablation["settings"])
+    for key, value in ablation.get("config", {}).items():
+        out[key] = copy.deepcopy(value)
     return out
 
 

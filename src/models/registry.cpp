@@ -117,7 +117,7 @@ ModelRegistry ModelRegistry::load(const std::string& registry_path) {
     if (!name_ok)
       e.fail("model name '" + name + "' must start with a letter, use only letters, digits, _ - . and not start with obj_");
     if (!e.is_map()) e.fail("expected a mapping (obj_id, source, ...)");
-    e.check_keys({"obj_id", "source", "scale", "fit_size", "up", "role", "symmetries_discrete",
+    e.check_keys({"obj_id", "source", "scale", "fit_size", "fit_extent", "up", "role", "symmetries_discrete",
                   "symmetries_continuous", "description"});
     ModelSpec s;
     s.name = name;
@@ -142,6 +142,16 @@ ModelRegistry ModelRegistry::load(const std::string& registry_path) {
     }
     s.scale = e.get_positive("scale", 1.0);
     s.fit_size = e.get_nonnegative("fit_size", 0.0);
+    if (const YamlNode fe = e["fit_extent"]; fe.defined()) {
+      if (!fe.is_sequence() || fe.size() != 3) fe.fail("must be [x, y, z] in mm");
+      Vec3 v;
+      for (size_t i = 0; i < 3; ++i) {
+        v[static_cast<int>(i)] = fe.at(i).as<double>();
+        if (!(v[static_cast<int>(i)] > 0) || !std::isfinite(v[static_cast<int>(i)]))
+          fe.at(i).fail("must be a positive length in mm");
+      }
+      s.fit_extent = v;
+    }
     s.up = e.get_or<std::string>("up", "+z");
     if (!ups.count(s.up)) e["up"].fail("unknown up axis '" + s.up + "' (one of +x -x +y -y +z -z)");
     s.role = e.get_or<std::string>("role", "target");
@@ -243,12 +253,20 @@ Mesh ModelRegistry::load_model(const std::string& name) const {
 }
 
 void ModelRegistry::normalize(Mesh* m, const ModelSpec& s) {
-  // 1. file units -> mm, 2. up axis -> +z, 3. fit_size, 4. bbox centre at 0.
+  // 1. file units -> mm, 2. up axis -> +z, 3. fit_extent or fit_size,
+  // 4. bbox centre at 0.
   Pose T;
   T.R = clean(up_rotation(s.up));
   for (auto& v : m->vertices) v *= static_cast<float>(s.scale);
   m->transform(T);
-  if (s.fit_size > 0) {
+  if (s.fit_extent) {
+    const Eigen::AlignedBox3f b = m->bounds();
+    const Eigen::Vector3f size = b.max() - b.min();
+    Eigen::Vector3f k = Eigen::Vector3f::Ones();
+    for (int a = 0; a < 3; ++a)
+      if (size[a] > 0) k[a] = static_cast<float>((*s.fit_extent)[a] / size[a]);
+    for (auto& v : m->vertices) v = v.cwiseProduct(k);
+  } else if (s.fit_size > 0) {
     const Eigen::AlignedBox3f b = m->bounds();
     const double extent = (b.max() - b.min()).maxCoeff();
     if (extent > 0) {

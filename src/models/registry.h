@@ -25,6 +25,11 @@ struct ModelSpec {
   // If > 0, the mesh is scaled uniformly so its largest extent equals this
   // (mm); overrides `scale`.
   double fit_size = 0.0;
+  // If set (all > 0), each axis is scaled on its own so the bounding box,
+  // after the up axis is turned to +z, measures x, y, z mm: a stand-in
+  // squeezed to another object's proportions (the armadillo to the
+  // thesis's Statue of Liberty). Overrides `scale` and `fit_size`.
+  std::optional<Vec3> fit_extent;
   std::string up = "+z";   // the file's up axis: +x -x +y -y +z -z
   std::string role = "target";  // "target" or "distractor" (informational)
   std::vector<Mat4> symmetries_discrete;  // in the normalized frame

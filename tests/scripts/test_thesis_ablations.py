@@ -55,6 +55,14 @@ class Derive(unittest.TestCase):
         self.assertEqual(d["settings"], {"verify": {"score": "inliers"}, "views": {"follow_scene": False}})
         self.assertEqual(d["scenes"], EXPERIMENT["scenes"])
 
+    def test_config_switch_replaces_top_level_keys_only(self):
+        d = ta.derive(spec(config={"perturb_deg": 30, "perturb_mm": 100}), "table_x", EXPERIMENT)
+        self.assertEqual((d["perturb_deg"], d["perturb_mm"]), (30, 100))
+        self.assertEqual(d["scenes"], EXPERIMENT["scenes"])
+        self.assertEqual(d["settings"], EXPERIMENT["settings"])
+        self.assertEqual(d["seed"], EXPERIMENT["seed"])
+        self.assertNotIn("perturb_deg", EXPERIMENT)
+
     def test_no_scene_left_is_an_error(self):
         with self.assertRaises(ta.SpecError) as c:
             ta.derive(spec(scenes=["nowhere"], generator={"x": 1}), "table_x", EXPERIMENT, "cfg.yaml")
@@ -103,6 +111,10 @@ class BadSpec(unittest.TestCase):
              "ablations[0].cause"),
             ("ablations:\n  - {name: a, cause: c, switched: s, experiments: [no_such], settings: {}}\n",
              "no config"),
+            ("ablations:\n  - {name: a, cause: c, switched: s, experiments: [x], config: {seed: 2}}\n",
+             "ablations[0].config.seed: cannot be switched"),
+            ("ablations:\n  - {name: a, cause: c, switched: s, experiments: [x], config: 3}\n",
+             "ablations[0].config: must be a mapping"),
         ]
         for text, want in cases:
             code, err = self.run_spec(text)
