@@ -54,8 +54,11 @@ OLD_DEFAULTS = {
     "astra": {"model": "structured_light", "baseline_mm": 75.0, "disparity_step_px": 0.125,
               "disparity_sigma_px": 0.05, "smoothing_radius_px": 1, "smoothing_edge_px": 1.0,
               "max_incidence_deg": 75.0, "shadows": True},
+    # not fitted (no real frames): its current model, with the driver's edge
+    # filter (results/sensors/README.md)
     "kinect_one": {"model": "tof", "sigma_base_mm": 1.5, "sigma_per_m2_mm": 0.75, "edge_jump_mm": 30.0,
-                   "flying_fraction": 1.0, "max_incidence_deg": 80.0},
+                   "flying_fraction": 1.0, "max_incidence_deg": 80.0, "driver_edge_filter": True,
+                   "edge_filter_close_mm": 50.0, "edge_filter_far_mm": 30.0, "edge_filter_span_mm": 100.0},
 }
 NOISE_BINS = (500.0, 4000.0)  # depth range the noise is fitted over
 QUANT_MIN_Z = 1500.0          # below, the real sensor's 1 mm output rounding hides the step
