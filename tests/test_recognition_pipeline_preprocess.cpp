@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cstring>
 #include <limits>
 
@@ -204,6 +205,56 @@ TEST(Preprocess, PlaneNoiseFactorRemovesANoisyTableWhole) {
   image.points[5].z() = std::numeric_limits<float>::quiet_NaN();  // invalid pixels are skipped
   EXPECT_NEAR(pb::detail::depth_noise_sigma(image), 3, 0.3);
   EXPECT_EQ(pb::detail::depth_noise_sigma(steps), 0);
+}
+
+// Mixed pixels at a depth edge: a wall at 1000 mm, a square 200 mm before
+// it, and between them one column of pixels halfway (the mixed returns of a
+// time-of-flight camera). The veil filter flags that column and the edge's
+// last pixel on each side, nothing inside either surface, even with 1 mm of
+// noise on 2 mm pixel spacing; off (0 deg) it flags nothing.
+TEST(Preprocess, VeilFilterDropsMixedPixelsAndKeepsSurfaces) {
+  const int W = 120, H = 80;
+  const double f = 500;  // pixel spacing z / f: 2 mm at 1 m
+  pb::Rng rng(3);
+  pb::OrganizedCloud cloud;
+  cloud.width = W;
+  cloud.height = H;
+  auto depth = [](int u) { return u < 60 ? 800.0 : u == 60 ? 900.0 : 1000.0; };
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u) {
+      const double z = depth(u) + rng.normal(0, 1.0);
+      cloud.points.emplace_back((u - W / 2 + 0.5) * z / f, (v - H / 2 + 0.5) * z / f, z);
+    }
+  cloud.points[5].z() = std::numeric_limits<float>::quiet_NaN();  // invalid pixels are skipped
+  const std::vector<char> veil = pb::detail::veil_pixels(cloud, 10);
+  int mixed = 0, edges = 0, inside = 0;
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u) {
+      const char flag = veil[static_cast<size_t>(v) * W + u];
+      if (u == 60) mixed += flag;
+      else if (u == 59 || u == 61) edges += flag;
+      else inside += flag;
+    }
+  EXPECT_EQ(mixed, H);
+  EXPECT_EQ(edges, 2 * H);
+  EXPECT_EQ(inside, 0);
+  const std::vector<char> off = pb::detail::veil_pixels(cloud, 0);
+  EXPECT_EQ(std::count(off.begin(), off.end(), 1), 0);
+
+  // preprocess_scene drops them before the voxel grid: no point left
+  // between the two surfaces.
+  pb::PreprocessSettings s;
+  s.voxel_mm = 0;
+  s.remove_plane = false;
+  s.normal_radius_mm = 10;
+  auto between = [](const PointSet& ps) {
+    int n = 0;
+    for (const auto& p : ps.points) n += p.z() > 820 && p.z() < 980;
+    return n;
+  };
+  EXPECT_EQ(between(pb::preprocess_scene(cloud, s, 1)), H);
+  s.veil_angle_deg = 10;
+  EXPECT_EQ(between(pb::preprocess_scene(cloud, s, 1)), 0);
 }
 
 // Normals by PCA in a radius: exact on a plane (zero curvature) and on a

@@ -49,6 +49,15 @@ double depth_noise_sigma(const OrganizedCloud& cloud, int row_step = 4);
 // evenly in tree order to that many (keep_evenly, kdtree.h).
 void estimate_normals(PointSet& cloud, double radius_mm, int max_points = 0);
 
+// Mixed ("flying", "veil") pixels of an organized cloud: flags a valid pixel
+// when the 3D step to one of its valid 8-neighbours lies within `angle_deg`
+// of the pixel's viewing ray (a surface seen that edge-on returns almost no
+// light, so such a step is a depth edge, not a surface). Flags the pixels
+// between the two sides of a depth edge and the edge's last pixel on each
+// side; a surface facing the camera keeps every pixel unless the noise
+// between two neighbours exceeds their spacing / tan(angle_deg).
+std::vector<char> veil_pixels(const OrganizedCloud& cloud, double angle_deg);
+
 // Keeps the points whose flag is set (all per-point arrays).
 PointSet select(const PointSet& in, const std::vector<char>& keep);
 

@@ -163,6 +163,35 @@ double depth_noise_sigma(const OrganizedCloud& cloud, int row_step) {
   return static_cast<double>(*mid) / 0.6745 / std::sqrt(6.0);
 }
 
+std::vector<char> veil_pixels(const OrganizedCloud& cloud, double angle_deg) {
+  const int W = cloud.width, H = cloud.height;
+  std::vector<char> veil(cloud.points.size(), 0);
+  if (!(angle_deg > 0) || W < 2 || H < 2) return veil;
+  // |d . r| > cos(angle) |d|, squared: (d . r)^2 > cos^2 |d|^2 (r unit).
+  const double c2 = std::pow(std::cos(angle_deg * M_PI / 180.0), 2);
+  auto valid = [](const Vec3f& p) { return std::isfinite(p.z()) && p.z() > 0; };
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u) {
+      const size_t i = static_cast<size_t>(v) * W + u;
+      const Vec3f& p = cloud.points[i];
+      if (!valid(p)) continue;
+      const Eigen::Vector3d r = p.cast<double>().normalized();
+      // Each unordered pair once (the right half of the 8-neighbourhood),
+      // flagging both ends.
+      for (const auto& [du, dv] : {std::pair{1, 0}, std::pair{-1, 1}, std::pair{0, 1}, std::pair{1, 1}}) {
+        const int uu = u + du, vv = v + dv;
+        if (uu < 0 || uu >= W || vv >= H) continue;
+        const size_t j = static_cast<size_t>(vv) * W + uu;
+        const Vec3f& q = cloud.points[j];
+        if (!valid(q)) continue;
+        const Eigen::Vector3d d = (q - p).cast<double>();
+        const double along = d.dot(r);
+        if (along * along > c2 * d.squaredNorm()) veil[i] = veil[j] = 1;
+      }
+    }
+  return veil;
+}
+
 }  // namespace detail
 
 namespace {
@@ -186,7 +215,16 @@ PointSet range_cut(const OrganizedCloud& cloud, double min_z, double max_z) {
 }  // namespace
 
 PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings& s, uint64_t seed) {
-  PointSet ps = range_cut(cloud, s.min_range_mm, s.max_range_mm);
+  PointSet ps;
+  if (s.veil_angle_deg > 0) {
+    OrganizedCloud kept = cloud;
+    const std::vector<char> veil = detail::veil_pixels(cloud, s.veil_angle_deg);
+    for (size_t i = 0; i < veil.size(); ++i)
+      if (veil[i]) kept.points[i] = Vec3f::Constant(std::numeric_limits<float>::quiet_NaN());
+    ps = range_cut(kept, s.min_range_mm, s.max_range_mm);
+  } else {
+    ps = range_cut(cloud, s.min_range_mm, s.max_range_mm);
+  }
   ps = voxel_downsample(ps, {s.voxel_mm});
   if (s.remove_plane) {
     const double min_count = s.min_plane_fraction * static_cast<double>(ps.size());

@@ -12,6 +12,12 @@ namespace pb {
 struct PreprocessSettings {
   double min_range_mm = 100.0;      // points closer than this are dropped
   double max_range_mm = 3000.0;     // far points cut (thesis: "cut by range")
+  double veil_angle_deg = 0.0;      // drop mixed ("flying") pixels first: a pixel whose 3D step to an
+                                    // 8-neighbour lies within this angle of its viewing ray, with that
+                                    // neighbour (a time-of-flight camera's mixed returns at depth edges;
+                                    // also the edge's last pixel on each side). 0 = off, as the thesis
+                                    // (which describes no such filter). Measured on the Kinect One
+                                    // rows: results/thesis/FINDINGS.md
   double voxel_mm = 10.0;           // downsampling voxel (Table 4.2: 20 warehouse, 10 table)
   bool remove_plane = true;         // remove the dominant plane (floor / table)
   double plane_threshold_mm = 10.0; // RANSAC inlier distance for the plane
@@ -43,6 +49,7 @@ struct PreprocessSettings {
   static void fields(S& s, F& f) {
     f("min_range_mm", s.min_range_mm, fields::nonnegative());
     f("max_range_mm", s.max_range_mm, fields::positive());
+    f("veil_angle_deg", s.veil_angle_deg, fields::in_range(0, 90));
     f("voxel_mm", s.voxel_mm, fields::length(fields::nonnegative()));
     f("remove_plane", s.remove_plane);
     f("plane_threshold_mm", s.plane_threshold_mm, fields::length(fields::positive()));
