@@ -1375,7 +1375,9 @@ def section_ablations(res, ablations, cells, path):
     o = ["## Ablations: what each change of the set-up does\n"]
     if not ablations:
         return o + ["No ablations (`%s` is missing or lists none).\n" % shown_path(path)]
-    o.append("Each ablation runs an experiment again with one cause switched back (`%s`). Per ablation: the cells "
+    o.append("Each ablation runs an experiment again with one cause switched back (`%s`): back to the set-up before "
+             "issue 10, or to another reading of what the thesis leaves open (the column says which). Per ablation: "
+             "the cells "
              "compared, those that move by more than 15 points, those whose two counts differ at p < 0.05 (Fisher's "
              "exact test), the mean robustness both ways and how many cells are within 15 points of the thesis both "
              "ways.\n" % shown_path(path))
