@@ -507,7 +507,8 @@ DIFFERENCES = [
     "the CRH roll), and, as CVFH, describes a cloud without a stable region by the ESF of all of it. Why it trails "
     "CVFH (an ESF of one smooth region looks like a smooth region of a distractor, so the right pair ranks below "
     "the top 5) and why Table 4.9's accuracy order is inverted (reciprocal correspondences) is measured in "
-    "`results/thesis/FINDINGS.md`.",
+    "`results/thesis/FINDINGS.md`. The cesf ablation runs CESF with the other reading of its definition, the ESF "
+    "of the whole cluster posed from each stable region (`global.cesf_whole_cluster`).",
     "Times are wall-clock seconds of the online computation of one image (training views excluded: they are "
     "rendered and described once and cached), single-threaded; the load column of the experiments table says "
     "what else ran on the machine.",

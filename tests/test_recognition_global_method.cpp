@@ -166,6 +166,30 @@ TEST_F(GlobalMethod, CesfWithoutStableRegionsFallsBackToTheWholeCloud) {
   EXPECT_FALSE(same(cesf_regions->hypothesize(*scene_, *views_, 11, t), esf_default->hypothesize(*scene_, *views_, 11, t)));
 }
 
+// global.cesf_whole_cluster: every region's signature is the ESF of the
+// whole cloud (ESF's own histogram, same stream), the regions giving only the
+// frames. So CESF's best match distance is ESF's, and its poses are not.
+TEST_F(GlobalMethod, CesfWholeClusterDescribesTheCloudFromEachRegion) {
+  GlobalSettings whole;
+  whole.cesf_whole_cluster = true;
+  ASSERT_FALSE(global::stable_regions(*scene_, whole).empty());
+  auto cesf = make("cesf", whole), esf = make("esf"), cesf_regions = make("cesf");
+  for (auto* m : {&cesf, &esf, &cesf_regions}) (*m)->train(*views_, 5);
+  StageTimes t;
+  const auto best = [](const std::vector<Hypothesis>& h) {
+    double b = 0;
+    for (const auto& x : h) b = std::max(b, x.score);
+    return b;
+  };
+  const auto h = cesf->hypothesize(*scene_, *views_, 11, t), he = esf->hypothesize(*scene_, *views_, 11, t),
+             hr = cesf_regions->hypothesize(*scene_, *views_, 11, t);
+  ASSERT_FALSE(h.empty());
+  ASSERT_FALSE(he.empty());
+  EXPECT_DOUBLE_EQ(best(h), best(he));
+  EXPECT_NE(best(h), best(hr));  // the regions' own ESFs match at other distances
+  EXPECT_FALSE(same(h, he));     // posed from the regions, not as ESF
+}
+
 TEST(GlobalRegions, StableRegionsMatchPclCvfh) {
   // Our stable regions (CESF) are CVFH's: the same centroids.
   RecognitionSettings s;

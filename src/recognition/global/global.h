@@ -19,6 +19,13 @@ struct GlobalSettings {
   double crh_peak_threshold = 0.3;      // distinct CRH peaks above this fraction of the max
   int crh_max_peaks = 3;                // at most this many roll hypotheses per match
   bool skip_crh = false;                // assume the object upright: roll from the view (Table 4.4)
+  // CESF, which ESF a stable region's signature holds. false: the ESF of
+  // the region's own points (the thesis's "an ESF-histogram for each
+  // sufficiently large cluster", the cluster read as the stable region).
+  // true: the ESF of the whole cloud, the region giving only the frame
+  // (CVFH's way: pcl::CVFHEstimation describes all the cloud's points from
+  // each region's frame). results/thesis/FINDINGS.md measures both.
+  bool cesf_whole_cluster = false;
   // Added by the global pipeline (PCL's defaults where PCL has the value):
   double cvfh_normal_radius_mm = 20.0;  // normals recomputed on the low-curvature points (CVFH, CESF)
   bool cvfh_normalize_bins = false;     // CVFH bins count points (thesis, PCL default); true: percentages
@@ -42,6 +49,7 @@ struct GlobalSettings {
     f("crh_peak_threshold", s.crh_peak_threshold, fields::in_range(0, 1));
     f("crh_max_peaks", s.crh_max_peaks, fields::at_least(1));
     f("skip_crh", s.skip_crh);
+    f("cesf_whole_cluster", s.cesf_whole_cluster);
     f("cvfh_normal_radius_mm", s.cvfh_normal_radius_mm, fields::length(fields::positive()));
     f("cvfh_normalize_bins", s.cvfh_normalize_bins);
     f("crh_peak_distance_deg", s.crh_peak_distance_deg, fields::nonnegative(180, " degrees"));

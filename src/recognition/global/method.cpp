@@ -101,10 +101,17 @@ std::vector<Signature> describe(Kind kind, const PointSet& cloud, const GlobalSe
       // back to the VFH of all the cloud's points), the ESF of the whole
       // cloud, posed like ESF's (centroid, camera-to-centroid axis).
       if (regions.empty()) return describe(Kind::kEsf, cloud, g, seed);
+      // cesf_whole_cluster: one ESF of the whole cloud (ESF's stream), shared
+      // by every region's signature.
+      std::vector<float> whole;
+      if (g.cesf_whole_cluster) {
+        Rng rng(derive_seed(seed, {0}));
+        whole = compute_esf(cloud.points, rng, g.esf_samples);
+      }
       for (size_t r = 0; r < regions.size(); ++r) {
         Rng rng(derive_seed(seed, {r + 1}));
         Signature s;
-        s.hist = compute_esf(regions[r].points, rng, g.esf_samples);
+        s.hist = g.cesf_whole_cluster ? whole : compute_esf(regions[r].points, rng, g.esf_samples);
         s.centroid = regions[r].centroid;
         s.axis = -regions[r].mean_normal;
         s.from_normal = true;
