@@ -502,7 +502,9 @@ DIFFERENCES = [
     "The milk carton is judged with the symmetries of `models/models.yaml` (stricter than the thesis; see Table "
     "4.5 for both judgments).",
     "ESF is the project's own seeded implementation (PCL's ESFEstimation reseeds the C generator from the clock); "
-    "the thesis used PCL's.",
+    "the thesis used PCL's. ESF has no surface frame: its initial pose aligns the rays from the camera to the two "
+    "clouds' centroids, where the thesis's section 3.2.4 aligns the clusters' average normals for every global "
+    "descriptor; the esfpose ablation runs ESF that way.",
     "CESF follows the thesis's definition (CVFH's stable regions after high-curvature removal, an ESF per region, "
     "the CRH roll), and, as CVFH, describes a cloud without a stable region by the ESF of all of it. Why it trails "
     "CVFH (an ESF of one smooth region looks like a smooth region of a distractor, so the right pair ranks below "

@@ -3,6 +3,7 @@
 // input, and the `global:` YAML section.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <sstream>
 #include <thread>
 
@@ -188,6 +189,28 @@ TEST_F(GlobalMethod, CesfWholeClusterDescribesTheCloudFromEachRegion) {
   EXPECT_DOUBLE_EQ(best(h), best(he));
   EXPECT_NE(best(h), best(hr));  // the regions' own ESFs match at other distances
   EXPECT_FALSE(same(h, he));     // posed from the regions, not as ESF
+}
+
+// global.esf_pose_from_normals: ESF's histograms and match distances are
+// the same, its poses are not (the average normals are aligned instead of
+// the camera-to-centroid rays).
+TEST_F(GlobalMethod, EsfPoseFromNormalsKeepsTheMatchesAndMovesThePoses) {
+  GlobalSettings normals;
+  normals.esf_pose_from_normals = true;
+  auto a = make("esf"), b = make("esf", normals);
+  a->train(*views_, 5);
+  b->train(*views_, 5);
+  StageTimes t;
+  const auto ha = a->hypothesize(*scene_, *views_, 11, t), hb = b->hypothesize(*scene_, *views_, 11, t);
+  ASSERT_FALSE(ha.empty());
+  ASSERT_EQ(ha.size(), hb.size());
+  std::vector<double> sa, sb;
+  for (const auto& h : ha) sa.push_back(h.score);
+  for (const auto& h : hb) sb.push_back(h.score);
+  std::sort(sa.begin(), sa.end());
+  std::sort(sb.begin(), sb.end());
+  EXPECT_EQ(sa, sb);
+  EXPECT_FALSE(same(ha, hb));
 }
 
 TEST(GlobalRegions, StableRegionsMatchPclCvfh) {

@@ -26,6 +26,12 @@ struct GlobalSettings {
   // (CVFH's way: pcl::CVFHEstimation describes all the cloud's points from
   // each region's frame). results/thesis/FINDINGS.md measures both.
   bool cesf_whole_cluster = false;
+  // ESF's initial pose (ESF has no surface frame). false: the rays from the
+  // camera to the two clouds' centroids are aligned (the view's axis). true:
+  // their average normals are, as the thesis's section 3.2.4 states for
+  // every global descriptor. Also CESF's fallback for a cloud without a
+  // stable region, which is posed as ESF.
+  bool esf_pose_from_normals = false;
   // Added by the global pipeline (PCL's defaults where PCL has the value):
   double cvfh_normal_radius_mm = 20.0;  // normals recomputed on the low-curvature points (CVFH, CESF)
   bool cvfh_normalize_bins = false;     // CVFH bins count points (thesis, PCL default); true: percentages
@@ -50,6 +56,7 @@ struct GlobalSettings {
     f("crh_max_peaks", s.crh_max_peaks, fields::at_least(1));
     f("skip_crh", s.skip_crh);
     f("cesf_whole_cluster", s.cesf_whole_cluster);
+    f("esf_pose_from_normals", s.esf_pose_from_normals);
     f("cvfh_normal_radius_mm", s.cvfh_normal_radius_mm, fields::length(fields::positive()));
     f("cvfh_normalize_bins", s.cvfh_normalize_bins);
     f("crh_peak_distance_deg", s.crh_peak_distance_deg, fields::nonnegative(180, " degrees"));

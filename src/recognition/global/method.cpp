@@ -92,6 +92,12 @@ std::vector<Signature> describe(Kind kind, const PointSet& cloud, const GlobalSe
       s.centroid = mean_point(cloud.points);
       if (!(s.centroid.norm() > 0)) return out;
       s.axis = s.centroid.normalized();
+      if (g.esf_pose_from_normals && cloud.has_normals()) {
+        const Vec3f n = mean_point(cloud.normals);  // toward the viewpoint
+        if (!(n.norm() > 0)) return out;
+        s.axis = -n.normalized();
+        s.from_normal = true;
+      }
       out.push_back(std::move(s));
       return out;
     }
