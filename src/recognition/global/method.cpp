@@ -76,6 +76,13 @@ Vec3f mean_point(const std::vector<Vec3f>& pts) {
   return pts.empty() ? Vec3f::Zero() : Vec3f((c / static_cast<double>(pts.size())).cast<float>());
 }
 
+// The ESF of a whole cloud, from the cloud's first stream (ESF's signature,
+// and CESF's with cesf_whole_cluster).
+std::vector<float> whole_cloud_esf(const PointSet& cloud, const GlobalSettings& g, uint64_t seed) {
+  Rng rng(derive_seed(seed, {0}));
+  return compute_esf(cloud.points, rng, g.esf_samples);
+}
+
 // The method's signatures of one cloud (a training view or a scene cluster).
 std::vector<Signature> describe(Kind kind, const PointSet& cloud, const GlobalSettings& g, uint64_t seed) {
   std::vector<Signature> out;
@@ -86,9 +93,8 @@ std::vector<Signature> describe(Kind kind, const PointSet& cloud, const GlobalSe
       return global::ourcvfh_signatures(cloud, g);
     case Kind::kEsf: {
       if (cloud.size() < 3) return out;
-      Rng rng(derive_seed(seed, {0}));
       Signature s;
-      s.hist = compute_esf(cloud.points, rng, g.esf_samples);
+      s.hist = whole_cloud_esf(cloud, g, seed);
       s.centroid = mean_point(cloud.points);
       if (!(s.centroid.norm() > 0)) return out;
       s.axis = s.centroid.normalized();
@@ -107,13 +113,9 @@ std::vector<Signature> describe(Kind kind, const PointSet& cloud, const GlobalSe
       // back to the VFH of all the cloud's points), the ESF of the whole
       // cloud, posed like ESF's (centroid, camera-to-centroid axis).
       if (regions.empty()) return describe(Kind::kEsf, cloud, g, seed);
-      // cesf_whole_cluster: one ESF of the whole cloud (ESF's stream), shared
-      // by every region's signature.
-      std::vector<float> whole;
-      if (g.cesf_whole_cluster) {
-        Rng rng(derive_seed(seed, {0}));
-        whole = compute_esf(cloud.points, rng, g.esf_samples);
-      }
+      // cesf_whole_cluster: one ESF of the whole cloud, shared by every
+      // region's signature.
+      const std::vector<float> whole = g.cesf_whole_cluster ? whole_cloud_esf(cloud, g, seed) : std::vector<float>{};
       for (size_t r = 0; r < regions.size(); ++r) {
         Rng rng(derive_seed(seed, {r + 1}));
         Signature s;

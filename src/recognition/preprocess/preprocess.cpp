@@ -196,7 +196,9 @@ std::vector<char> veil_pixels(const OrganizedCloud& cloud, double angle_deg) {
 
 namespace {
 
-PointSet range_cut(const OrganizedCloud& cloud, double min_z, double max_z) {
+// The valid pixels within [min_z, max_z], except those flagged in `drop`
+// (empty: none).
+PointSet range_cut(const OrganizedCloud& cloud, double min_z, double max_z, const std::vector<char>& drop = {}) {
   PointSet ps;
   ps.source_width = cloud.width;
   ps.source_height = cloud.height;
@@ -205,7 +207,7 @@ PointSet range_cut(const OrganizedCloud& cloud, double min_z, double max_z) {
   for (size_t i = 0; i < cloud.points.size(); ++i) {
     const Vec3f& p = cloud.points[i];
     if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) continue;
-    if (p.z() < min_z || p.z() > max_z) continue;
+    if (p.z() < min_z || p.z() > max_z || (!drop.empty() && drop[i])) continue;
     ps.points.push_back(p);
     ps.pixel.push_back(static_cast<int>(i));
   }
@@ -215,16 +217,8 @@ PointSet range_cut(const OrganizedCloud& cloud, double min_z, double max_z) {
 }  // namespace
 
 PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings& s, uint64_t seed) {
-  PointSet ps;
-  if (s.veil_angle_deg > 0) {
-    OrganizedCloud kept = cloud;
-    const std::vector<char> veil = detail::veil_pixels(cloud, s.veil_angle_deg);
-    for (size_t i = 0; i < veil.size(); ++i)
-      if (veil[i]) kept.points[i] = Vec3f::Constant(std::numeric_limits<float>::quiet_NaN());
-    ps = range_cut(kept, s.min_range_mm, s.max_range_mm);
-  } else {
-    ps = range_cut(cloud, s.min_range_mm, s.max_range_mm);
-  }
+  PointSet ps = range_cut(cloud, s.min_range_mm, s.max_range_mm,
+                          s.veil_angle_deg > 0 ? detail::veil_pixels(cloud, s.veil_angle_deg) : std::vector<char>{});
   ps = voxel_downsample(ps, {s.voxel_mm});
   if (s.remove_plane) {
     const double min_count = s.min_plane_fraction * static_cast<double>(ps.size());
