@@ -1,10 +1,12 @@
 // Noise models: measured Gaussian sigma, structured-light error growth with
 // depth and projector shadows, time-of-flight flying pixels only at depth
-// edges, grazing angles, ranges, and seeding.
+// edges, grazing angles, ranges, seeding, and the structured-light model
+// against its definition bit for bit.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 #include "core/rotation.h"
 #include "render/sensor.h"
@@ -122,6 +124,86 @@ TEST(RenderNoise, StructuredLightQuantizesDisparity) {
       ++checked;
     }
   EXPECT_GT(checked, 100000u);
+}
+
+// The structured-light model by its definition, pixel by pixel (sensor.h):
+// measured pixels (valid, not grazing, not in the projector's shadow) get
+// disparity fb / z plus one normal draw each in row-major order; each is
+// then the mean over its window of the measured pixels whose true disparity
+// lies within smoothing_edge_px of its own, rounded to the disparity step.
+DepthImage structured_light_by_definition(const RenderOutput& out, const SensorProfile& sensor,
+                                          const StructuredLightNoise& s, uint64_t seed) {
+  const Intrinsics& K = sensor.K;
+  const int W = K.width, H = K.height;
+  const size_t N = static_cast<size_t>(W) * H;
+  const double fb = K.fx * s.baseline_mm;
+  const std::vector<uint8_t> shadow = projector_shadow_mask(out.depth, K, s.baseline_mm);
+  const double cos_max = std::cos(s.max_incidence_deg * M_PI / 180.0);
+  std::vector<uint8_t> ok(N, 0);
+  std::vector<double> d_true(N, 0.0), d_noisy(N, 0.0);
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u) {
+      const size_t px = static_cast<size_t>(v) * W + u;
+      const float z = out.depth.z[px];
+      if (!(z > 0.f && std::isfinite(z))) continue;
+      const Vec3 n = out.normals[px].cast<double>();
+      const Vec3 ray = Vec3((u - K.cx) / K.fx, (v - K.cy) / K.fy, 1.0).normalized();
+      const bool grazing = n.squaredNorm() >= 1e-12 && std::abs(n.normalized().dot(ray)) < cos_max;
+      ok[px] = !grazing && !(s.shadows && shadow[px]);
+      d_true[px] = fb / z;
+    }
+  Rng rng(seed);
+  for (size_t px = 0; px < N; ++px)
+    if (ok[px]) d_noisy[px] = d_true[px] + rng.normal(0.0, s.disparity_sigma_px);
+  DepthImage d(W, H);
+  const int r = s.smoothing_radius_px;
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u) {
+      const size_t px = static_cast<size_t>(v) * W + u;
+      if (!ok[px]) continue;
+      double sum = 0;
+      int count = 0;
+      for (int vv = std::max(0, v - r); vv <= std::min(H - 1, v + r); ++vv)
+        for (int uu = std::max(0, u - r); uu <= std::min(W - 1, u + r); ++uu) {
+          const size_t q = static_cast<size_t>(vv) * W + uu;
+          if (ok[q] && std::abs(d_true[q] - d_true[px]) <= s.smoothing_edge_px) {
+            sum += d_noisy[q];
+            ++count;
+          }
+        }
+      const double dq = std::round(sum / count / s.disparity_step_px) * s.disparity_step_px;
+      const float z = dq > 0 ? static_cast<float>(fb / dq) : 0.f;
+      d.z[px] = z < sensor.min_range_mm || z > sensor.max_range_mm ? 0.f : z;
+    }
+  return d;
+}
+
+TEST(RenderNoise, StructuredLightEqualsItsDefinitionBitForBit) {
+  // The generator's version sums four pixels' windows side by side; every
+  // depth must be the plain definition's, on the Astra frame and on frames
+  // narrower than a block of windows, for several window sizes.
+  const SensorProfile astra = sensor_profile("astra");
+  std::vector<SensorProfile> sensors{astra};
+  for (int width : {3, 7, 13}) {
+    sensors.push_back(astra);
+    sensors.back().K = Intrinsics::from_fov(width, 9, 60, 45);
+  }
+  for (const SensorProfile& sensor : sensors) {
+    const RenderOutput out = render_box_wall(sensor.K);
+    for (int r : {0, 1, 2, 3}) {
+      NoiseSettings n = astra.noise;
+      n.structured_light.smoothing_radius_px = r;
+      const DepthImage got = noisy(out, sensor, n, 7);
+      const DepthImage want = structured_light_by_definition(out, sensor, n.structured_light, 7);
+      size_t differ = 0, measured = 0;
+      for (size_t i = 0; i < got.z.size(); ++i) {
+        differ += std::memcmp(&got.z[i], &want.z[i], sizeof(float)) != 0;
+        measured += want.z[i] > 0;
+      }
+      EXPECT_EQ(differ, 0u) << sensor.K.width << " px wide, radius " << r;
+      EXPECT_GT(measured, got.z.size() / 4) << sensor.K.width << " px wide, radius " << r;
+    }
+  }
 }
 
 TEST(RenderNoise, ProjectorShadowsLieLeftOfTheBox) {

@@ -217,6 +217,15 @@ RenderOutput DepthRenderer::render(const std::vector<RenderItem>& items) {
   }
 
   const double zA = f + n, zB = f - n, zC = 2.0 * f * n;
+  // The viewing ray's x of every column and y of every row (the same values
+  // as computing them per pixel).
+  std::vector<double> ray_x(static_cast<size_t>(W)), ray_y(static_cast<size_t>(H));
+  for (int u = 0; u < W; ++u) ray_x[static_cast<size_t>(u)] = (u - K_.cx) / K_.fx;
+  for (int v = 0; v < H; ++v) ray_y[static_cast<size_t>(v)] = (v - K_.cy) / K_.fy;
+  // The face of the previous pixel: neighbouring pixels mostly share one.
+  uint64_t last_gid = ~uint64_t(0);
+  size_t item = 0;
+  const Impl::Plane* pl = nullptr;
   const uint8_t* col = impl_->color.data();
   for (int v = 0; v < H; ++v) {
     const int row = H - 1 - v;  // GL row 0 is the bottom row
@@ -226,28 +235,29 @@ RenderOutput DepthRenderer::render(const std::vector<RenderItem>& items) {
                           (uint32_t(col[4 * gl + 2]) << 16) | (uint32_t(col[4 * gl + 3]) << 24);
       if (id == 0) continue;
       const uint64_t gid = id - 1;
-      const size_t item = std::upper_bound(base.begin(), base.end(), gid) - base.begin() - 1;
+      if (gid != last_gid) {
+        item = std::upper_bound(base.begin(), base.end(), gid) - base.begin() - 1;
+        pl = item < items.size() && need_planes ? &impl_->face_plane(items, base, item, gid) : nullptr;
+        last_gid = gid;
+      }
       if (item >= items.size()) continue;  // cannot happen with an intact colour buffer
       const size_t px = static_cast<size_t>(v) * W + u;
       const double dn = impl_->depth[gl] / 4294967295.0;
       const double z_ndc = 2.0 * dn - 1.0;
       double z = zC / (zA - z_ndc * zB);
       out.labels[px] = items[item].label;
-      if (need_planes) {
-        const Impl::Plane& pl = impl_->face_plane(items, base, item, gid);
-        if (pl.valid) {
-          const Vec3 ray((u - K_.cx) / K_.fx, (v - K_.cy) / K_.fy, 1.0);
-          const double denom = pl.n.dot(ray);
-          if (settings_.exact_depth && std::abs(denom) > 1e-12) {
-            const double ze = pl.d / denom;
-            // Guard against extrapolation far off the face at extreme grazing
-            // angles: keep the buffer value unless the two agree.
-            if (ze > 0 && std::abs(ze - z) < 1.0 + 1e-3 * z) z = ze;
-          }
-          if (settings_.normals) {
-            const Vec3 nc = denom > 0 ? Vec3(-pl.n) : pl.n;
-            out.normals[px] = nc.cast<float>();
-          }
+      if (pl && pl->valid) {
+        const Vec3 ray(ray_x[static_cast<size_t>(u)], ray_y[static_cast<size_t>(v)], 1.0);
+        const double denom = pl->n.dot(ray);
+        if (settings_.exact_depth && std::abs(denom) > 1e-12) {
+          const double ze = pl->d / denom;
+          // Guard against extrapolation far off the face at extreme grazing
+          // angles: keep the buffer value unless the two agree.
+          if (ze > 0 && std::abs(ze - z) < 1.0 + 1e-3 * z) z = ze;
+        }
+        if (settings_.normals) {
+          const Vec3 nc = denom > 0 ? Vec3(-pl->n) : pl->n;
+          out.normals[px] = nc.cast<float>();
         }
       }
       out.depth.z[px] = static_cast<float>(z);

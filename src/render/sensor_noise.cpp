@@ -1,0 +1,309 @@
+// The depth noise models (see sensor.h): Gaussian, structured light, time
+// of flight, applied to a rendered depth image.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+
+#include "core/error.h"
+#include "render/sensor.h"
+
+namespace pb {
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+bool valid_depth(float z) { return z > 0.f && std::isfinite(z); }
+
+// The unit viewing ray of every pixel of K, row-major: computed once per
+// thread and camera (the generator renders every image of a set with one K).
+const std::vector<Vec3>& unit_rays(const Intrinsics& K) {
+  thread_local Intrinsics cached;
+  thread_local std::vector<Vec3> rays;
+  const bool same = cached.fx == K.fx && cached.fy == K.fy && cached.cx == K.cx && cached.cy == K.cy &&
+                    cached.width == K.width && cached.height == K.height;
+  if (same && rays.size() == static_cast<size_t>(K.width) * K.height) return rays;
+  rays.resize(static_cast<size_t>(K.width) * K.height);
+  for (int v = 0; v < K.height; ++v)
+    for (int u = 0; u < K.width; ++u)
+      rays[static_cast<size_t>(v) * K.width + u] = Vec3((u - K.cx) / K.fx, (v - K.cy) / K.fy, 1.0).normalized();
+  cached = K;
+  return rays;
+}
+
+// Pixels whose viewing ray meets the surface at more than max_deg from the
+// normal (zero normals are never grazing).
+std::vector<uint8_t> grazing_mask(const DepthImage& depth, const std::vector<Vec3f>& normals,
+                                  const Intrinsics& K, double max_deg) {
+  const size_t N = static_cast<size_t>(depth.width) * depth.height;
+  std::vector<uint8_t> mask(N, 0);
+  const double cos_max = std::cos(max_deg * kDeg);
+  const std::vector<Vec3>& rays = unit_rays(K);
+  for (size_t px = 0; px < N; ++px) {
+    if (!valid_depth(depth.z[px])) continue;
+    const Vec3 n = normals[px].cast<double>();
+    if (n.squaredNorm() < 1e-12) continue;
+    const double c = std::abs(n.normalized().dot(rays[px]));
+    mask[px] = c < cos_max;
+  }
+  return mask;
+}
+
+// std::round (halves away from zero) for |x| < 2^52, without the library
+// call: x minus its truncation is exact.
+inline double round_half_away(double x) {
+  if (!(std::abs(x) < 4503599627370496.0)) return std::round(x);
+  const double t = static_cast<double>(static_cast<int64_t>(x));
+  const double f = x - t;
+  return f >= 0.5 ? t + 1.0 : f <= -0.5 ? t - 1.0 : t;
+}
+
+const std::vector<Vec3f>& normals_for(const DepthImage& depth, const RenderOutput& render, const Intrinsics& K,
+                                      std::vector<Vec3f>& storage) {
+  if (render.normals.size() == depth.z.size()) return render.normals;
+  storage = estimate_normals(depth, K);
+  return storage;
+}
+
+void apply_gaussian(DepthImage& depth, const GaussianNoise& g, Rng& rng) {
+  if (g.sigma_mm <= 0) return;
+  for (float& z : depth.z)
+    if (valid_depth(z)) z = static_cast<float>(z + rng.normal(0.0, g.sigma_mm));
+}
+
+void apply_structured_light(DepthImage& depth, const std::vector<Vec3f>& normals, const Intrinsics& K,
+                            const StructuredLightNoise& s, Rng& rng) {
+  const int W = depth.width, H = depth.height;
+  const size_t N = depth.z.size();
+  const double fb = K.fx * s.baseline_mm;
+  // Per-thread scratch, reused from image to image (no fresh pages each
+  // time). d_cmp: the true disparity of a measured pixel, +inf elsewhere (it
+  // then fails every same-surface test); d_noisy: 0 where not measured.
+  thread_local std::vector<double> d_cmp, d_noisy;
+  thread_local std::vector<uint8_t> ok;
+  d_cmp.assign(N, std::numeric_limits<double>::infinity());
+  d_noisy.assign(N, 0.0);
+  ok.assign(N, 0);
+  std::vector<uint8_t> shadow;
+  if (s.shadows) shadow = projector_shadow_mask(depth, K, s.baseline_mm);
+  const std::vector<uint8_t> grazing = grazing_mask(depth, normals, K, s.max_incidence_deg);
+  for (size_t px = 0; px < N; ++px) {
+    if (!valid_depth(depth.z[px])) continue;
+    ok[px] = !grazing[px] && !(s.shadows && shadow[px]);
+    if (ok[px]) d_cmp[px] = fb / depth.z[px];
+  }
+  for (size_t px = 0; px < N; ++px)
+    if (ok[px]) d_noisy[px] = d_cmp[px] + rng.normal(0.0, s.disparity_sigma_px);
+  const int r = std::max(0, s.smoothing_radius_px);
+  const double edge = s.smoothing_edge_px;
+  const auto finish = [&](size_t px, double sum, int count) {
+    const double d = sum / count;  // count >= 1: the pixel itself
+    const double dq = round_half_away(d / s.disparity_step_px) * s.disparity_step_px;
+    depth.z[px] = dq > 0 ? static_cast<float>(fb / dq) : 0.f;
+  };
+  // Each measured pixel: the mean noisy disparity of the window's pixels of
+  // the same surface, summed in row-major window order; a pixel left out
+  // adds +0.0, which leaves the sum as it is, bit for bit. A sum is a chain
+  // of dependent additions: four neighbouring pixels are summed side by side
+  // (SSE2, two lanes per register) so that their chains overlap, each in
+  // its own order.
+  for (int v = 0; v < H; ++v) {
+    const int v0 = std::max(0, v - r), v1 = std::min(H - 1, v + r);
+    const size_t line = static_cast<size_t>(v) * W;
+    // One pixel on its own (the windows cut by the border; every pixel
+    // without SSE2).
+    const auto single = [&](int u) {
+      const size_t px = line + u;
+      if (!ok[px]) {
+        depth.z[px] = 0.f;
+        return;
+      }
+      const int u0 = std::max(0, u - r), u1 = std::min(W - 1, u + r);
+      const double centre = d_cmp[px];
+      double sum = 0.0;
+      int count = 0;
+      for (int vv = v0; vv <= v1; ++vv) {
+        const size_t row = static_cast<size_t>(vv) * W;
+        for (int uu = u0; uu <= u1; ++uu) {
+          const bool same = !(std::abs(d_cmp[row + uu] - centre) > edge);
+          sum += same ? d_noisy[row + uu] : 0.0;
+          count += same;
+        }
+      }
+      finish(px, sum, count);
+    };
+    int u = 0;
+#ifdef __SSE2__
+    for (; u < std::min(r, W); ++u) single(u);
+    const __m128d sign = _mm_set1_pd(-0.0), lim = _mm_set1_pd(edge), one = _mm_set1_pd(1.0);
+    for (; u + 3 + r < W; u += 4) {
+      const __m128d c0 = _mm_loadu_pd(&d_cmp[line + u]), c1 = _mm_loadu_pd(&d_cmp[line + u + 2]);
+      __m128d s0 = _mm_setzero_pd(), s1 = s0, n0 = s0, n1 = s0;
+      for (int vv = v0; vv <= v1; ++vv) {
+        const size_t row = static_cast<size_t>(vv) * W + u;
+        for (int du = -r; du <= r; ++du) {
+          const size_t q = row + du;
+          const __m128d m0 = _mm_cmpngt_pd(_mm_andnot_pd(sign, _mm_sub_pd(_mm_loadu_pd(&d_cmp[q]), c0)), lim);
+          const __m128d m1 = _mm_cmpngt_pd(_mm_andnot_pd(sign, _mm_sub_pd(_mm_loadu_pd(&d_cmp[q + 2]), c1)), lim);
+          s0 = _mm_add_pd(s0, _mm_and_pd(m0, _mm_loadu_pd(&d_noisy[q])));
+          s1 = _mm_add_pd(s1, _mm_and_pd(m1, _mm_loadu_pd(&d_noisy[q + 2])));
+          n0 = _mm_add_pd(n0, _mm_and_pd(m0, one));
+          n1 = _mm_add_pd(n1, _mm_and_pd(m1, one));
+        }
+      }
+      alignas(16) double sum[4], count[4];
+      _mm_store_pd(sum, s0);
+      _mm_store_pd(sum + 2, s1);
+      _mm_store_pd(count, n0);
+      _mm_store_pd(count + 2, n1);
+      for (int k = 0; k < 4; ++k) {
+        const size_t px = line + u + k;
+        if (ok[px]) finish(px, sum[k], static_cast<int>(count[k]));
+        else depth.z[px] = 0.f;
+      }
+    }
+#endif
+    for (; u < W; ++u) single(u);
+  }
+}
+
+// The driver's edge filter (TimeOfFlightNoise::driver_edge_filter): judges
+// every pixel against the nearest and farthest valid depth of its 3x3
+// window in the unfiltered image, so the result does not depend on the
+// scan order. Border pixels are kept (no full window).
+void drop_flying_pixels(DepthImage& depth, const TimeOfFlightNoise& t) {
+  const int W = depth.width, H = depth.height;
+  const DepthImage raw = depth;
+  for (int v = 1; v + 1 < H; ++v)
+    for (int u = 1; u + 1 < W; ++u) {
+      const float z = raw.at(u, v);
+      if (!valid_depth(z)) continue;
+      float lo = z, hi = z;
+      for (int dv = -1; dv <= 1; ++dv)
+        for (int du = -1; du <= 1; ++du) {
+          const float zq = raw.at(u + du, v + dv);
+          if (!valid_depth(zq)) continue;
+          lo = std::min(lo, zq);
+          hi = std::max(hi, zq);
+        }
+      const double behind_nearest = z - lo, before_farthest = hi - z;
+      if (behind_nearest > t.edge_filter_close_mm && before_farthest > t.edge_filter_far_mm &&
+          std::max(behind_nearest, before_farthest) > t.edge_filter_span_mm)
+        depth.z[static_cast<size_t>(v) * W + u] = 0.f;
+    }
+}
+
+void apply_tof(DepthImage& depth, const std::vector<Vec3f>& normals, const Intrinsics& K,
+               const TimeOfFlightNoise& t, Rng& rng) {
+  const int W = depth.width, H = depth.height;
+  const DepthImage truth = depth;
+  const std::vector<uint8_t> grazing = grazing_mask(truth, normals, K, t.max_incidence_deg);
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u) {
+      const size_t px = static_cast<size_t>(v) * W + u;
+      const float z0 = truth.z[px];
+      if (!valid_depth(z0) || grazing[px]) {
+        depth.z[px] = 0.f;
+        continue;
+      }
+      // The largest depth jump to a valid 8-neighbour.
+      float other = z0;
+      for (int dv = -1; dv <= 1; ++dv)
+        for (int du = -1; du <= 1; ++du) {
+          const int uu = u + du, vv = v + dv;
+          if ((du == 0 && dv == 0) || uu < 0 || vv < 0 || uu >= W || vv >= H) continue;
+          const float zq = truth.at(uu, vv);
+          if (valid_depth(zq) && std::abs(zq - z0) > std::abs(other - z0)) other = zq;
+        }
+      double z = z0;
+      if (std::abs(other - z0) > t.edge_jump_mm && rng.bernoulli(t.flying_fraction)) {
+        const double lo = std::min(z0, other), hi = std::max(z0, other);
+        z = lo + rng.uniform() * (hi - lo);
+      }
+      const double zm = z / 1000.0;
+      z += rng.normal(0.0, t.sigma_base_mm + t.sigma_per_m2_mm * zm * zm);
+      depth.z[px] = z > 0 ? static_cast<float>(z) : 0.f;
+    }
+  if (t.driver_edge_filter) drop_flying_pixels(depth, t);
+}
+
+}  // namespace
+
+std::vector<uint8_t> projector_shadow_mask(const DepthImage& depth, const Intrinsics& K, double baseline_mm) {
+  // The projector shares the camera's orientation and intrinsics and sits at
+  // +b along x, so a camera point at pixel (u, v), depth z, appears in the
+  // projector at column u_p = u - fx b / z of the same row. Along one
+  // projector ray, nearer points have larger camera u. Z-buffering in the
+  // projector therefore reduces to: a pixel is shadowed if some pixel to its
+  // right in the row maps to a smaller projector column (it passed in front).
+  const int W = depth.width, H = depth.height;
+  std::vector<uint8_t> mask(static_cast<size_t>(W) * H, 0);
+  const double fb = K.fx * baseline_mm;
+  constexpr double kTol = 1e-3;  // px; a surface seen exactly edge-on is not self-shadowed
+  for (int v = 0; v < H; ++v) {
+    double min_up = std::numeric_limits<double>::infinity();
+    for (int u = W - 1; u >= 0; --u) {
+      const float z = depth.at(u, v);
+      if (!valid_depth(z)) continue;
+      const double up = u - fb / z;
+      if (up > min_up + kTol) mask[static_cast<size_t>(v) * W + u] = 1;
+      min_up = std::min(min_up, up);
+    }
+  }
+  return mask;
+}
+
+std::vector<Vec3f> estimate_normals(const DepthImage& depth, const Intrinsics& K, double edge_jump_mm) {
+  const int W = depth.width, H = depth.height;
+  std::vector<Vec3f> normals(static_cast<size_t>(W) * H, Vec3f::Zero());
+  auto point = [&](int u, int v) { return K.backproject(u, v, depth.at(u, v)); };
+  // A neighbour on the same surface as (u, v), or none.
+  auto same = [&](int u, int v, int uu, int vv) {
+    if (uu < 0 || vv < 0 || uu >= W || vv >= H) return false;
+    const float z = depth.at(uu, vv);
+    return valid_depth(z) && std::abs(z - depth.at(u, v)) <= edge_jump_mm;
+  };
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u) {
+      if (!valid_depth(depth.at(u, v))) continue;
+      const Vec3 p = point(u, v);
+      const bool r = same(u, v, u + 1, v), l = same(u, v, u - 1, v);
+      const bool d = same(u, v, u, v + 1), t = same(u, v, u, v - 1);
+      if (!(r || l) || !(d || t)) continue;
+      const Vec3 dx = (r ? point(u + 1, v) : p) - (l ? point(u - 1, v) : p);
+      const Vec3 dy = (d ? point(u, v + 1) : p) - (t ? point(u, v - 1) : p);
+      Vec3 n = dx.cross(dy);
+      const double len = n.norm();
+      if (!(len > 0)) continue;
+      n /= len;
+      if (n.dot(p) > 0) n = -n;
+      normals[static_cast<size_t>(v) * W + u] = n.cast<float>();
+    }
+  return normals;
+}
+
+void apply_noise(DepthImage& depth, const RenderOutput& render, const SensorProfile& sensor,
+                 const NoiseSettings& noise, Rng& rng) {
+  const Intrinsics& K = sensor.K;
+  if (depth.width != K.width || depth.height != K.height)
+    throw std::invalid_argument("apply_noise: depth image size differs from the sensor's intrinsics");
+  std::vector<Vec3f> estimated;
+  if (noise.model == "none") {
+  } else if (noise.model == "gaussian") {
+    apply_gaussian(depth, noise.gaussian, rng);
+  } else if (noise.model == "structured_light") {
+    apply_structured_light(depth, normals_for(depth, render, K, estimated), K, noise.structured_light, rng);
+  } else if (noise.model == "tof") {
+    apply_tof(depth, normals_for(depth, render, K, estimated), K, noise.tof, rng);
+  } else {
+    throw InputError("", "noise.model", "unknown noise model '" + noise.model + "'");
+  }
+  for (float& z : depth.z)
+    if (!valid_depth(z) || z < sensor.min_range_mm || z > sensor.max_range_mm) z = 0.f;
+}
+
+}  // namespace pb
