@@ -4,6 +4,9 @@
 #include <cstdint>
 #include <cstring>
 #include <numeric>
+#ifdef __SSE2__
+#include <xmmintrin.h>
+#endif
 
 namespace pb {
 
@@ -15,10 +18,15 @@ KdTree3::KdTree3(const std::vector<Vec3f>& points, int leaf_size) {
   build(points, 0, static_cast<int>(points.size()), std::max(1, leaf_size));
   points_.resize(points.size());
   position_.resize(points.size());
+  for (auto& c : xyz_) c.reserve(points.size() + 3);
   for (size_t i = 0; i < order_.size(); ++i) {
     points_[i] = points[static_cast<size_t>(order_[i])];
+    xyz_[0].push_back(points_[i].x());
+    xyz_[1].push_back(points_[i].y());
+    xyz_[2].push_back(points_[i].z());
     position_[static_cast<size_t>(order_[i])] = static_cast<int>(i);
   }
+  for (auto& c : xyz_) c.resize(points.size() + 3, 0.f);  // the last block of four reads whole
 }
 
 // Splits at the median of the widest extent (the input points, addressed
@@ -54,15 +62,41 @@ int KdTree3::build(const std::vector<Vec3f>& pts, int begin, int end, int leaf_s
   return id;
 }
 
+inline int KdTree3::leaf_distances(const Vec3f& q, int i, int m, float bound, float* d4) const {
+#ifdef __SSE2__
+  // Four lanes read whole (the arrays are padded); lanes from m on are masked.
+  const __m128 dx = _mm_sub_ps(_mm_loadu_ps(&xyz_[0][static_cast<size_t>(i)]), _mm_set1_ps(q.x()));
+  const __m128 dy = _mm_sub_ps(_mm_loadu_ps(&xyz_[1][static_cast<size_t>(i)]), _mm_set1_ps(q.y()));
+  const __m128 dz = _mm_sub_ps(_mm_loadu_ps(&xyz_[2][static_cast<size_t>(i)]), _mm_set1_ps(q.z()));
+  const __m128 d = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_add_ps(_mm_mul_ps(dy, dy), _mm_mul_ps(dz, dz)));
+  _mm_storeu_ps(d4, d);
+  return _mm_movemask_ps(_mm_cmple_ps(d, _mm_set1_ps(bound))) & ((1 << m) - 1);
+#else
+  int mask = 0;
+  for (int k = 0; k < m; ++k) {
+    d4[k] = (points_[static_cast<size_t>(i + k)] - q).squaredNorm();
+    if (d4[k] <= bound) mask |= 1 << k;
+  }
+  return mask;
+#endif
+}
+
 void KdTree3::nearest_in(int node, const Vec3f& q, int& best, float& best_d) const {
   const Node& n = nodes_[static_cast<size_t>(node)];
   if (n.dim < 0) {
-    for (int i = n.begin; i < n.end; ++i) {
-      const float d = (points_[static_cast<size_t>(i)] - q).squaredNorm();
-      const int idx = order_[static_cast<size_t>(i)];
-      if (d < best_d || (d == best_d && best >= 0 && idx < best)) {
-        best_d = d;
-        best = idx;
+    // Four squared distances at a time, each as Eigen's squaredNorm sums it
+    // (x^2 + (y^2 + z^2)); only those at most the bound are looked at.
+    float d4[4];
+    for (int i = n.begin; i < n.end; i += 4) {
+      const int m = std::min(4, n.end - i);
+      for (int mask = leaf_distances(q, i, m, best_d, d4); mask != 0; mask &= mask - 1) {
+        const int k = __builtin_ctz(static_cast<unsigned>(mask));
+        const float d = d4[k];
+        const int idx = order_[static_cast<size_t>(i + k)];
+        if (d < best_d || (d == best_d && best >= 0 && idx < best)) {
+          best_d = d;
+          best = idx;
+        }
       }
     }
     return;
