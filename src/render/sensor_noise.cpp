@@ -20,7 +20,8 @@ constexpr double kDeg = M_PI / 180.0;
 bool valid_depth(float z) { return z > 0.f && std::isfinite(z); }
 
 // The unit viewing ray of every pixel of K, row-major: computed once per
-// thread and camera (the generator renders every image of a set with one K).
+// thread and camera (the generator renders every image of a set with one K;
+// 24 bytes per pixel, 7 MB at 640 x 480, kept by each thread).
 const std::vector<Vec3>& unit_rays(const Intrinsics& K) {
   thread_local Intrinsics cached;
   thread_local std::vector<Vec3> rays;
