@@ -181,7 +181,8 @@ DepthImage structured_light_by_definition(const RenderOutput& out, const SensorP
 TEST(RenderNoise, StructuredLightEqualsItsDefinitionBitForBit) {
   // The generator's version sums four pixels' windows side by side; every
   // depth must be the plain definition's, on the Astra frame and on frames
-  // narrower than a block of windows, for several window sizes.
+  // narrower than a block of windows, for several window sizes, with and
+  // without the edge test (an infinite edge).
   const SensorProfile astra = sensor_profile("astra");
   std::vector<SensorProfile> sensors{astra};
   for (int width : {3, 7, 13}) {
@@ -190,19 +191,21 @@ TEST(RenderNoise, StructuredLightEqualsItsDefinitionBitForBit) {
   }
   for (const SensorProfile& sensor : sensors) {
     const RenderOutput out = render_box_wall(sensor.K);
-    for (int r : {0, 1, 2, 3}) {
-      NoiseSettings n = astra.noise;
-      n.structured_light.smoothing_radius_px = r;
-      const DepthImage got = noisy(out, sensor, n, 7);
-      const DepthImage want = structured_light_by_definition(out, sensor, n.structured_light, 7);
-      size_t differ = 0, measured = 0;
-      for (size_t i = 0; i < got.z.size(); ++i) {
-        differ += std::memcmp(&got.z[i], &want.z[i], sizeof(float)) != 0;
-        measured += want.z[i] > 0;
+    for (int r : {0, 1, 2, 3})
+      for (double edge : {astra.noise.structured_light.smoothing_edge_px, HUGE_VAL}) {  // inf: no edge awareness
+        NoiseSettings n = astra.noise;
+        n.structured_light.smoothing_radius_px = r;
+        n.structured_light.smoothing_edge_px = edge;
+        const DepthImage got = noisy(out, sensor, n, 7);
+        const DepthImage want = structured_light_by_definition(out, sensor, n.structured_light, 7);
+        size_t differ = 0, measured = 0;
+        for (size_t i = 0; i < got.z.size(); ++i) {
+          differ += std::memcmp(&got.z[i], &want.z[i], sizeof(float)) != 0;
+          measured += want.z[i] > 0;
+        }
+        EXPECT_EQ(differ, 0u) << sensor.K.width << " px wide, radius " << r << ", edge " << edge;
+        EXPECT_GT(measured, got.z.size() / 4) << sensor.K.width << " px wide, radius " << r << ", edge " << edge;
       }
-      EXPECT_EQ(differ, 0u) << sensor.K.width << " px wide, radius " << r;
-      EXPECT_GT(measured, got.z.size() / 4) << sensor.K.width << " px wide, radius " << r;
-    }
   }
 }
 

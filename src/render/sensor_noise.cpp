@@ -100,7 +100,9 @@ void apply_structured_light(DepthImage& depth, const std::vector<Vec3f>& normals
   for (size_t px = 0; px < N; ++px)
     if (ok[px]) d_noisy[px] = d_cmp[px] + rng.normal(0.0, s.disparity_sigma_px);
   const int r = std::max(0, s.smoothing_radius_px);
-  const double edge = s.smoothing_edge_px;
+  // An infinite edge (average every measured pixel) as the largest finite
+  // one: the +inf of unmeasured pixels must still fail the test.
+  const double edge = std::min(s.smoothing_edge_px, std::numeric_limits<double>::max());
   const auto finish = [&](size_t px, double sum, int count) {
     const double d = sum / count;  // count >= 1: the pixel itself
     const double dq = round_half_away(d / s.disparity_step_px) * s.disparity_step_px;
