@@ -20,16 +20,29 @@ namespace {
 // or degenerate.
 bool pca_normal(const std::vector<Vec3f>& pts, const std::vector<int>& nb, Vec3f& normal, float& curvature) {
   if (nb.size() < 3) return false;
-  const Vec3 o = pts[static_cast<size_t>(nb[0])].cast<double>();
-  Vec3 sum = Vec3::Zero();
-  Mat3 sq = Mat3::Zero();
+  const Vec3f& o = pts[static_cast<size_t>(nb[0])];
+  const double ox = o.x(), oy = o.y(), oz = o.z();
+  // The six distinct entries of the sum of d d^T (d_i d_j == d_j d_i
+  // exactly), each summed in neighbour order as the full outer product was.
+  double sx = 0, sy = 0, sz = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
   for (int j : nb) {
-    const Vec3 d = pts[static_cast<size_t>(j)].cast<double>() - o;
-    sum += d;
-    sq += d * d.transpose();
+    const Vec3f& p = pts[static_cast<size_t>(j)];
+    const double dx = static_cast<double>(p.x()) - ox, dy = static_cast<double>(p.y()) - oy,
+                 dz = static_cast<double>(p.z()) - oz;
+    sx += dx;
+    sy += dy;
+    sz += dz;
+    xx += dx * dx;
+    xy += dx * dy;
+    xz += dx * dz;
+    yy += dy * dy;
+    yz += dy * dz;
+    zz += dz * dz;
   }
+  Mat3 sq;
+  sq << xx, xy, xz, xy, yy, yz, xz, yz, zz;
   const double n = static_cast<double>(nb.size());
-  const Vec3 mean = sum / n;
+  const Vec3 mean = Vec3(sx, sy, sz) / n;
   const Mat3 cov = sq / n - mean * mean.transpose();
   Eigen::SelfAdjointEigenSolver<Mat3> es;
   es.computeDirect(cov);
