@@ -31,6 +31,7 @@
 #include <limits>
 
 #include "recognition/local/internal.h"
+#include "recognition/scatter.h"
 
 namespace pb::local {
 
@@ -138,14 +139,13 @@ bool board_frame(const Vec3f& q, const PointSet& cloud, const Neighbours& nn, Bo
   Vec3f centroid = Vec3f::Zero();
   for (const auto& e : nn) centroid += cloud.points[static_cast<size_t>(e.second)];
   centroid /= static_cast<float>(nn.size());
-  Mat3 cov = Mat3::Zero();
+  Scatter3 cov;
   Vec3f normal_sum = Vec3f::Zero();
   for (const auto& e : nn) {
-    const Vec3 d = (cloud.points[static_cast<size_t>(e.second)] - centroid).cast<double>();
-    cov.noalias() += d * d.transpose();
+    cov.add((cloud.points[static_cast<size_t>(e.second)] - centroid).cast<double>());
     normal_sum += cloud.normals[static_cast<size_t>(e.second)];
   }
-  Vec3f z = Eigen::SelfAdjointEigenSolver<Mat3>(cov).eigenvectors().col(0).cast<float>();
+  Vec3f z = Eigen::SelfAdjointEigenSolver<Mat3>(cov.matrix()).eigenvectors().col(0).cast<float>();
   if (z.dot(normal_sum.normalized()) < 0) z = -z;
   // x: the steepest margin point, or the widest hole in the margin.
   const Vec3f x0 = start_axis(z, how);

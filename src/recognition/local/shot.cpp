@@ -30,6 +30,7 @@
 #include <limits>
 
 #include "recognition/local/internal.h"
+#include "recognition/scatter.h"
 
 namespace pb::local {
 
@@ -70,19 +71,19 @@ Vec3 disambiguate(Vec3 axis, const std::vector<Vec3>& off) {
 bool reference_frame(const Vec3f& q, const std::vector<Vec3f>& pts, const Neighbours& nn, double radius, Frame* f,
                      std::vector<Vec3>& off) {
   off.clear();
-  Mat3 cov = Mat3::Zero();
+  Scatter3 scatter;
   double sum = 0;
   for (const auto& [d2, i] : nn) {
     const Vec3f& p = pts[static_cast<size_t>(i)];
     if (p == q) continue;
     const Vec3 v = (p - q).cast<double>();
     const double w = radius - std::sqrt(static_cast<double>(d2));
-    cov.noalias() += w * (v * v.transpose());
+    scatter.add_weighted(w, v);
     sum += w;
     off.push_back(v);
   }
   if (off.size() < 5) return false;
-  cov /= sum;
+  const Mat3 cov = scatter.matrix() / sum;
   const Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
   if (!es.eigenvalues().allFinite()) return false;
   const Vec3 x = disambiguate(es.eigenvectors().col(2), off);

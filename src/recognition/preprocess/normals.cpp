@@ -11,6 +11,7 @@
 
 #include "recognition/kdtree.h"
 #include "recognition/preprocess/internal.h"
+#include "recognition/scatter.h"
 
 namespace pb::detail {
 
@@ -22,9 +23,8 @@ bool pca_normal(const std::vector<Vec3f>& pts, const std::vector<int>& nb, Vec3f
   if (nb.size() < 3) return false;
   const Vec3f& o = pts[static_cast<size_t>(nb[0])];
   const double ox = o.x(), oy = o.y(), oz = o.z();
-  // The six distinct entries of the sum of d d^T (d_i d_j == d_j d_i
-  // exactly), each summed in neighbour order as the full outer product was.
-  double sx = 0, sy = 0, sz = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+  double sx = 0, sy = 0, sz = 0;
+  Scatter3 sq;
   for (int j : nb) {
     const Vec3f& p = pts[static_cast<size_t>(j)];
     const double dx = static_cast<double>(p.x()) - ox, dy = static_cast<double>(p.y()) - oy,
@@ -32,18 +32,11 @@ bool pca_normal(const std::vector<Vec3f>& pts, const std::vector<int>& nb, Vec3f
     sx += dx;
     sy += dy;
     sz += dz;
-    xx += dx * dx;
-    xy += dx * dy;
-    xz += dx * dz;
-    yy += dy * dy;
-    yz += dy * dz;
-    zz += dz * dz;
+    sq.add(dx, dy, dz);
   }
-  Mat3 sq;
-  sq << xx, xy, xz, xy, yy, yz, xz, yz, zz;
   const double n = static_cast<double>(nb.size());
   const Vec3 mean = Vec3(sx, sy, sz) / n;
-  const Mat3 cov = sq / n - mean * mean.transpose();
+  const Mat3 cov = sq.matrix() / n - mean * mean.transpose();
   Eigen::SelfAdjointEigenSolver<Mat3> es;
   es.computeDirect(cov);
   const Vec3 ev = es.eigenvalues();
