@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/yaml.h"
+#include "recognition/kdtree.h"
 #include "recognition/preprocess/internal.h"
 #include "recognition/preprocess/preprocess.h"
 #include "recognition/preprocess/voxel_grid.h"
@@ -91,6 +92,18 @@ void BM_Normals(benchmark::State& st) {
   st.counters["points"] = static_cast<double>(ps.size());
 }
 
+// The kd-tree over the downsampled cloud (normals, refinement crops and
+// verification build one per cloud).
+void BM_KdTreeBuild(benchmark::State& st) {
+  const Frame& f = frame(static_cast<int>(st.range(0)));
+  const PointSet ps = voxel_downsample(cut(f), {f.s.voxel_mm});
+  for (auto _ : st) {
+    const KdTree3 tree(ps.points);
+    benchmark::DoNotOptimize(tree.size());
+  }
+  st.counters["points"] = static_cast<double>(ps.size());
+}
+
 void BM_PreprocessScene(benchmark::State& st) {
   const Frame& f = frame(static_cast<int>(st.range(0)));
   const OrganizedCloud c = OrganizedCloud::from_depth(f.depth, f.K);
@@ -109,6 +122,7 @@ BENCHMARK(BM_FromDepth)->Apply(Args);
 BENCHMARK(BM_VoxelGrid)->Apply(Args);
 BENCHMARK(BM_Plane)->Apply(Args);
 BENCHMARK(BM_Normals)->Apply(Args);
+BENCHMARK(BM_KdTreeBuild)->Apply(Args);
 BENCHMARK(BM_PreprocessScene)->Apply(Args);
 
 BENCHMARK_MAIN();

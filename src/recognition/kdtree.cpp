@@ -15,12 +15,15 @@ KdTree3::KdTree3(const std::vector<Vec3f>& points, int leaf_size) {
   std::iota(order_.begin(), order_.end(), 0);
   if (points.empty()) return;
   nodes_.reserve(2 * points.size() / static_cast<size_t>(std::max(1, leaf_size)) + 2);
-  build(points, 0, static_cast<int>(points.size()), std::max(1, leaf_size));
+  std::vector<Entry> entries(points.size());
+  for (size_t i = 0; i < points.size(); ++i) entries[i] = {points[i], static_cast<int>(i)};
+  build(entries, 0, static_cast<int>(points.size()), std::max(1, leaf_size));
+  for (size_t i = 0; i < entries.size(); ++i) order_[i] = entries[i].index;
   points_.resize(points.size());
   position_.resize(points.size());
   for (auto& c : xyz_) c.reserve(points.size() + 3);
   for (size_t i = 0; i < order_.size(); ++i) {
-    points_[i] = points[static_cast<size_t>(order_[i])];
+    points_[i] = entries[i].point;
     xyz_[0].push_back(points_[i].x());
     xyz_[1].push_back(points_[i].y());
     xyz_[2].push_back(points_[i].z());
@@ -29,17 +32,18 @@ KdTree3::KdTree3(const std::vector<Vec3f>& points, int leaf_size) {
   for (auto& c : xyz_) c.resize(points.size() + 3, 0.f);  // the last block of four reads whole
 }
 
-// Splits at the median of the widest extent (the input points, addressed
-// through order_).
-int KdTree3::build(const std::vector<Vec3f>& pts, int begin, int end, int leaf_size) {
+// Splits at the median of the widest extent. The entries carry their points
+// (no lookup through the index); ties in the coordinate go by the input
+// index, so the order is total and the tree depends on the points alone.
+int KdTree3::build(std::vector<Entry>& e, int begin, int end, int leaf_size) {
   const int id = static_cast<int>(nodes_.size());
   nodes_.emplace_back();
   nodes_[static_cast<size_t>(id)].begin = begin;
   nodes_[static_cast<size_t>(id)].end = end;
   if (end - begin <= leaf_size) return id;
-  Vec3f lo = pts[static_cast<size_t>(order_[static_cast<size_t>(begin)])], hi = lo;
+  Vec3f lo = e[static_cast<size_t>(begin)].point, hi = lo;
   for (int i = begin + 1; i < end; ++i) {
-    const Vec3f& p = pts[static_cast<size_t>(order_[static_cast<size_t>(i)])];
+    const Vec3f& p = e[static_cast<size_t>(i)].point;
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
@@ -47,13 +51,13 @@ int KdTree3::build(const std::vector<Vec3f>& pts, int begin, int end, int leaf_s
   (hi - lo).maxCoeff(&dim);
   if (!(hi[dim] > lo[dim])) return id;  // all points equal: one leaf
   const int mid = begin + (end - begin) / 2;
-  std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end, [&](int a, int b) {
-    const float x = pts[static_cast<size_t>(a)][dim], y = pts[static_cast<size_t>(b)][dim];
-    return x < y || (x == y && a < b);
+  std::nth_element(e.begin() + begin, e.begin() + mid, e.begin() + end, [dim](const Entry& a, const Entry& b) {
+    const float x = a.point[dim], y = b.point[dim];
+    return x < y || (x == y && a.index < b.index);
   });
-  const float split = pts[static_cast<size_t>(order_[static_cast<size_t>(mid)])][dim];
-  const int left = build(pts, begin, mid, leaf_size);
-  const int right = build(pts, mid, end, leaf_size);
+  const float split = e[static_cast<size_t>(mid)].point[dim];
+  const int left = build(e, begin, mid, leaf_size);
+  const int right = build(e, mid, end, leaf_size);
   Node& n = nodes_[static_cast<size_t>(id)];
   n.dim = dim;
   n.split = split;

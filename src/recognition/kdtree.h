@@ -42,7 +42,11 @@ class KdTree3 {
     float split = 0;
     int left = -1, right = -1;
   };
-  int build(const std::vector<Vec3f>& pts, int begin, int end, int leaf_size);
+  struct Entry {
+    Vec3f point;
+    int index;  // in the input
+  };
+  int build(std::vector<Entry>& entries, int begin, int end, int leaf_size);
   void nearest_in(int node, const Vec3f& q, int& best, float& best_d) const;
   // Squared distances from q of the m <= 4 points at tree positions i..i+m
   // into d4 (as Eigen's squaredNorm computes them); bit k of the result: the
