@@ -3,7 +3,8 @@
 // in the order the offsets are added. The same sums, bit for bit, as the
 // lower triangle of Eigen's `S += d * d.transpose()` (or `w * (...)`, see
 // add_weighted) over the full 3x3, at a third of the work.
-// Used by every PCA of a neighbourhood: normals, the SHOT and BOARD frames.
+// Used by every PCA of a point set: normals (preprocessing, refinement),
+// the plane fit, the SHOT and BOARD frames.
 #pragma once
 
 #include "core/types.h"

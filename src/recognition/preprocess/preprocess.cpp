@@ -19,6 +19,7 @@
 #include "core/random.h"
 #include "recognition/preprocess/internal.h"
 #include "recognition/preprocess/voxel_grid.h"
+#include "recognition/scatter.h"
 
 namespace pb {
 
@@ -60,13 +61,10 @@ bool fit_plane(const std::vector<Vec3f>& pts, const std::vector<char>& use, Eige
     }
   if (cnt < 3) return false;
   mean /= static_cast<double>(cnt);
-  Mat3 cov = Mat3::Zero();
+  Scatter3 cov;
   for (size_t i = 0; i < pts.size(); ++i)
-    if (use[i]) {
-      const Vec3 d = pts[i].cast<double>() - mean;
-      cov += d * d.transpose();
-    }
-  Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
+    if (use[i]) cov.add(pts[i].cast<double>() - mean);
+  Eigen::SelfAdjointEigenSolver<Mat3> es(cov.matrix());
   if (es.info() != Eigen::Success) return false;
   const Vec3 nrm = es.eigenvectors().col(0).normalized();
   if (!nrm.allFinite()) return false;

@@ -16,6 +16,7 @@
 #include "recognition/refine/internal.h"
 #include "recognition/refine/refine.h"
 #include "recognition/registry.h"
+#include "recognition/scatter.h"
 
 namespace pb {
 
@@ -35,12 +36,9 @@ std::vector<Vec3f> estimate_normals(const std::vector<Vec3f>& pts, int k) {
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     for (int j : idx) mean += pts[j].cast<double>();
     mean /= static_cast<double>(idx.size());
-    Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
-    for (int j : idx) {
-      const Eigen::Vector3d d = pts[j].cast<double>() - mean;
-      C += d * d.transpose();
-    }
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(C);
+    Scatter3 C;
+    for (int j : idx) C.add(pts[j].cast<double>() - mean);
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(C.matrix());
     normals[i] = es.eigenvectors().col(0).cast<float>().normalized();
   }
   return normals;
