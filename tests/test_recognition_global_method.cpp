@@ -213,6 +213,25 @@ TEST_F(GlobalMethod, EsfPoseFromNormalsKeepsTheMatchesAndMovesThePoses) {
   EXPECT_FALSE(same(ha, hb));
 }
 
+TEST_F(GlobalMethod, TopKCountingRollsKeepsTheFirstTopKHypotheses) {
+  // top_k 2 matches with up to 3 CRH rolls each; counting the rolls keeps
+  // the first 2 of those hypotheses, in the same order.
+  GlobalSettings g;
+  g.top_k = 2;
+  GlobalSettings rolls = g;
+  rolls.top_k_counts_rolls = true;
+  for (const char* name : {"cvfh", "cesf"}) {
+    auto a = make(name, g), b = make(name, rolls);
+    a->train(*views_, 5);
+    b->train(*views_, 5);
+    StageTimes t;
+    const auto ha = a->hypothesize(*scene_, *views_, 11, t), hb = b->hypothesize(*scene_, *views_, 11, t);
+    ASSERT_GT(ha.size(), 2u) << name << ": the fixture should give more than one roll per match";
+    ASSERT_EQ(hb.size(), 2u) << name;
+    EXPECT_TRUE(same({ha[0], ha[1]}, hb)) << name;
+  }
+}
+
 TEST(GlobalRegions, StableRegionsMatchPclCvfh) {
   // Our stable regions (CESF) are CVFH's: the same centroids.
   RecognitionSettings s;
@@ -230,8 +249,10 @@ TEST(GlobalRegions, StableRegionsMatchPclCvfh) {
 
 TEST(GlobalSettingsYaml, ParsesAndRejects) {
   GlobalSettings g;
-  parse_section(YamlNode::load_string("top_k: 7\nskip_crh: true\ncrh_max_peaks: 2\nesf_samples: 5000\n", "g.yaml"), g);
+  parse_section(YamlNode::load_string("top_k: 7\nskip_crh: true\ncrh_max_peaks: 2\nesf_samples: 5000\n"
+                                      "top_k_counts_rolls: true\n", "g.yaml"), g);
   EXPECT_EQ(g.top_k, 7);
+  EXPECT_TRUE(g.top_k_counts_rolls);
   EXPECT_TRUE(g.skip_crh);
   EXPECT_EQ(g.crh_max_peaks, 2);
   EXPECT_EQ(g.esf_samples, 5000);

@@ -15,7 +15,15 @@ struct GlobalSettings {
   double cvfh_cluster_tolerance_mm = 15.0;  // region growing distance threshold (t_d)
   int cvfh_min_region_points = 20;      // "sufficiently large" stable region (also CESF)
   int esf_samples = 20000;              // ESF random triples (PCL's value)
-  int top_k = 5;                        // hypotheses passed to refinement (thesis: 5)
+  int top_k = 5;                        // matches passed on to the initial poses (thesis: "the top
+                                        // five hypotheses"), each with its CRH roll peaks
+  // What top_k counts. false: matches, each expanded into up to
+  // crh_max_peaks roll hypotheses (so up to top_k x crh_max_peaks are
+  // refined). true: hypotheses after that expansion, the first top_k in
+  // match order with each match's rolls strongest first. The thesis passes
+  // "the top five hypotheses" to refinement (section 4.2.1), and "multiple
+  // distinguished peaks result in multiple new hypotheses" (section 3.2.4).
+  bool top_k_counts_rolls = false;
   double crh_peak_threshold = 0.3;      // distinct CRH peaks above this fraction of the max
   int crh_max_peaks = 3;                // at most this many roll hypotheses per match
   bool skip_crh = false;                // assume the object upright: roll from the view (Table 4.4)
@@ -52,6 +60,7 @@ struct GlobalSettings {
     f("cvfh_min_region_points", s.cvfh_min_region_points, fields::at_least(3));
     f("esf_samples", s.esf_samples, fields::at_least(1));
     f("top_k", s.top_k, fields::at_least(1));
+    f("top_k_counts_rolls", s.top_k_counts_rolls);
     f("crh_peak_threshold", s.crh_peak_threshold, fields::in_range(0, 1));
     f("crh_max_peaks", s.crh_max_peaks, fields::at_least(1));
     f("skip_crh", s.skip_crh);

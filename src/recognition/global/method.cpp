@@ -301,6 +301,8 @@ class GlobalMethod : public Method {
         hyps.push_back(h);
       }
     }
+    const size_t top_k = static_cast<size_t>(std::max(g.top_k, 1));
+    if (g.top_k_counts_rolls && hyps.size() > top_k) hyps.resize(top_k);  // the first top_k hypotheses
     times.initial_pose += timer.seconds();
     return hyps;
   }
