@@ -514,6 +514,10 @@ DIFFERENCES = [
     "the top 5) and why Table 4.9's accuracy order is inverted (reciprocal correspondences) is measured in "
     "`results/thesis/FINDINGS.md`. The cesf ablation runs CESF with the other reading of its definition, the ESF "
     "of the whole cluster posed from each stable region (`global.cesf_whole_cluster`).",
+    "Global hypotheses: the top five matches (`global.top_k`) go on, each with up to three CRH roll peaks "
+    "(`global.crh_max_peaks`), so up to 15 hypotheses are refined; the thesis passes \"the top five hypotheses\" "
+    "to refinement and makes a new hypothesis of each distinguished CRH peak. The rolls ablation counts five "
+    "hypotheses after the CRH instead (`global.top_k_counts_rolls`).",
     "Times are wall-clock seconds of the online computation of one image (training views excluded: they are "
     "rendered and described once and cached), single-threaded; the load column of the experiments table says "
     "what else ran on the machine.",
