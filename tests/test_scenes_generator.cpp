@@ -12,6 +12,7 @@
 #include "io/bop.h"
 #include "render/renderer.h"
 #include "scenes/generator.h"
+#include "scenes/rest_poses.h"
 #include "scenes_test_util.h"
 
 namespace fs = std::filesystem;
@@ -201,6 +202,42 @@ TEST(SceneGenerator, ObjectsRestOnTheTableWithoutOverlap) {
     // 1 target + 3..8 distractors placed (some may fall outside the image).
     EXPECT_LE(img.info.gt.size(), 9u);
   }
+}
+
+// target_free_probability 1: the target lies on its lowest point in
+// orientations no rest pose gives (a rest pose fixes the tilt: row 2 of
+// Rz(yaw) R_rest is row 2 of R_rest), and the ground truth still matches the
+// depth.
+TEST(SceneGenerator, FreeTargetOrientationRestsOnItsLowestPoint) {
+  const std::string free_cfg = std::string(kTable) + "target_free_probability: 1\n";
+  SceneGenerator gen(settings_from(free_cfg));
+  const SceneModel& target = gen.model("ls5");
+  const RestPoses rest = compute_rest_poses(target.mesh);
+  ASSERT_FALSE(rest.poses.empty());
+  for (int im = 0; im < 4; ++im) {
+    const GeneratedImage img = gen.generate(im);
+    const Pose T_world_model = img.T_world_cam * img.info.gt[0].T_cam_model;
+    double zmin = 1e300;
+    for (const auto& v : target.mesh.vertices) zmin = std::min(zmin, (T_world_model * v.cast<double>()).z());
+    EXPECT_NEAR(zmin, 0.0, 1e-6) << "im " << im;
+    double nearest = 1e300;
+    for (const auto& p : rest.poses) nearest = std::min(nearest, (T_world_model.R.row(2) - p.R_rest.row(2)).norm());
+    EXPECT_GT(nearest, 1e-3) << "im " << im << ": the target's tilt is a rest pose's";
+    // The depth where the target is visible lies on its mesh at the ground
+    // truth pose (noise: none).
+    pbtest::MeshDistance md(target.mesh, 20.0);
+    const Pose T_model_cam = img.info.gt[0].T_cam_model.inverse();
+    std::vector<double> dist;
+    for (int v = 0; v < img.depth.height; ++v)
+      for (int u = 0; u < img.depth.width; ++u) {
+        const float z = img.depth.at(u, v);
+        if (img.labels[static_cast<size_t>(v) * img.depth.width + u] != 0 || !(z > 0)) continue;
+        dist.push_back(md.distance(T_model_cam * img.info.K.backproject(u, v, z)));
+      }
+    ASSERT_GT(dist.size(), 100u) << "im " << im;
+    EXPECT_LE(pbtest::percentile(dist, 0.99), 2.0) << "im " << im;
+  }
+  EXPECT_EQ(settings_from(kTable).target_free_probability, 0.0);  // rest poses only unless asked
 }
 
 TEST(SceneGenerator, SameSeedSameImageAnyOrder) {

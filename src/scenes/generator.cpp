@@ -192,10 +192,13 @@ const SceneModel& SceneGenerator::model(const std::string& name) const {
 }
 
 SceneGenerator::Impl::Placed SceneGenerator::Impl::on_ground(int mi, int ri, double yaw, const Vec2& xy) const {
+  return on_ground_rotated(mi, axis_angle(Vec3::UnitZ(), yaw) * rest[mi].poses[ri].R_rest, xy);
+}
+
+SceneGenerator::Impl::Placed SceneGenerator::Impl::on_ground_rotated(int mi, const Mat3& R, const Vec2& xy) const {
   Placed p;
   p.model = mi;
   p.mesh = &models[mi].mesh;
-  const Mat3 R = axis_angle(Vec3::UnitZ(), yaw) * rest[mi].poses[ri].R_rest;
   double zmin = 1e300, zmax = -1e300;
   std::vector<Vec2> pts;
   pts.reserve(hull[mi].size());

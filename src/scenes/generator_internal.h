@@ -114,6 +114,9 @@ struct SceneGenerator::Impl : scene_detail::GeneratorState {
 
   // Places model `mi` in rest pose `ri` with yaw at ground point xy.
   Placed on_ground(int mi, int ri, double yaw, const Vec2& xy) const;
+  // Places model `mi` rotated by R (model -> world) with its lowest point on
+  // the ground at xy.
+  Placed on_ground_rotated(int mi, const Mat3& R, const Vec2& xy) const;
 
   // generator.cpp: one attempt at image im_id (false with `why`).
   bool generate_attempt(int im_id, int attempt, GeneratedImage& img, std::string& why);

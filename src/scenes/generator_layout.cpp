@@ -13,6 +13,11 @@ using namespace scene_detail;
 
 // 1. Target at the origin.
 void SceneGenerator::Impl::place_target(Rng& rng, Layout& L) const {
+  if (s.target_free_probability > 0 && rng.uniform() < s.target_free_probability) {
+    const Mat3 R = random_rotation(rng);  // uniform: yaw included
+    L.objs.push_back(on_ground_rotated(target, R, Vec2::Zero()));
+    return;
+  }
   const int ri = sample_rest_pose(rest[target], s.target_upright_probability, rng);
   const double yaw = rng.uniform(0, 2 * M_PI);
   L.objs.push_back(on_ground(target, ri, yaw, Vec2::Zero()));

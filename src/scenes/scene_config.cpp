@@ -205,7 +205,7 @@ void parse_identity_and_sensor(const YamlNode& root, SceneSettings& s) {
 
 SceneSettings parse_scene_settings(const YamlNode& root) {
   root.check_keys({"scenario", "description", "scene_id", "seed", "images", "sensor", "noise",
-                   "depth_scale", "registry", "target", "target_upright_probability",
+                   "depth_scale", "registry", "target", "target_upright_probability", "target_free_probability",
                    "min_target_visib", "distractors", "occlusion", "camera", "table", "warehouse",
                    "masks", "max_attempts"});
   const std::string scen = root.get<std::string>("scenario");
@@ -227,6 +227,7 @@ SceneSettings parse_scene_settings(const YamlNode& root) {
   if (s.target.empty()) root["target"].fail("empty model name");
   s.target_upright_probability =
       read_probability(root, "target_upright_probability", s.target_upright_probability);
+  s.target_free_probability = read_probability(root, "target_free_probability", s.target_free_probability);
   s.min_target_visib = read_probability(root, "min_target_visib", s.min_target_visib);
 
   if (root.has("distractors")) parse_distractors(root["distractors"], s.distractors);
@@ -333,6 +334,7 @@ std::string scene_settings_json(const SceneSettings& s) {
   j["registry"] = s.registry.empty() ? "(default)" : s.registry;
   j["target"] = s.target;
   j["target_upright_probability"] = s.target_upright_probability;
+  if (s.target_free_probability > 0) j["target_free_probability"] = s.target_free_probability;  // older sets' json
   j["min_target_visib"] = s.min_target_visib;
   j["distractors"] = {{"pool", s.distractors.pool},
                       {"count", {s.distractors.min_count, s.distractors.max_count}},

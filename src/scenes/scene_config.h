@@ -16,6 +16,7 @@
 //   registry: ../../models/models.yaml        # relative to this file; default: the tree's
 //   target: ls5
 //   target_upright_probability: 0.5
+//   target_free_probability: 0       # else a uniformly random orientation on its lowest point
 //   min_target_visib: 0.5
 //   distractors: {pool: [milk_carton, boletus], count: [3, 8], upright_probability: 0.5}
 //   occlusion: none                 # none | [0.4, 0.9] | {visib_fract: [0.4, 0.9], probability: 1.0}
@@ -175,6 +176,12 @@ struct SceneSettings {
   std::string target = "ls5"; // registry name of the object of interest
   // Probability that the target stands upright (the thesis's real scenes: 1).
   double target_upright_probability = 0.5;
+  // Probability that the target is placed in a uniformly random orientation
+  // instead of a rest pose (resting on its lowest point, yawed at random; not
+  // physically stable): the thesis's synthetic table shows its statue
+  // "upside down" (section 4.1.2). 0 (default): rest poses only, and no
+  // random draw is spent on it, so existing scene sets stay the same.
+  double target_free_probability = 0.0;
   // Without an occluder, the target's visible fraction must reach this
   // (otherwise the layout is resampled).
   double min_target_visib = 0.5;
