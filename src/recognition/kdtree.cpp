@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
-#include <numeric>
 #ifdef __SSE2__
 #include <xmmintrin.h>
 #endif
@@ -11,13 +10,12 @@
 namespace pb {
 
 KdTree3::KdTree3(const std::vector<Vec3f>& points, int leaf_size) {
-  order_.resize(points.size());
-  std::iota(order_.begin(), order_.end(), 0);
   if (points.empty()) return;
   nodes_.reserve(2 * points.size() / static_cast<size_t>(std::max(1, leaf_size)) + 2);
   std::vector<Entry> entries(points.size());
   for (size_t i = 0; i < points.size(); ++i) entries[i] = {points[i], static_cast<int>(i)};
   build(entries, 0, static_cast<int>(points.size()), std::max(1, leaf_size));
+  order_.resize(points.size());
   for (size_t i = 0; i < entries.size(); ++i) order_[i] = entries[i].index;
   points_.resize(points.size());
   position_.resize(points.size());
