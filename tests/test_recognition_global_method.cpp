@@ -232,6 +232,34 @@ TEST_F(GlobalMethod, TopKCountingRollsKeepsTheFirstTopKHypotheses) {
   }
 }
 
+TEST_F(GlobalMethod, EsfSamplesFromPointsDrawsOneTriplePerPoint) {
+  // The thesis's reading (section 3.2.3): as many triples as points. The
+  // count follows the cloud; the hypotheses' scores are those of fewer
+  // triples than the default's 20000 (the scene cluster here has a few
+  // hundred points), so they differ from the default's.
+  GlobalSettings g;
+  EXPECT_EQ(global::esf_triples(g, 1234), 20000);
+  GlobalSettings per_point = g;
+  per_point.esf_samples_from_points = true;
+  EXPECT_EQ(global::esf_triples(per_point, 1234), 1234);
+  EXPECT_EQ(global::esf_triples(per_point, 0), 0);
+  ASSERT_LT(scene_->size(), 20000u);
+  for (const char* name : {"esf", "cesf"}) {
+    auto a = make(name, g), b = make(name, per_point);
+    a->train(*views_, 5);
+    b->train(*views_, 5);
+    StageTimes t;
+    const auto ha = a->hypothesize(*scene_, *views_, 11, t), hb = b->hypothesize(*scene_, *views_, 11, t);
+    ASSERT_FALSE(ha.empty()) << name;
+    ASSERT_FALSE(hb.empty()) << name;
+    EXPECT_NE(ha[0].score, hb[0].score) << name;
+    // Same settings, same hypotheses: the per-point count is deterministic.
+    auto c = make(name, per_point);
+    c->train(*views_, 5);
+    EXPECT_TRUE(same(hb, c->hypothesize(*scene_, *views_, 11, t))) << name;
+  }
+}
+
 TEST(GlobalRegions, StableRegionsMatchPclCvfh) {
   // Our stable regions (CESF) are CVFH's: the same centroids.
   RecognitionSettings s;
@@ -250,8 +278,9 @@ TEST(GlobalRegions, StableRegionsMatchPclCvfh) {
 TEST(GlobalSettingsYaml, ParsesAndRejects) {
   GlobalSettings g;
   parse_section(YamlNode::load_string("top_k: 7\nskip_crh: true\ncrh_max_peaks: 2\nesf_samples: 5000\n"
-                                      "top_k_counts_rolls: true\n", "g.yaml"), g);
+                                      "top_k_counts_rolls: true\nesf_samples_from_points: true\n", "g.yaml"), g);
   EXPECT_EQ(g.top_k, 7);
+  EXPECT_TRUE(g.esf_samples_from_points);
   EXPECT_TRUE(g.top_k_counts_rolls);
   EXPECT_TRUE(g.skip_crh);
   EXPECT_EQ(g.crh_max_peaks, 2);

@@ -15,6 +15,11 @@ struct GlobalSettings {
   double cvfh_cluster_tolerance_mm = 15.0;  // region growing distance threshold (t_d)
   int cvfh_min_region_points = 20;      // "sufficiently large" stable region (also CESF)
   int esf_samples = 20000;              // ESF random triples (PCL's value)
+  // ESF's triple count. false: esf_samples (PCL's ESFEstimation). true: as
+  // many triples as the described cloud has points, the thesis's reading
+  // (section 3.2.3: "It then iterates using the number of points as number
+  // of iterations"). ESF and CESF, training views and scene clusters alike.
+  bool esf_samples_from_points = false;
   int top_k = 5;                        // matches passed on to the initial poses (thesis: "the top
                                         // five hypotheses"), each with its CRH roll peaks
   // What top_k counts. false: matches, each expanded into up to
@@ -59,6 +64,7 @@ struct GlobalSettings {
     f("cvfh_cluster_tolerance_mm", s.cvfh_cluster_tolerance_mm, fields::length(fields::positive()));
     f("cvfh_min_region_points", s.cvfh_min_region_points, fields::at_least(3));
     f("esf_samples", s.esf_samples, fields::at_least(1));
+    f("esf_samples_from_points", s.esf_samples_from_points);
     f("top_k", s.top_k, fields::at_least(1));
     f("top_k_counts_rolls", s.top_k_counts_rolls);
     f("crh_peak_threshold", s.crh_peak_threshold, fields::in_range(0, 1));

@@ -104,6 +104,9 @@ std::vector<double> pcl_crh_roll_peaks(const std::vector<float>& scene_crh, cons
 std::vector<float> pcl_esf(const std::vector<Vec3f>& points);
 
 // --- global_method.cpp ---
+// The number of ESF triples drawn for a cloud of `points` points:
+// esf_samples, or `points` with esf_samples_from_points.
+int esf_triples(const GlobalSettings& s, size_t points);
 // R_cam_view such that R * view_axis = scene_axis: R_s^T Rz(theta) R_v with
 // R_x = rotation_to_z(x).
 Mat3 roll_rotation(const Vec3f& view_axis, const Vec3f& scene_axis, double theta);

@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <tuple>
 
 #include "core/error.h"
@@ -45,6 +46,11 @@ double upright_roll(const Vec3f& view_axis, const Vec3f& scene_axis) {
   const Vec3 us = rotation_to_z(scene_axis.cast<double>()) * up;
   if (std::hypot(uv.x(), uv.y()) < 1e-6 || std::hypot(us.x(), us.y()) < 1e-6) return 0.0;
   return std::atan2(us.y(), us.x()) - std::atan2(uv.y(), uv.x());
+}
+
+int esf_triples(const GlobalSettings& s, size_t points) {
+  if (!s.esf_samples_from_points) return s.esf_samples;
+  return static_cast<int>(std::min<size_t>(points, static_cast<size_t>(std::numeric_limits<int>::max())));
 }
 
 }  // namespace global
@@ -80,7 +86,7 @@ Vec3f mean_point(const std::vector<Vec3f>& pts) {
 // and CESF's with cesf_whole_cluster).
 std::vector<float> whole_cloud_esf(const PointSet& cloud, const GlobalSettings& g, uint64_t seed) {
   Rng rng(derive_seed(seed, {0}));
-  return compute_esf(cloud.points, rng, g.esf_samples);
+  return compute_esf(cloud.points, rng, global::esf_triples(g, cloud.points.size()));
 }
 
 // The method's signatures of one cloud (a training view or a scene cluster).
@@ -119,7 +125,7 @@ std::vector<Signature> describe(Kind kind, const PointSet& cloud, const GlobalSe
       for (size_t r = 0; r < regions.size(); ++r) {
         Rng rng(derive_seed(seed, {r + 1}));
         Signature s;
-        s.hist = g.cesf_whole_cluster ? whole : compute_esf(regions[r].points, rng, g.esf_samples);
+        s.hist = g.cesf_whole_cluster ? whole : compute_esf(regions[r].points, rng, global::esf_triples(g, regions[r].points.size()));
         s.centroid = regions[r].centroid;
         s.axis = -regions[r].mean_normal;
         s.from_normal = true;
