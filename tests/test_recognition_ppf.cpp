@@ -6,8 +6,11 @@
 // trained state round trip, determinism, empty inputs, YAML parsing.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
+#include <random>
 #include <sstream>
 
 #include "core/error.h"
@@ -15,6 +18,7 @@
 #include "core/yaml.h"
 #include "recognition/method.h"
 #include "recognition/pipeline.h"
+#include "recognition/ppf/internal.h"
 #include "recognition_train_util.h"
 #include "test_recognition_refine_scenes.h"
 
@@ -161,6 +165,98 @@ TEST_F(PpfScenes, EmptyInputsGiveNoHypothesis) {
   BinaryReader in(ss.buffer(), "test");
   loaded->load(in);
   EXPECT_TRUE(loaded->hypothesize(cases_[0].scene, views_, 1, t).empty());
+}
+
+// Our pair feature against pcl::computePairFeatures, bit for bit (the
+// scene's keys must be the model table's, which PCL computes): random
+// pairs, pairs whose two cosines tie or nearly tie (PCL's acos comparison
+// decides them), cosines rounded above 1, signed zeros, coincident points,
+// normals along the line, NaN.
+TEST(PpfPairFeature, EqualsPclBitForBit) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> pos(-150.f, 150.f), unit(-1.f, 1.f);
+  auto normal = [&] {
+    Vec3f n(unit(rng), unit(rng), unit(rng));
+    return n.norm() > 1e-3f ? Vec3f(n.normalized()) : Vec3f(0, 0, 1);
+  };
+  auto nudge = [](Vec3f v, int ulps) {
+    for (int k = 0; k < ulps; ++k) v.x() = std::nextafter(v.x(), 2.f);
+    return v;
+  };
+  size_t checked = 0, ties = 0, mismatched = 0;
+  auto check = [&](const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2) {
+    float a[4], b[4];
+    const bool ra = ppf::pair_feature(p1, n1, p2, n2, a), rb = ppf::pcl_pair_feature(p1, n1, p2, n2, b);
+    ++checked;
+    if (ra != rb || std::memcmp(a, b, sizeof a) != 0) {
+      if (++mismatched <= 5)
+        ADD_FAILURE() << "p1 " << p1.transpose() << " n1 " << n1.transpose() << " p2 " << p2.transpose() << " n2 "
+                      << n2.transpose() << ": ours " << ra << " " << a[0] << " " << a[1] << " " << a[2] << " "
+                      << a[3] << ", PCL " << rb << " " << b[0] << " " << b[1] << " " << b[2] << " " << b[3];
+    }
+  };
+  for (int i = 0; i < 400000; ++i) {
+    const Vec3f p1(pos(rng), pos(rng), pos(rng)), p2(pos(rng), pos(rng), pos(rng));
+    const Vec3f n1 = normal();
+    check(p1, n1, p2, normal());
+    // n2 mirrored across the plane normal to the line: |cos| ties up to
+    // rounding; then nudged by a few ulps either way.
+    const Vec3f d = (p2 - p1).normalized();
+    const Vec3f m = n1 - 2 * n1.dot(d) * d;
+    for (int u = 0; u < 4; ++u) {
+      check(p1, n1, p2, nudge(m, u));
+      check(p1, nudge(n1, u), p2, m);
+      ties += 1;
+    }
+    check(p1, n1, p2, -m);
+  }
+  // Axis-aligned cases: exact zeros, signed zeros, cosines of exactly 1.
+  const float vals[] = {0.f, -0.f, 1.f, -1.f, 10.f};
+  const Vec3f axes[] = {Vec3f(1, 0, 0), Vec3f(0, 1, 0), Vec3f(0, 0, 1), Vec3f(-1, 0, 0), Vec3f(0, -0.f, -1),
+                        Vec3f(-0.f, -0.f, 1)};
+  for (float x : vals)
+    for (float y : vals)
+      for (float z : vals)
+        for (const Vec3f& n1 : axes)
+          for (const Vec3f& n2 : axes) check(Vec3f(0, 0, 0), n1, Vec3f(x, y, z), n2);
+  // Cosines rounded above 1: a normal of norm slightly above 1 along the line.
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3f p1(pos(rng), pos(rng), pos(rng)), p2(pos(rng), pos(rng), pos(rng));
+    const Vec3f d = (p2 - p1).normalized();
+    check(p1, nudge(d, 1 + i % 3), p2, normal());
+    check(p1, normal(), p2, nudge(-d, 1 + i % 3));
+  }
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  check(Vec3f(0, 0, 0), Vec3f(0, 0, 1), Vec3f(1, 2, 3), Vec3f(nan, 0, 0));
+  check(Vec3f(0, 0, 0), Vec3f(nan, nan, nan), Vec3f(1, 2, 3), Vec3f(0, 0, 1));
+  check(Vec3f(1, 2, 3), Vec3f(0, 0, 1), Vec3f(1, 2, 3), Vec3f(0, 1, 0));
+  EXPECT_EQ(mismatched, 0u) << "of " << checked << " pairs (" << ties << " near ties)";
+}
+
+// The alpha bin from each bin's first float equals PCL's formula: every
+// float within 2000 ulps of each bin edge, and a million random ones, for
+// the default 12 degrees and two steps that do not divide 360.
+TEST(PpfAlphaBins, EqualTheFormula) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> any(-3.3f, 3.3f);
+  for (const double deg : {12.0, 7.0, 25.3}) {
+    const float step = static_cast<float>(deg * M_PI / 180.0);
+    const int n = std::max(1, static_cast<int>(std::floor(2 * M_PI / step)));
+    const ppf::AlphaBins bins(step, n);
+    size_t wrong = 0, checked = 0;
+    auto check = [&](float a) {
+      ++checked;
+      if (bins(a) != bins.exact(a) && ++wrong <= 3) ADD_FAILURE() << deg << " deg, alpha " << a;
+    };
+    for (int k = 0; k <= n; ++k) {
+      float a = static_cast<float>(k * static_cast<double>(step) - M_PI);
+      for (int u = 0; u < 2000; ++u) a = std::nextafter(a, -4.f);
+      for (int u = 0; u < 4000; ++u, a = std::nextafter(a, 4.f)) check(a);
+    }
+    for (int i = 0; i < 1000000; ++i) check(any(rng));
+    for (float a : {-0.f, 0.f, -3.2f, 3.2f, static_cast<float>(M_PI), -static_cast<float>(M_PI)}) check(a);
+    EXPECT_EQ(wrong, 0u) << deg << " deg, of " << checked;
+  }
 }
 
 TEST(Ppf, ParseReadsEveryFieldAndRejectsBadOnes) {

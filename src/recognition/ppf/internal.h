@@ -27,6 +27,13 @@ struct PairEntry {
   }
 };
 
+// What voting reads of a table entry, in the table's order (8 bytes where
+// PairEntry has 24: the ranges a scene pair looks up stay in cache).
+struct VoteEntry {
+  uint32_t ref;   // model reference point
+  float alpha_m;  // its pair's alpha_m
+};
+
 // The table's key index: for each distinct key its range [begin, end) of
 // the sorted table, in an open-addressing hash (one probe sequence per
 // scene pair instead of a binary search over the whole table).
@@ -93,6 +100,7 @@ struct Model {
   std::vector<Vec3f> points, normals;
   std::vector<PairFeature> features;
   std::vector<PairEntry> table;  // empty: nothing to match
+  std::vector<VoteEntry> votes;   // table[e]'s ref and alpha_m, for every e
   KeyIndex index;                 // over table
   float angle_step = 0, distance_step = 0, diameter = 0;
 };
@@ -101,6 +109,18 @@ struct PoseVote {
   Pose pose;
   double votes = 0;
 };
+
+// PCL's pair feature (pcl::computePairFeatures, bit for bit): f[0..2] the
+// angles f1..f3 of the pair's Darboux frame, f[3] the distance; false (and
+// zeros) when the points coincide or the frame is degenerate. The source
+// point is the one whose normal makes the smaller angle with the line, PCL's
+// acos comparison, taken from |cos| where the two differ by far more than
+// acos's rounding (acos is decreasing with slope at most -1 on [0, 1]).
+// Dot products are summed in the order of Eigen's four-lane SSE reduction,
+// (x + z) + (y + 0), as PCL's Vector4f code sums them.
+bool pair_feature(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2, float f[4]);
+// pcl::computePairFeatures itself (tests: the reference of pair_feature).
+bool pcl_pair_feature(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2, float f[4]);
 
 // Rigid transform taking point p to the origin and the unit normal n onto
 // +x (PCL's PPF convention).
@@ -113,6 +133,34 @@ float pcl_alpha(const Eigen::Affine3f& T, const Vec3f& other);
 
 // The seeded subset of scene reference points (ascending indices).
 std::vector<int> reference_points(size_t n, double fraction, uint64_t seed);
+
+// PCL's alpha bin value of a vote: (alpha + pi) / step in double, as float.
+inline float alpha_bin_value(float alpha, float angle_step) {
+  return static_cast<float>((alpha + M_PI) / angle_step);
+}
+
+// The alpha bin of a vote, floor(alpha_bin_value) clamped to [0, n), without
+// the double division: that map is non-decreasing in alpha (every step of it
+// is), so each bin's first float, found once by bisection, tells the bin
+// after a guess by multiplication.
+class AlphaBins {
+ public:
+  AlphaBins(float angle_step, int n);
+  int operator()(float alpha) const {
+    int b = static_cast<int>((alpha + static_cast<float>(M_PI)) * scale_);
+    b = std::max(0, std::min(n_ - 1, b));
+    while (alpha >= first_[static_cast<size_t>(b) + 1]) ++b;
+    while (alpha < first_[static_cast<size_t>(b)]) --b;
+    return b;
+  }
+  int exact(float alpha) const;  // the same from the formula (finite alpha)
+
+ private:
+  float step_;
+  int n_;
+  std::vector<float> first_;  // first_[k]: the smallest float of bin k; first_[0] -inf, first_[n] +inf
+  float scale_ = 0;
+};
 
 // How a scene pair votes (PpfSettings::neighbour_margin, vote_once).
 struct VoteOptions {

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <numeric>
 
 #include "core/random.h"
@@ -29,6 +31,63 @@ float pcl_alpha(const Eigen::Affine3f& T, const Vec3f& other) {
   float a = std::atan2(-q.z(), q.y());
   if (std::sin(a) * q.z() < 0.0f) a = -a;
   return -a;
+}
+
+namespace {
+
+// Eigen's Vector4f dot product with a zero fourth lane, in its SSE
+// reduction order: (x + z) + (y + 0). The + 0 keeps the sign of a zero sum
+// as Eigen's does (atan2 tells -0 from +0).
+inline float dot4(const Vec3f& a, const Vec3f& b) {
+  return (a.x() * b.x() + a.z() * b.z()) + (a.y() * b.y() + 0.0f);
+}
+
+// PCL's choice of source point: acos(|c1|) > acos(|c2|). acos is
+// decreasing on [0, 1] with slope at most -1 and rounds to within an ulp
+// (at most 1.2e-7 below pi / 2), so cosines 1e-6 apart decide it alone;
+// closer ones, values above 1 (acos gives NaN) and NaN take PCL's test.
+inline bool second_is_source(float c1, float c2) {
+  const float a1 = std::fabs(c1), a2 = std::fabs(c2);
+  constexpr float kSure = 1e-6f;
+  if (a2 <= 1.0f && a1 < a2 - kSure) return true;
+  if (a1 <= 1.0f && a2 < a1 - kSure) return false;
+  return std::acos(a1) > std::acos(a2);
+}
+
+}  // namespace
+
+bool pair_feature(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2, float f[4]) {
+  Vec3f d = p2 - p1;
+  f[3] = std::sqrt(dot4(d, d));
+  if (f[3] == 0.0f) {
+    f[0] = f[1] = f[2] = 0.0f;
+    return false;
+  }
+  const float c1 = dot4(n1, d) / f[3], c2 = dot4(n2, d) / f[3];
+  Vec3f u = n1, target = n2;
+  f[2] = c1;
+  if (second_is_source(c1, c2)) {
+    u = n2;
+    target = n1;
+    d = -d;
+    f[2] = -c2;
+  }
+  Vec3f v = d.cross(u);
+  const float vn = std::sqrt(dot4(v, v));
+  if (vn == 0.0f) {
+    f[0] = f[1] = f[2] = f[3] = 0.0f;
+    return false;
+  }
+  v /= vn;
+  const Vec3f w = u.cross(v);
+  f[1] = dot4(v, target);
+  f[0] = std::atan2(dot4(w, target), dot4(u, target));
+  return true;
+}
+
+bool pcl_pair_feature(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2, float f[4]) {
+  auto v4 = [](const Vec3f& v) { return Eigen::Vector4f(v.x(), v.y(), v.z(), 0.f); };
+  return pcl::computePairFeatures(v4(p1), v4(n1), v4(p2), v4(n2), f[0], f[1], f[2], f[3]);
 }
 
 std::vector<int> reference_points(size_t n, double fraction, uint64_t seed) {
@@ -138,37 +197,124 @@ class VoteFlags {
 
 }  // namespace
 
+namespace {
+
+// Accumulator cells stamped with the reference point that voted for them
+// (its generation in the high 32 bits, the count in the low 32): a new
+// reference starts from zero without clearing, and a vote needs no branch.
+// The best cell is kept as votes arrive: the most votes, the lowest cell
+// among equals (the first maximum in cell order, as a scan of the
+// accumulator finds it, since counts only grow).
+class Accumulator {
+ public:
+  explicit Accumulator(size_t cells) : cells_(cells, 0) {}
+  void next_reference() {
+    ++gen_;
+    best_ = 0;
+    best_cell_ = 0;
+  }
+  void add(uint32_t cell) {
+    const uint64_t v = cells_[cell];
+    const uint64_t stamp = static_cast<uint64_t>(gen_) << 32;
+    const uint64_t nv = (v >> 32) == gen_ ? v + 1 : stamp + 1;
+    cells_[cell] = nv;
+    const uint32_t c = static_cast<uint32_t>(nv);
+    const bool better = c > best_ || (c == best_ && cell < best_cell_);
+    best_ = better ? c : best_;
+    best_cell_ = better ? cell : best_cell_;
+  }
+  uint32_t best() const { return best_; }  // 0: no vote since next_reference()
+  uint32_t best_cell() const { return best_cell_; }
+
+ private:
+  std::vector<uint64_t> cells_;
+  uint32_t gen_ = 0;
+  uint32_t best_ = 0, best_cell_ = 0;
+};
+
+// alpha = alpha_m - alpha_s brought into [-pi, pi] (PCL's wrap).
+inline float wrapped_alpha(float alpha_m, float alpha_s) {
+  float alpha = alpha_m - alpha_s;
+  if (alpha < -M_PI) alpha += static_cast<float>(2 * M_PI);
+  else if (alpha > M_PI) alpha -= static_cast<float>(2 * M_PI);
+  return alpha;
+}
+
+// The votes of one scene pair's model pairs [begin, end) with neighbouring
+// alpha bins (margin > 0): PCL's bin value, its fraction decides the
+// neighbour.
+void vote_with_margin(const Model& m, uint32_t begin, uint32_t end, float alpha_s, int n_alpha, float margin,
+                      Accumulator& acc) {
+  for (uint32_t e = begin; e < end; ++e) {
+    const VoteEntry& it = m.votes[e];
+    const float alpha = wrapped_alpha(it.alpha_m, alpha_s);
+    if (!std::isfinite(alpha)) continue;
+    const float b = alpha_bin_value(alpha, m.angle_step);
+    const float floored = std::floor(b);
+    const int bin = std::max(0, std::min(n_alpha - 1, static_cast<int>(floored)));
+    const uint32_t cell = it.ref * static_cast<uint32_t>(n_alpha);
+    acc.add(cell + static_cast<uint32_t>(bin));
+    const float frac = b - floored;  // the neighbouring alpha bin (alpha wraps around)
+    if (frac < margin) acc.add(cell + static_cast<uint32_t>((bin + n_alpha - 1) % n_alpha));
+    else if (frac > 1 - margin) acc.add(cell + static_cast<uint32_t>((bin + 1) % n_alpha));
+  }
+}
+
+}  // namespace
+
+AlphaBins::AlphaBins(float angle_step, int n) : step_(angle_step), n_(n), first_(static_cast<size_t>(n) + 1) {
+  // Floats in order as integers (-0 and +0 both 0: they bin alike).
+  auto ord = [](float f) {
+    int32_t b;
+    std::memcpy(&b, &f, sizeof b);
+    return b < 0 ? -static_cast<int64_t>(b & 0x7fffffff) : static_cast<int64_t>(b);
+  };
+  auto from_ord = [](int64_t o) {
+    const uint32_t b = o < 0 ? (static_cast<uint32_t>(-o) | 0x80000000u) : static_cast<uint32_t>(o);
+    float f;
+    std::memcpy(&f, &b, sizeof f);
+    return f;
+  };
+  first_[0] = -std::numeric_limits<float>::infinity();
+  first_[static_cast<size_t>(n)] = std::numeric_limits<float>::infinity();
+  for (int k = 1; k < n; ++k) {  // the first float of bin k: bisection between -8 (bin 0) and 8 (bin n - 1)
+    int64_t lo = ord(-8.f), hi = ord(8.f);
+    while (hi - lo > 1) {
+      const int64_t mid = lo + (hi - lo) / 2;
+      (exact(from_ord(mid)) >= k ? hi : lo) = mid;
+    }
+    first_[static_cast<size_t>(k)] = from_ord(hi);
+  }
+  scale_ = 1.0f / angle_step;
+}
+
+int AlphaBins::exact(float alpha) const {
+  return std::max(0, std::min(n_ - 1, static_cast<int>(std::floor(alpha_bin_value(alpha, step_)))));
+}
+
 std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vector<int>& refs,
                            const VoteOptions& opt) {
   const KdTree3 tree(scene.points);
   const size_t n_model = m.points.size();
   const int n_alpha = std::max(1, static_cast<int>(std::floor(2 * M_PI / m.angle_step)));
-  std::vector<uint32_t> acc(n_model * static_cast<size_t>(n_alpha), 0);
-  std::vector<uint32_t> touched;  // accumulator cells voted for by the current reference point
+  const AlphaBins bins(m.angle_step, n_alpha);
+  Accumulator acc(n_model * static_cast<size_t>(n_alpha));
   std::vector<PoseVote> poses;
   std::vector<int> nn;
   VoteFlags flags;
   const float step[4] = {m.angle_step, m.angle_step, m.angle_step, m.distance_step};
   uint64_t keys[16];
-  auto v4 = [](const Vec3f& v) { return Eigen::Vector4f(v.x(), v.y(), v.z(), 0.f); };
-  auto add = [&](uint32_t ref, int bin) {
-    const uint32_t cell = ref * static_cast<uint32_t>(n_alpha) + static_cast<uint32_t>(bin);
-    if (acc[cell]++ == 0) touched.push_back(cell);
-  };
   for (int r : refs) {
     const Vec3f sr = scene.points[r], nr = scene.normals[r];
     if (!sr.allFinite() || !nr.allFinite()) continue;
     const Eigen::Affine3f T_sg = to_reference_frame(sr, nr);
     tree.radius_unsorted(sr, m.diameter, nn);  // votes add up: the neighbour order does not matter
-    for (uint32_t c : touched) acc[c] = 0;
-    touched.clear();
+    acc.next_reference();
     flags.next_reference();
-    const Eigen::Vector4f pr = v4(sr), npr = v4(nr);
     for (int i : nn) {
       if (i == r) continue;
       float f[4];
-      if (!pcl::computePairFeatures(pr, npr, v4(scene.points[static_cast<size_t>(i)]),
-                                    v4(scene.normals[static_cast<size_t>(i)]), f[0], f[1], f[2], f[3]))
+      if (!pair_feature(sr, nr, scene.points[static_cast<size_t>(i)], scene.normals[static_cast<size_t>(i)], f))
         continue;
       if (!std::isfinite(f[0]) || !std::isfinite(f[1]) || !std::isfinite(f[2]) || !std::isfinite(f[3])) continue;
       const int n_keys = neighbour_keys(f, step, opt.margin, keys);
@@ -179,30 +325,21 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
         const auto [begin, end] = m.index.find(keys[k]);
         if (begin == end) continue;
         if (opt.vote_once && !flags.first(keys[k], alpha_s_bin)) continue;
+        if (opt.margin > 0) {
+          vote_with_margin(m, begin, end, alpha_s, n_alpha, opt.margin, acc);
+          continue;
+        }
+        // alpha_m and alpha_s are finite (the table holds finite ones), so
+        // alpha is.
         for (uint32_t e = begin; e < end; ++e) {
-          const PairEntry& it = m.table[e];
-          float alpha = it.alpha_m - alpha_s;
-          if (!std::isfinite(alpha)) continue;
-          if (alpha < -M_PI) alpha += static_cast<float>(2 * M_PI);
-          else if (alpha > M_PI) alpha -= static_cast<float>(2 * M_PI);
-          const float b = static_cast<float>((alpha + M_PI) / m.angle_step);
-          const float floored = std::floor(b);
-          const int bin = std::max(0, std::min(n_alpha - 1, static_cast<int>(floored)));
-          add(it.ref, bin);
-          if (opt.margin > 0) {  // the neighbouring alpha bin (alpha wraps around)
-            const float frac = b - floored;
-            if (frac < opt.margin) add(it.ref, (bin + n_alpha - 1) % n_alpha);
-            else if (frac > 1 - opt.margin) add(it.ref, (bin + 1) % n_alpha);
-          }
+          const VoteEntry& it = m.votes[e];
+          acc.add(it.ref * static_cast<uint32_t>(n_alpha) +
+                  static_cast<uint32_t>(bins(wrapped_alpha(it.alpha_m, alpha_s))));
         }
       }
     }
-    if (touched.empty()) continue;
-    // The first maximum in cell order (deterministic, as max_element over
-    // the whole accumulator).
-    uint32_t best_cell = touched[0];
-    for (uint32_t c : touched)
-      if (acc[c] > acc[best_cell] || (acc[c] == acc[best_cell] && c < best_cell)) best_cell = c;
+    if (acc.best() == 0) continue;
+    const uint32_t best_cell = acc.best_cell();
     const size_t mr = best_cell / static_cast<size_t>(n_alpha);
     const int bin = static_cast<int>(best_cell % static_cast<size_t>(n_alpha));
     const float alpha = static_cast<float>((bin + 0.5) * m.angle_step - M_PI);
@@ -211,7 +348,7 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
     PoseVote pv;
     pv.pose.R = T.linear().cast<double>();
     pv.pose.t = T.translation().cast<double>();
-    pv.votes = acc[best_cell];
+    pv.votes = acc.best();
     poses.push_back(pv);
   }
   return poses;
