@@ -106,6 +106,8 @@ TEST(SceneConfig, Errors) {
   error_of("scenario: table\ndistractors: {pool: [boletus], count: [-1, 2]}\n", "distractors.count");
   error_of("scenario: table\ntarget_upright_probability: 2\n", "target_upright_probability");
   error_of("scenario: table\ntarget_free_probability: -0.5\n", "target_free_probability");
+  error_of("scenario: table\ntarget_tilt_deg: 95\n", "target_tilt_deg");
+  error_of("scenario: table\ntarget_tilt_deg: -1\n", "target_tilt_deg");
   error_of("scenario: table\nimages: many\n", "images");
   // A key that is not a plain name (found by fuzz/fuzz_scene_yaml.cpp:
   // yaml-cpp's BadConversion escaped as an internal error).

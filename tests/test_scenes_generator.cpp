@@ -240,6 +240,44 @@ TEST(SceneGenerator, FreeTargetOrientationRestsOnItsLowestPoint) {
   EXPECT_EQ(settings_from(kTable).target_free_probability, 0.0);  // rest poses only unless asked
 }
 
+// target_tilt_deg 20, upright only: the target's up axis leans from the
+// vertical by at most 20 degrees (more than 2 in some image), its lowest
+// point on the ground, and the ground truth matches the depth.
+TEST(SceneGenerator, TiltedTargetLeansAtMostTheTiltOnItsLowestPoint) {
+  std::string cfg = kTable;
+  cfg.replace(cfg.find("target_upright_probability: 0.5"), 31, "target_upright_probability: 1");
+  cfg += "target_tilt_deg: 20\n";
+  SceneGenerator gen(settings_from(cfg));
+  const SceneModel& target = gen.model("ls5");
+  const RestPoses rest = compute_rest_poses(target.mesh);
+  ASSERT_GE(rest.upright, 0);
+  const Vec3 up_model = rest.poses[static_cast<size_t>(rest.upright)].R_rest.transpose() * Vec3::UnitZ();
+  double most = 0;
+  for (int im = 0; im < 6; ++im) {
+    const GeneratedImage img = gen.generate(im);
+    const Pose T_world_model = img.T_world_cam * img.info.gt[0].T_cam_model;
+    const double lean = std::acos(std::min(1.0, (T_world_model.R * up_model).z())) * 180.0 / M_PI;
+    EXPECT_LE(lean, 20.0 + 1e-6) << "im " << im;
+    most = std::max(most, lean);
+    double zmin = 1e300;
+    for (const auto& v : target.mesh.vertices) zmin = std::min(zmin, (T_world_model * v.cast<double>()).z());
+    EXPECT_NEAR(zmin, 0.0, 1e-6) << "im " << im;
+    pbtest::MeshDistance md(target.mesh, 20.0);
+    const Pose T_model_cam = img.info.gt[0].T_cam_model.inverse();
+    std::vector<double> dist;
+    for (int v = 0; v < img.depth.height; ++v)
+      for (int u = 0; u < img.depth.width; ++u) {
+        const float z = img.depth.at(u, v);
+        if (img.labels[static_cast<size_t>(v) * img.depth.width + u] != 0 || !(z > 0)) continue;
+        dist.push_back(md.distance(T_model_cam * img.info.K.backproject(u, v, z)));
+      }
+    ASSERT_GT(dist.size(), 100u) << "im " << im;
+    EXPECT_LE(pbtest::percentile(dist, 0.99), 2.0) << "im " << im;
+  }
+  EXPECT_GT(most, 2.0) << "no image leaned";
+  EXPECT_EQ(settings_from(kTable).target_tilt_deg, 0.0);
+}
+
 TEST(SceneGenerator, SameSeedSameImageAnyOrder) {
   const SceneSettings s = settings_from(kTable);
   SceneGenerator a(s), b(s);

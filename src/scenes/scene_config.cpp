@@ -206,7 +206,7 @@ void parse_identity_and_sensor(const YamlNode& root, SceneSettings& s) {
 SceneSettings parse_scene_settings(const YamlNode& root) {
   root.check_keys({"scenario", "description", "scene_id", "seed", "images", "sensor", "noise",
                    "depth_scale", "registry", "target", "target_upright_probability", "target_free_probability",
-                   "min_target_visib", "distractors", "occlusion", "camera", "table", "warehouse",
+                   "target_tilt_deg", "min_target_visib", "distractors", "occlusion", "camera", "table", "warehouse",
                    "masks", "max_attempts"});
   const std::string scen = root.get<std::string>("scenario");
   Scenario scenario;
@@ -228,6 +228,9 @@ SceneSettings parse_scene_settings(const YamlNode& root) {
   s.target_upright_probability =
       read_probability(root, "target_upright_probability", s.target_upright_probability);
   s.target_free_probability = read_probability(root, "target_free_probability", s.target_free_probability);
+  s.target_tilt_deg = root.get_or<double>("target_tilt_deg", s.target_tilt_deg);
+  if (!(s.target_tilt_deg >= 0.0 && s.target_tilt_deg <= 90.0))
+    root["target_tilt_deg"].fail("must be in [0, 90] degrees, got " + num(s.target_tilt_deg));
   s.min_target_visib = read_probability(root, "min_target_visib", s.min_target_visib);
 
   if (root.has("distractors")) parse_distractors(root["distractors"], s.distractors);
@@ -335,6 +338,7 @@ std::string scene_settings_json(const SceneSettings& s) {
   j["target"] = s.target;
   j["target_upright_probability"] = s.target_upright_probability;
   if (s.target_free_probability > 0) j["target_free_probability"] = s.target_free_probability;  // older sets' json
+  if (s.target_tilt_deg > 0) j["target_tilt_deg"] = s.target_tilt_deg;  // older sets' json
   j["min_target_visib"] = s.min_target_visib;
   j["distractors"] = {{"pool", s.distractors.pool},
                       {"count", {s.distractors.min_count, s.distractors.max_count}},

@@ -17,6 +17,7 @@
 //   target: ls5
 //   target_upright_probability: 0.5
 //   target_free_probability: 0       # else a uniformly random orientation on its lowest point
+//   target_tilt_deg: 0               # rest pose leaned by up to this many degrees
 //   min_target_visib: 0.5
 //   distractors: {pool: [milk_carton, boletus], count: [3, 8], upright_probability: 0.5}
 //   occlusion: none                 # none | [0.4, 0.9] | {visib_fract: [0.4, 0.9], probability: 1.0}
@@ -182,6 +183,12 @@ struct SceneSettings {
   // "upside down" (section 4.1.2). 0 (default): rest poses only, and no
   // random draw is spent on it, so existing scene sets stay the same.
   double target_free_probability = 0.0;
+  // The target, in its rest pose, leaned by a uniform angle of up to this
+  // many degrees about a random horizontal axis, resting on its lowest point
+  // (not physically stable): the thesis's synthetic LS5 is "slightly tilted"
+  // (section 4.1.2) and "not standing upright" (Table 4.4's text). 0
+  // (default): no lean, and no random draw is spent on it.
+  double target_tilt_deg = 0.0;
   // Without an occluder, the target's visible fraction must reach this
   // (otherwise the layout is resampled).
   double min_target_visib = 0.5;
