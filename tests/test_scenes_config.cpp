@@ -107,6 +107,10 @@ TEST(SceneConfig, Errors) {
   error_of("scenario: table\ntarget_upright_probability: 2\n", "target_upright_probability");
   error_of("scenario: table\ntarget_free_probability: -0.5\n", "target_free_probability");
   error_of("scenario: table\ntarget_tilt_deg: 95\n", "target_tilt_deg");
+  // A key given twice (yaml-cpp keeps the first silently).
+  m = error_of("scenario: table\ntarget_tilt_deg: 5\nimages: 3\ntarget_tilt_deg: 10\n", "target_tilt_deg");
+  EXPECT_NE(m.find("key given twice, at lines 2 and 4"), std::string::npos) << m;
+  error_of("scenario: table\ncamera: {distance_mm: [600, 900], distance_mm: [700, 800]}\n", "camera.distance_mm");
   error_of("scenario: table\ntarget_tilt_deg: -1\n", "target_tilt_deg");
   error_of("scenario: table\nimages: many\n", "images");
   // A key that is not a plain name (found by fuzz/fuzz_scene_yaml.cpp:

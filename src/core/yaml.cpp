@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 namespace pb {
@@ -130,8 +131,13 @@ std::vector<std::string> YamlNode::keys() const {
 void YamlNode::check_keys(const std::set<std::string>& allowed) const {
   if (!defined()) return;
   if (!node_.IsMap()) fail("expected a mapping");
+  std::map<std::string, int> seen;  // key -> line: YAML keys are unique (yaml-cpp keeps the first silently)
   for (const auto& kv : node_) {
     const std::string key = key_text(kv.first, file_, path_);
+    const int line = kv.first.Mark().line + 1;
+    if (const auto [it, fresh] = seen.emplace(key, line); !fresh)
+      throw InputError(file_, path_.empty() ? key : path_ + "." + key,
+                       "key given twice, at lines " + std::to_string(it->second) + " and " + std::to_string(line));
     if (!allowed.count(key)) {
       std::string list;
       for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
