@@ -204,6 +204,27 @@ TEST(SceneGenerator, ObjectsRestOnTheTableWithoutOverlap) {
   }
 }
 
+// The target (gt[0]) rests with its lowest point on the ground, and the
+// depth where it is visible lies on its mesh at the ground-truth pose
+// (noise: none).
+void expect_target_on_ground_and_depth(const GeneratedImage& img, const SceneModel& target, int im) {
+  const Pose T_world_model = img.T_world_cam * img.info.gt[0].T_cam_model;
+  double zmin = 1e300;
+  for (const auto& v : target.mesh.vertices) zmin = std::min(zmin, (T_world_model * v.cast<double>()).z());
+  EXPECT_NEAR(zmin, 0.0, 1e-6) << "im " << im;
+  pbtest::MeshDistance md(target.mesh, 20.0);
+  const Pose T_model_cam = img.info.gt[0].T_cam_model.inverse();
+  std::vector<double> dist;
+  for (int v = 0; v < img.depth.height; ++v)
+    for (int u = 0; u < img.depth.width; ++u) {
+      const float z = img.depth.at(u, v);
+      if (img.labels[static_cast<size_t>(v) * img.depth.width + u] != 0 || !(z > 0)) continue;
+      dist.push_back(md.distance(T_model_cam * img.info.K.backproject(u, v, z)));
+    }
+  ASSERT_GT(dist.size(), 100u) << "im " << im;
+  EXPECT_LE(pbtest::percentile(dist, 0.99), 2.0) << "im " << im;
+}
+
 // target_free_probability 1: the target lies on its lowest point in
 // orientations no rest pose gives (a rest pose fixes the tilt: row 2 of
 // Rz(yaw) R_rest is row 2 of R_rest), and the ground truth still matches the
@@ -217,25 +238,10 @@ TEST(SceneGenerator, FreeTargetOrientationRestsOnItsLowestPoint) {
   for (int im = 0; im < 4; ++im) {
     const GeneratedImage img = gen.generate(im);
     const Pose T_world_model = img.T_world_cam * img.info.gt[0].T_cam_model;
-    double zmin = 1e300;
-    for (const auto& v : target.mesh.vertices) zmin = std::min(zmin, (T_world_model * v.cast<double>()).z());
-    EXPECT_NEAR(zmin, 0.0, 1e-6) << "im " << im;
     double nearest = 1e300;
     for (const auto& p : rest.poses) nearest = std::min(nearest, (T_world_model.R.row(2) - p.R_rest.row(2)).norm());
     EXPECT_GT(nearest, 1e-3) << "im " << im << ": the target's tilt is a rest pose's";
-    // The depth where the target is visible lies on its mesh at the ground
-    // truth pose (noise: none).
-    pbtest::MeshDistance md(target.mesh, 20.0);
-    const Pose T_model_cam = img.info.gt[0].T_cam_model.inverse();
-    std::vector<double> dist;
-    for (int v = 0; v < img.depth.height; ++v)
-      for (int u = 0; u < img.depth.width; ++u) {
-        const float z = img.depth.at(u, v);
-        if (img.labels[static_cast<size_t>(v) * img.depth.width + u] != 0 || !(z > 0)) continue;
-        dist.push_back(md.distance(T_model_cam * img.info.K.backproject(u, v, z)));
-      }
-    ASSERT_GT(dist.size(), 100u) << "im " << im;
-    EXPECT_LE(pbtest::percentile(dist, 0.99), 2.0) << "im " << im;
+    expect_target_on_ground_and_depth(img, target, im);
   }
   EXPECT_EQ(settings_from(kTable).target_free_probability, 0.0);  // rest poses only unless asked
 }
@@ -259,20 +265,7 @@ TEST(SceneGenerator, TiltedTargetLeansAtMostTheTiltOnItsLowestPoint) {
     const double lean = std::acos(std::min(1.0, (T_world_model.R * up_model).z())) * 180.0 / M_PI;
     EXPECT_LE(lean, 20.0 + 1e-6) << "im " << im;
     most = std::max(most, lean);
-    double zmin = 1e300;
-    for (const auto& v : target.mesh.vertices) zmin = std::min(zmin, (T_world_model * v.cast<double>()).z());
-    EXPECT_NEAR(zmin, 0.0, 1e-6) << "im " << im;
-    pbtest::MeshDistance md(target.mesh, 20.0);
-    const Pose T_model_cam = img.info.gt[0].T_cam_model.inverse();
-    std::vector<double> dist;
-    for (int v = 0; v < img.depth.height; ++v)
-      for (int u = 0; u < img.depth.width; ++u) {
-        const float z = img.depth.at(u, v);
-        if (img.labels[static_cast<size_t>(v) * img.depth.width + u] != 0 || !(z > 0)) continue;
-        dist.push_back(md.distance(T_model_cam * img.info.K.backproject(u, v, z)));
-      }
-    ASSERT_GT(dist.size(), 100u) << "im " << im;
-    EXPECT_LE(pbtest::percentile(dist, 0.99), 2.0) << "im " << im;
+    expect_target_on_ground_and_depth(img, target, im);
   }
   EXPECT_GT(most, 2.0) << "no image leaned";
   EXPECT_EQ(settings_from(kTable).target_tilt_deg, 0.0);
