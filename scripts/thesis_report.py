@@ -507,7 +507,12 @@ DIFFERENCES = [
     "ESF is the project's own seeded implementation (PCL's ESFEstimation reseeds the C generator from the clock); "
     "the thesis used PCL's. ESF has no surface frame: its initial pose aligns the rays from the camera to the two "
     "clouds' centroids, where the thesis's section 3.2.4 aligns the clusters' average normals for every global "
-    "descriptor; the esfpose ablation runs ESF that way.",
+    "descriptor; the esfpose ablation runs ESF that way. It draws 20,000 point triples (PCL's value), where the "
+    "thesis's section 3.2.3 iterates \"the number of points\" (the triples ablation), and takes its roll from the "
+    "CRH, which needs normals the thesis's ESF does not compute (the esfroll ablation skips it).",
+    "Synthetic table: the LS5 stands upright in half of the images and lies in another rest pose in the other "
+    "half (`target_upright_probability: 0.5`); the thesis's synthetic LS5 is \"slightly tilted\" and \"not "
+    "standing upright\". The tilt ablation stands it upright, leaned by up to 20 degrees (`target_tilt_deg`).",
     "CESF follows the thesis's definition (CVFH's stable regions after high-curvature removal, an ESF per region, "
     "the CRH roll), and, as CVFH, describes a cloud without a stable region by the ESF of all of it. Why it trails "
     "CVFH (an ESF of one smooth region looks like a smooth region of a distractor, so the right pair ranks below "
