@@ -42,6 +42,32 @@ TEST(ExperimentYaml, BytesThatAreNotUtf8AreAnInputErrorNamingFileAndLine) {
   }
 }
 
+// A key given twice is an InputError naming the file, the key's path and
+// both lines, wherever it is: a checked section, the free-form generator
+// overrides (converted to JSON, where the copies collapsed silently), or
+// the top level.
+TEST(ExperimentYaml, AKeyGivenTwiceIsAnInputErrorNamingFileKeyAndLines) {
+  const std::string scene = "object: ls5\nscenes:\n  - name: a\n    generate: " + std::string(POSEBENCH_SOURCE_DIR) +
+                            "/configs/scenes/table_astra.yaml\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {scene + "    generator: {images: 2, noise: {model: none}, images: 3}\ndescriptors: [fpfh]\n",
+       "scenes[0].generator.images"},
+      {scene + "    settings:\n      preprocess: {voxel_mm: 5}\n      preprocess: {voxel_mm: 6}\ndescriptors: [fpfh]\n",
+       "scenes[0].settings.preprocess"},
+      {scene + "descriptors: [fpfh]\ndescriptors: [shot]\n", "descriptors"}};
+  for (const auto& [text, field] : cases) {
+    const std::string path = write("twice.yaml", text);
+    try {
+      pb::load_experiment(path);
+      ADD_FAILURE() << "no error for " << field;
+    } catch (const pb::InputError& e) {
+      EXPECT_EQ(e.file(), path);
+      EXPECT_EQ(e.field(), field) << e.what();
+      EXPECT_NE(std::string(e.what()).find("key given twice, at lines"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(ExperimentYaml, Utf8TextIsAccepted) {
   const std::string path = write("utf8.yaml", experiment("caf\xc3\xa9_\xe2\x82\xac_\xf0\x9f\x93\xa6"));
   const pb::YamlNode root = pb::YamlNode::load_file(path);

@@ -121,6 +121,16 @@ static std::string key_text(const YAML::Node& key, const std::string& file, cons
   return key.Scalar();
 }
 
+// Records `key` (at `line`) as seen in one mapping; a key seen before is an
+// InputError: YAML keys are unique, yaml-cpp keeps every copy and its
+// lookups return the first.
+static void check_unique_key(std::map<std::string, int>& seen, const std::string& key, int line,
+                             const std::string& file, const std::string& path) {
+  if (const auto [it, fresh] = seen.emplace(key, line); !fresh)
+    throw InputError(file, path.empty() ? key : path + "." + key,
+                     "key given twice, at lines " + std::to_string(it->second) + " and " + std::to_string(line));
+}
+
 std::vector<std::string> YamlNode::keys() const {
   std::vector<std::string> k;
   if (node_.IsMap())
@@ -131,13 +141,10 @@ std::vector<std::string> YamlNode::keys() const {
 void YamlNode::check_keys(const std::set<std::string>& allowed) const {
   if (!defined()) return;
   if (!node_.IsMap()) fail("expected a mapping");
-  std::map<std::string, int> seen;  // key -> line: YAML keys are unique (yaml-cpp keeps the first silently)
+  std::map<std::string, int> seen;
   for (const auto& kv : node_) {
     const std::string key = key_text(kv.first, file_, path_);
-    const int line = kv.first.Mark().line + 1;
-    if (const auto [it, fresh] = seen.emplace(key, line); !fresh)
-      throw InputError(file_, path_.empty() ? key : path_ + "." + key,
-                       "key given twice, at lines " + std::to_string(it->second) + " and " + std::to_string(line));
+    check_unique_key(seen, key, kv.first.Mark().line + 1, file_, path_);
     if (!allowed.count(key)) {
       std::string list;
       for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
@@ -191,15 +198,21 @@ double YamlNode::get_nonnegative(const std::string& key, double fallback) const 
   return v;
 }
 
-nlohmann::json yaml_to_json(const YAML::Node& n) {
+static nlohmann::json to_json(const YAML::Node& n, const std::string& file, const std::string& path) {
   if (n.IsMap()) {
     nlohmann::json j = nlohmann::json::object();
-    for (const auto& kv : n) j[key_text(kv.first, "", "")] = yaml_to_json(kv.second);
+    std::map<std::string, int> seen;
+    for (const auto& kv : n) {
+      const std::string key = key_text(kv.first, file, path);
+      check_unique_key(seen, key, kv.first.Mark().line + 1, file, path);
+      j[key] = to_json(kv.second, file, path.empty() ? key : path + "." + key);
+    }
     return j;
   }
   if (n.IsSequence()) {
     nlohmann::json j = nlohmann::json::array();
-    for (const auto& e : n) j.push_back(yaml_to_json(e));
+    size_t i = 0;
+    for (const auto& e : n) j.push_back(to_json(e, file, path + "[" + std::to_string(i++) + "]"));
     return j;
   }
   if (!n.IsDefined() || n.IsNull()) return nullptr;
@@ -216,5 +229,9 @@ nlohmann::json yaml_to_json(const YAML::Node& n) {
   if (*end == '\0') return dv;
   return s;
 }
+
+nlohmann::json yaml_to_json(const YAML::Node& n) { return to_json(n, "", ""); }
+
+nlohmann::json YamlNode::json() const { return to_json(node_, file_, path_); }
 
 }  // namespace pb

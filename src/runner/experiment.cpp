@@ -110,7 +110,7 @@ void parse_thresholds(const YamlNode& root, ExperimentConfig& c) {
 void parse_settings_and_grid(const YamlNode& root, const std::string& path, ExperimentConfig& c) {
   if (root.has("settings")) {
     parse_recognition_settings(root["settings"]);
-    c.settings = yaml_to_json(root["settings"].raw());
+    c.settings = root["settings"].json();
   }
 
   if (root.has("grid")) {
@@ -121,7 +121,7 @@ void parse_settings_and_grid(const YamlNode& root, const std::string& path, Expe
       if (!v.is_sequence() || v.size() == 0) v.fail("expected a non-empty list of values");
       std::vector<nlohmann::json> vals;
       for (size_t i = 0; i < v.size(); ++i) {
-        vals.push_back(yaml_to_json(v.at(i).raw()));
+        vals.push_back(v.at(i).json());
         nlohmann::json probe = c.settings;
         set_path(probe, key, vals.back());
         try {
@@ -151,7 +151,7 @@ SceneSource parse_scene(const YamlNode& s, const std::string& path, std::set<std
     if (src.clouds.empty()) s["cloud"].fail("only valid with 'clouds'");
     s["cloud"].check_keys({"units", "intrinsics", "camera"});
     parse_cloud_units(s["cloud"].get_or<std::string>("units", "auto"), "cloud.units");
-    src.cloud = yaml_to_json(s["cloud"].raw());
+    src.cloud = s["cloud"].json();
     if (src.cloud.contains("camera")) src.cloud["camera"] = resolve(path, src.cloud["camera"].get<std::string>());
   }
   if (std::error_code ec; !src.generate.empty() && !fs::exists(src.generate, ec))
@@ -174,11 +174,11 @@ SceneSource parse_scene(const YamlNode& s, const std::string& path, std::set<std
   check_refinements(s["refinements"], src.refinements);
   if (s.has("generator")) {
     if (src.generate.empty()) s["generator"].fail("only valid with 'generate'");
-    src.generator_overrides = yaml_to_json(s["generator"].raw());
+    src.generator_overrides = s["generator"].json();
   }
   if (s.has("settings")) {
     parse_recognition_settings(s["settings"]);
-    src.settings = yaml_to_json(s["settings"].raw());
+    src.settings = s["settings"].json();
   }
   return src;
 }
@@ -267,7 +267,7 @@ ExperimentConfig load_experiment(const std::string& path) {
   if (root.has("report")) {
     const YamlNode r = root["report"];
     r.check_keys({"reference_table", "plot_x", "columns"});
-    c.report = yaml_to_json(r.raw());
+    c.report = r.json();
   }
 
   const YamlNode scenes = root["scenes"];

@@ -40,7 +40,7 @@ namespace pb {
 
 // The generator configs are YAML; overrides merge at the JSON level and the
 // result is written as JSON (a YAML subset) for the generator to read.
-static nlohmann::json yaml_to_json_file(const std::string& path) { return yaml_to_json(YamlNode::load_file(path).raw()); }
+static nlohmann::json yaml_to_json_file(const std::string& path) { return YamlNode::load_file(path).json(); }
 
 static int run_command(const std::vector<std::string>& args, const std::string& log_path) {
   const pid_t pid = fork();
