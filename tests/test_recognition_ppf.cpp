@@ -3,7 +3,9 @@
 // the whole pipeline (PPF + ICP point-to-plane + inlier verification) find
 // the pose within the thesis's table thresholds (translation < 50 mm,
 // 1 - |p.q| < 0.05) in at least the fraction measured, minus a margin. Also:
-// trained state round trip, determinism, empty inputs, YAML parsing.
+// trained state round trip, determinism, empty inputs, YAML parsing, and the
+// voting's pieces against their definitions bit for bit (the pair feature
+// against PCL's, the alpha bins against the formula).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -206,9 +208,10 @@ TEST(PpfPairFeature, EqualsPclBitForBit) {
     for (int u = 0; u < 4; ++u) {
       check(p1, n1, p2, nudge(m, u));
       check(p1, nudge(n1, u), p2, m);
-      ties += 1;
+      ties += 2;
     }
     check(p1, n1, p2, -m);
+    ties += 1;
   }
   // Axis-aligned cases: exact zeros, signed zeros, cosines of exactly 1.
   const float vals[] = {0.f, -0.f, 1.f, -1.f, 10.f};
