@@ -3,6 +3,7 @@
 // step draws from the attempt's random stream in a fixed order.
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "core/rotation.h"
 #include "scenes/generator_internal.h"
@@ -20,15 +21,14 @@ void SceneGenerator::Impl::place_target(Rng& rng, Layout& L) const {
   }
   const int ri = sample_rest_pose(rest[target], s.target_upright_probability, rng);
   const double yaw = rng.uniform(0, 2 * M_PI);
-  if (s.target_tilt_deg > 0) {  // leaned about a horizontal axis, on its lowest point
+  Placed p = on_ground(target, ri, yaw, Vec2::Zero());
+  if (s.target_tilt_deg > 0) {  // the rest pose leaned about a horizontal axis, on its lowest point
     const double axis_az = rng.uniform(0, 2 * M_PI);
     const double tilt = rng.uniform(0, s.target_tilt_deg) * M_PI / 180.0;
-    const Mat3 R = axis_angle(Vec3(std::cos(axis_az), std::sin(axis_az), 0), tilt) *
-                   axis_angle(Vec3::UnitZ(), yaw) * rest[target].poses[static_cast<size_t>(ri)].R_rest;
-    L.objs.push_back(on_ground_rotated(target, R, Vec2::Zero()));
-    return;
+    p = on_ground_rotated(target, axis_angle(Vec3(std::cos(axis_az), std::sin(axis_az), 0), tilt) * p.T_world_model.R,
+                          Vec2::Zero());
   }
-  L.objs.push_back(on_ground(target, ri, yaw, Vec2::Zero()));
+  L.objs.push_back(std::move(p));
 }
 
 // 2. Camera: distance, elevation and azimuth, looking at the target's centre
