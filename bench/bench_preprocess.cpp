@@ -32,10 +32,13 @@ Frame make_frame(const std::string& scene_file, bool warehouse) {
   const GeneratedImage g = gen.generate(0);
   Frame f{g.depth, g.info.K, {}};
   if (warehouse) {
+    // As bench-pipeline resolves them for the LS5 (lengths scaled to its
+    // size: records' settings_resolved.preprocess).
     f.s.voxel_mm = 20;
     f.s.max_range_mm = 9000;
-    f.s.normal_radius_mm = 60;
-    f.s.plane_threshold_mm = 20;
+    f.s.max_planes = 2;
+    f.s.normal_radius_mm = 181.6;
+    f.s.plane_threshold_mm = 90.8;
   }
   return f;
 }

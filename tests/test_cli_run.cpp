@@ -100,6 +100,36 @@ TEST_F(RunTest, ResultsDoNotDependOnJobsAndResumeAfterKillLosesNothing) {
   EXPECT_EQ(pbcli::slurp(tmp.path + "/r1/records.jsonl"), before);
 }
 
+// The sensor's floor of relative lengths comes from the scene's first image
+// and the trial's scale settings: a worker that runs every trial (one job)
+// computes it once per scene and scale setting, and two settings of
+// scale.sensor_floor_px in one sweep still get their own floors (here the
+// pixel footprint term: 2 and 200 footprints at the median depth).
+TEST_F(RunTest, SensorFloorFollowsTheScaleSettingsOfEachGridPoint) {
+  pbcli::write_file(tmp.path + "/floor.yaml",
+                    "name: floortest\nseed: 3\nobject: ls5\nscenes:\n  - name: table_small\n    generate: " +
+                        tmp.path + "/scene.yaml\n    scenario: table\ndescriptors: [cvfh]\nrefinements: [icp]\n" +
+                        "settings:\n  views: {views: 4}\ngrid:\n  scale.sensor_floor_px: [2, 200]\n");
+  auto r = pbcli::run("run floor.yaml --out rf --jobs 1 " + common(), tmp.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::map<double, std::vector<double>> floors;  // sensor_floor_px -> min_length_mm of each image
+  for (const auto& [key, rec] : comparable(tmp.path + "/rf")) {
+    ASSERT_NE(rec["status"], "error") << key;  // at 200 footprints nothing is found: no matter
+    floors[rec["settings_resolved"]["scale"]["sensor_floor_px"].get<double>()].push_back(
+        rec["settings_resolved"]["scale"]["min_length_mm"].get<double>());
+  }
+  ASSERT_EQ(floors.size(), 2u);
+  for (const auto& [px, v] : floors) {
+    ASSERT_EQ(v.size(), 3u) << px;
+    for (double m : v) EXPECT_EQ(m, v[0]) << "every image of the scene shares its first image's floor";
+  }
+  // 200 footprints against 2: at most 100 times the floor (the noise term may
+  // dominate at 2), and far above it.
+  const double ratio = floors[200][0] / floors[2][0];
+  EXPECT_GT(ratio, 40.0);
+  EXPECT_LE(ratio, 100.0 * (1 + 1e-12));
+}
+
 TEST_F(RunTest, UnknownKeyIsExit2NamingFileLineAndKey) {
   pbcli::write_file(tmp.path + "/bad.yaml", experiment_yaml(tmp.path + "/scene.yaml") + "descriptorz: [esf]\n");
   auto r = pbcli::run("run bad.yaml --out rb " + common(), tmp.path);

@@ -1,6 +1,7 @@
 #include "runner/trial.h"
 
 #include <cmath>
+#include <cstdio>
 #include <new>
 #include <map>
 #include <memory>
@@ -28,7 +29,9 @@ struct WorkerCache {
   std::map<std::string, std::shared_ptr<const TrainedModel>> models;
   std::map<std::string, std::unique_ptr<Mesh>> meshes;
   std::map<std::string, std::unique_ptr<DepthRenderer>> renderers;  // by intrinsics, for VSD
-  std::map<std::string, DepthImage> first_depths;  // each scene's first image (the sensor's floor)
+  std::map<std::string, SceneInfo> scenes;        // each scene's JSON files, read once
+  std::map<std::string, double> sensor_floors;     // each scene's sensor floor (from its first image),
+                                                   // by scene and scale settings
   std::map<std::string, double> view_elevations;   // views.follow_scene: each scene set's, read once
 };
 WorkerCache& cache() {
@@ -118,8 +121,9 @@ ThesisThresholds thresholds_for(const std::string& scenario, const TrialContext&
 
 // The thesis's errors (symmetry-aware), the extra judgements and the BOP
 // errors (MSSD, MSPD, VSD with bop19 settings) of an estimate.
+// `clean`: the image's depth as stored, without the trial's added noise.
 void evaluate(const Pose& est, const GtObject& gt, const BopDataset& ds, const ImageInfo& im, int obj_id,
-              const Mesh& mesh, const TrialContext& ctx, TrialRecord& rec) {
+              const Mesh& mesh, const DepthImage& clean, const TrialContext& ctx, TrialRecord& rec) {
   const ThesisThresholds thr = thresholds_for(rec.scenario, ctx);
   const auto syms = symmetry_transformations(ds.model_info(obj_id));
   const ThesisJudgement judged = thesis_judge(est, gt.T_cam_model, syms, thr);
@@ -141,7 +145,6 @@ void evaluate(const Pose& est, const GtObject& gt, const BopDataset& ds, const I
   bm.mesh = &mesh;
   bm.symmetries = syms;
   bm.diameter = ds.model_info(obj_id).diameter;
-  const DepthImage clean = ds.load_depth(rec.split, rec.scene_id, im);  // without the trial's added noise
   const BopPoseErrors be = bop_pose_errors(est, gt.T_cam_model, bm, im.K, {}, &clean, renderer.get());
   rec.bop = BopErrorsRecord{be.mssd_mm, be.mspd_px, be.vsd, bm.diameter, im.K.width};
 }
@@ -189,22 +192,39 @@ void run(TrialRecord& rec, const TrialContext& ctx) {
   const BopDataset& ds = dataset(rec.dataset);
   const int obj_id = rec.obj_id ? *rec.obj_id : ds.resolve_object(ctx.object);
   rec.obj_id = obj_id;
-  const SceneInfo scene = ds.load_scene(rec.split, rec.scene_id);
+  // A scene set does not change while it is run: its scenes' JSON files are
+  // read once per worker.
+  const std::string scene_key = ds.root() + "#" + rec.split + "#" + std::to_string(rec.scene_id);
+  auto scene_it = cache().scenes.find(scene_key);
+  if (scene_it == cache().scenes.end())
+    scene_it = cache().scenes.emplace(scene_key, ds.load_scene(rec.split, rec.scene_id)).first;
+  const SceneInfo& scene = scene_it->second;
   const ImageInfo& im = scene.images.at(rec.im_id);
   const DepthImage depth_clean = ds.load_depth(rec.split, rec.scene_id, im);
   DepthImage depth = depth_clean;
   add_noise(depth, rec.added_noise_mm, rec.seed);
 
   // Relative lengths in mm, for the object's diameter and the sensor's floor
-  // at the scene's first image (the same for every image of the scene).
+  // at the scene's first image (the same for every image of the scene; once
+  // per scene and scale settings).
+  RecognitionSettings parsed =
+      parse_recognition_settings(YamlNode::load_string(rec.settings.dump(), "trial " + rec.key));
   const ImageInfo& first = scene.images.begin()->second;
-  const std::string first_key = ds.root() + "#" + rec.split + "#" + std::to_string(rec.scene_id);
-  if (!cache().first_depths.count(first_key))
-    cache().first_depths[first_key] =
-        first.im_id == im.im_id ? depth_clean : ds.load_depth(rec.split, rec.scene_id, first);
-  RecognitionSettings s = resolve_lengths_for_sensor(
-      parse_recognition_settings(YamlNode::load_string(rec.settings.dump(), "trial " + rec.key)),
-      ds.model_info(obj_id).diameter, cache().first_depths.at(first_key), first.K);
+  if (!parsed.relative.empty() && !(parsed.scale.min_length_mm > 0)) {
+    char scale_key[96];
+    std::snprintf(scale_key, sizeof scale_key, "#%.17g#%.17g#%.17g", parsed.scale.sensor_floor_px,
+                  parsed.scale.sensor_floor_sigmas, parsed.scale.working_distance_mm);
+    const std::string floor_key = scene_key + scale_key;
+    auto floor_it = cache().sensor_floors.find(floor_key);
+    if (floor_it == cache().sensor_floors.end()) {
+      const double floor = sensor_length_floor_mm(
+          parsed.scale, first.im_id == im.im_id ? depth_clean : ds.load_depth(rec.split, rec.scene_id, first),
+          first.K);
+      floor_it = cache().sensor_floors.emplace(floor_key, floor).first;
+    }
+    parsed.scale.min_length_mm = floor_it->second;
+  }
+  RecognitionSettings s = parsed.relative.empty() ? parsed : resolve_lengths(parsed, ds.model_info(obj_id).diameter);
   RecognitionSettings st = s;  // training keeps the settings' seed
   s.seed = rec.seed;
   rec.settings_resolved = nlohmann::json::parse(settings_to_json(s));
@@ -239,7 +259,7 @@ void run(TrialRecord& rec, const TrialContext& ctx) {
   if (gi < im.gt_info.size() && std::isfinite(im.gt_info[gi].visib_fract))  // NaN: not given
     rec.visib_fract = im.gt_info[gi].visib_fract;
   if (res.status == "ok")
-    evaluate(res.T_cam_model, *gt, ds, im, obj_id, *mesh, ctx, rec);
+    evaluate(res.T_cam_model, *gt, ds, im, obj_id, *mesh, depth_clean, ctx, rec);
   else
     rec.correct = false;
 }
