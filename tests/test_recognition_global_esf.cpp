@@ -8,6 +8,7 @@
 #include <functional>
 #include <thread>
 
+#include "core/hash.h"
 #include "core/random.h"
 #include "recognition/global/esf.h"
 #include "recognition/global/internal.h"
@@ -101,6 +102,20 @@ TEST(GlobalEsf, ShapeAndNormalization) {
   Rng r3(1);
   const auto line = compute_esf({Vec3f(0, 0, 1), Vec3f(0, 0, 2), Vec3f(0, 0, 3), Vec3f(0, 0, 4)}, r3);
   for (float v : line) EXPECT_EQ(v, 0.f);
+}
+
+// The histograms of every test shape, bit for bit, as the implementation
+// that traced each line with its rounding steppers step by step computed them
+// (before the lines' minor-axis moves came from a table): a change of the
+// line tracing, the binning or the draws changes the fingerprint.
+TEST(GlobalEsf, HistogramsAreThoseOfTheSteppedLineTracing) {
+  std::string bytes;
+  for (const auto& [name, f] : shapes()) {
+    Rng rng(11);
+    const std::vector<float> h = compute_esf(sample(f, 2000, 5), rng);
+    bytes.append(reinterpret_cast<const char*>(h.data()), h.size() * sizeof(float));
+  }
+  EXPECT_EQ(hash_hex(bytes), "ac09ddb762035115");
 }
 
 TEST(GlobalEsf, DeterministicAndThreadSafe) {

@@ -50,8 +50,9 @@ struct Line {
 // One minor coordinate of the traced line: a + (d i / n rounded to nearest,
 // halves up) for i = 0, 1, ..., that is a + floor((2 d i + n) / (2 n)),
 // exact in integers for negative d too, kept as a remainder 0 <= rem < 2n.
-// |2 d| <= 2 n, so one step moves the coordinate by at most one voxel; the
-// move is applied to the grid index branch-free (masks from the sign bit).
+// |2 d| <= 2 n, so one step moves the coordinate by at most one voxel (by
+// `stride` in the grid index; branch-free, masks from the sign bit). It
+// defines the lines; the tracing reads its moves from MoveTable.
 struct Stepper {
   int rem, step, den, stride;
   Stepper(int d, int n, int stride_) : rem(n), step(2 * d), den(2 * n), stride(stride_) {}  // i = 0: n / 2n = 0 rem n
@@ -64,9 +65,41 @@ struct Stepper {
   }
 };
 
+// The minor axis moves of a line of n steps whose minor coordinate changes
+// by d in all: bit i set when step i moves it (by the sign of d), as the
+// Stepper takes them. One table for every |d| <= n < kG, built once from
+// the Stepper itself, so a line read from it is the Stepper's line. Per
+// step, a shift and a multiply instead of the Stepper's remainder update:
+// ESF 20-25% faster (bench_global BM_EsfOurs, alternating runs), the same
+// histograms bit for bit (test GlobalEsf.HistogramsAreThoseOfTheSteppedLineTracing).
+class MoveTable {
+ public:
+  MoveTable() {
+    for (int n = 1; n < kG; ++n)
+      for (int d = -n; d <= n; ++d) {
+        Stepper s(d, n, 1);
+        uint64_t m = 0;
+        for (int i = 0; i < n; ++i)
+          if (s.next() != 0) m |= uint64_t(1) << i;
+        moves_[static_cast<size_t>(n) * (2 * kG + 1) + static_cast<size_t>(d + kG)] = m;
+      }
+  }
+  uint64_t operator()(int d, int n) const {
+    return moves_[static_cast<size_t>(n) * (2 * kG + 1) + static_cast<size_t>(d + kG)];
+  }
+
+ private:
+  std::vector<uint64_t> moves_ = std::vector<uint64_t>(static_cast<size_t>(kG) * (2 * kG + 1), 0);
+};
+
+const MoveTable& move_table() {
+  static const MoveTable t;
+  return t;
+}
+
 // Traces the line from voxel a toward voxel b: max(|d|) voxels (at least
 // one), a included, b excluded, the minor axes rounded to nearest. The major
-// axis moves one voxel per step; the two others follow their Steppers.
+// axis moves one voxel per step; the two others as their move masks say.
 Line trace(const OccupancyGrid& g, const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
   const Eigen::Vector3i d = b - a;
   const Eigen::Vector3i ad = d.cwiseAbs();
@@ -80,11 +113,14 @@ Line trace(const OccupancyGrid& g, const Eigen::Vector3i& a, const Eigen::Vector
     const int major = ad.x() == n ? 0 : (ad.y() == n ? 1 : 2);
     const int m1 = major == 0 ? 1 : 0, m2 = major == 2 ? 1 : 2;
     const int major_step = (d[major] > 0 ? 1 : -1) * OccupancyGrid::stride(major);
-    Stepper s1(d[m1], n, OccupancyGrid::stride(m1)), s2(d[m2], n, OccupancyGrid::stride(m2));
+    const MoveTable& t = move_table();
+    const uint64_t moves1 = t(d[m1], n), moves2 = t(d[m2], n);
+    const int step1 = (d[m1] > 0 ? 1 : -1) * OccupancyGrid::stride(m1);
+    const int step2 = (d[m2] > 0 ? 1 : -1) * OccupancyGrid::stride(m2);
     int occupied = 0;
     for (int i = 0; i < n; ++i) {
       occupied += g.occupied(idx);
-      idx += major_step + s1.next() + s2.next();
+      idx += major_step + static_cast<int>((moves1 >> i) & 1) * step1 + static_cast<int>((moves2 >> i) & 1) * step2;
     }
     L.occupied = occupied;
   }
