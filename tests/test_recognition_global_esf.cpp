@@ -107,7 +107,8 @@ TEST(GlobalEsf, ShapeAndNormalization) {
 // The histograms of every test shape, bit for bit, as the implementation
 // that traced each line with its rounding steppers step by step computed them
 // (before the lines' minor-axis moves came from a table): a change of the
-// line tracing, the binning or the draws changes the fingerprint.
+// line tracing, the binning or the draws changes the fingerprint (on this
+// toolchain: x86-64 without FMA contraction, glibc's acos).
 TEST(GlobalEsf, HistogramsAreThoseOfTheSteppedLineTracing) {
   std::string bytes;
   for (const auto& [name, f] : shapes()) {

@@ -210,11 +210,14 @@ double sensor_length_floor_mm(const ScaleSettings& scale, const DepthImage& imag
   return std::max(noise, scale.sensor_floor_px * z / K.fx);
 }
 
+bool needs_sensor_floor(const RecognitionSettings& s) {
+  return !s.relative.empty() && !(s.scale.min_length_mm > 0);
+}
+
 RecognitionSettings resolve_lengths_for_sensor(const RecognitionSettings& in, double model_diameter_mm,
                                                const DepthImage& image, const Intrinsics& K) {
-  if (in.relative.empty()) return in;
   RecognitionSettings s = in;
-  if (!(s.scale.min_length_mm > 0)) s.scale.min_length_mm = sensor_length_floor_mm(s.scale, image, K);
+  if (needs_sensor_floor(s)) s.scale.min_length_mm = sensor_length_floor_mm(s.scale, image, K);
   return resolve_lengths(s, model_diameter_mm);
 }
 

@@ -104,6 +104,10 @@ RecognitionSettings resolve_lengths(const RecognitionSettings& s, double model_d
 // factors 0).
 double sensor_length_floor_mm(const ScaleSettings& scale, const DepthImage& image, const Intrinsics& K);
 
+// Whether resolving s's lengths takes the sensor's floor: some length is
+// relative and scale.min_length_mm is not given (0).
+bool needs_sensor_floor(const RecognitionSettings& s);
+
 // The depth noise of an image (mm, one standard deviation), estimated from
 // the image alone: along each row, the second difference
 // z[u-1] - 2 z[u] + z[u+1] of three valid pixels cancels a locally linear
@@ -115,9 +119,10 @@ double sensor_length_floor_mm(const ScaleSettings& scale, const DepthImage& imag
 double depth_noise_sigma_mm(const DepthImage& image);
 
 // resolve_lengths with the sensor's floor: when scale.min_length_mm is 0 it
-// becomes sensor_length_floor_mm(scale, image, K) first. The runner passes
-// the first image of the trial's scene, so every image of a scene resolves
-// alike (and shares one trained model).
+// becomes sensor_length_floor_mm(scale, image, K) first. The runner does
+// the same with the floor of the trial's scene's first image (computed once
+// per scene and scale setting), so every image of a scene resolves alike
+// (and shares one trained model).
 RecognitionSettings resolve_lengths_for_sensor(const RecognitionSettings& s, double model_diameter_mm,
                                                const DepthImage& image, const Intrinsics& K);
 

@@ -210,7 +210,7 @@ void run(TrialRecord& rec, const TrialContext& ctx) {
   RecognitionSettings parsed =
       parse_recognition_settings(YamlNode::load_string(rec.settings.dump(), "trial " + rec.key));
   const ImageInfo& first = scene.images.begin()->second;
-  if (!parsed.relative.empty() && !(parsed.scale.min_length_mm > 0)) {
+  if (needs_sensor_floor(parsed)) {
     char scale_key[96];
     std::snprintf(scale_key, sizeof scale_key, "#%.17g#%.17g#%.17g", parsed.scale.sensor_floor_px,
                   parsed.scale.sensor_floor_sigmas, parsed.scale.working_distance_mm);
@@ -224,7 +224,7 @@ void run(TrialRecord& rec, const TrialContext& ctx) {
     }
     parsed.scale.min_length_mm = floor_it->second;
   }
-  RecognitionSettings s = parsed.relative.empty() ? parsed : resolve_lengths(parsed, ds.model_info(obj_id).diameter);
+  RecognitionSettings s = resolve_lengths(parsed, ds.model_info(obj_id).diameter);
   RecognitionSettings st = s;  // training keeps the settings' seed
   s.seed = rec.seed;
   rec.settings_resolved = nlohmann::json::parse(settings_to_json(s));
