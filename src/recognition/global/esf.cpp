@@ -69,9 +69,10 @@ struct Stepper {
 // by d in all: bit i set when step i moves it (by the sign of d), as the
 // Stepper takes them. One table for every |d| <= n < kG, built once from
 // the Stepper itself, so a line read from it is the Stepper's line. Per
-// step, a shift and a multiply instead of the Stepper's remainder update:
-// ESF 20-25% faster (bench_global BM_EsfOurs, alternating runs), the same
-// histograms bit for bit (test GlobalEsf.HistogramsAreThoseOfTheSteppedLineTracing).
+// step, a shift and a multiply instead of the Stepper's remainder update
+// (bench_global BM_EsfOurs in alternating runs: results/bench/README.md,
+// eleventh round), the same histograms bit for bit (test
+// GlobalEsf.HistogramsAreThoseOfTheSteppedLineTracing).
 class MoveTable {
  public:
   MoveTable() {
