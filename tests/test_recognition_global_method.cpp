@@ -46,6 +46,14 @@ class GlobalMethod : public ::testing::TestWithParam<std::string> {
     scene_ = new PointSet(
         preprocess_scene(render_cloud(*mesh_, camera_pose(60, 30, 5, 650), synthetic_camera(), 1.0, 9), pre, 4));
   }
+  // A fresh method `name` with settings g, trained on the views (seed 5):
+  // its hypotheses for the scene (seed 11).
+  static std::vector<Hypothesis> hypotheses(const std::string& name, const GlobalSettings& g = {}) {
+    auto m = make(name, g);
+    m->train(*views_, 5);
+    StageTimes t;
+    return m->hypothesize(*scene_, *views_, 11, t);
+  }
   static void TearDownTestSuite() {
     delete mesh_;
     delete views_;
@@ -151,20 +159,14 @@ TEST_F(GlobalMethod, CesfWithoutStableRegionsFallsBackToTheWholeCloud) {
   GlobalSettings g;
   g.cvfh_min_region_points = 1000000;
   ASSERT_TRUE(global::stable_regions(*scene_, g).empty());
-  auto cvfh = make("cvfh", g), cesf = make("cesf", g), esf = make("esf", g);
-  for (auto* m : {&cvfh, &cesf, &esf}) (*m)->train(*views_, 5);
-  StageTimes t;
-  EXPECT_FALSE(cvfh->hypothesize(*scene_, *views_, 11, t).empty());  // PCL's fallback
-  const auto h = cesf->hypothesize(*scene_, *views_, 11, t);
+  EXPECT_FALSE(hypotheses("cvfh", g).empty());  // PCL's fallback
+  const auto h = hypotheses("cesf", g);
   ASSERT_FALSE(h.empty());
-  EXPECT_TRUE(same(h, esf->hypothesize(*scene_, *views_, 11, t)));
+  EXPECT_TRUE(same(h, hypotheses("esf", g)));
   // With stable regions (the defaults) CESF describes the regions, not the
   // whole cloud.
-  auto cesf_regions = make("cesf"), esf_default = make("esf");
-  cesf_regions->train(*views_, 5);
-  esf_default->train(*views_, 5);
   ASSERT_FALSE(global::stable_regions(*scene_, GlobalSettings{}).empty());
-  EXPECT_FALSE(same(cesf_regions->hypothesize(*scene_, *views_, 11, t), esf_default->hypothesize(*scene_, *views_, 11, t)));
+  EXPECT_FALSE(same(hypotheses("cesf"), hypotheses("esf")));
 }
 
 // global.cesf_whole_cluster: every region's signature is the ESF of the
@@ -174,16 +176,12 @@ TEST_F(GlobalMethod, CesfWholeClusterDescribesTheCloudFromEachRegion) {
   GlobalSettings whole;
   whole.cesf_whole_cluster = true;
   ASSERT_FALSE(global::stable_regions(*scene_, whole).empty());
-  auto cesf = make("cesf", whole), esf = make("esf"), cesf_regions = make("cesf");
-  for (auto* m : {&cesf, &esf, &cesf_regions}) (*m)->train(*views_, 5);
-  StageTimes t;
   const auto best = [](const std::vector<Hypothesis>& h) {
     double b = 0;
     for (const auto& x : h) b = std::max(b, x.score);
     return b;
   };
-  const auto h = cesf->hypothesize(*scene_, *views_, 11, t), he = esf->hypothesize(*scene_, *views_, 11, t),
-             hr = cesf_regions->hypothesize(*scene_, *views_, 11, t);
+  const auto h = hypotheses("cesf", whole), he = hypotheses("esf"), hr = hypotheses("cesf");
   ASSERT_FALSE(h.empty());
   ASSERT_FALSE(he.empty());
   EXPECT_DOUBLE_EQ(best(h), best(he));
@@ -197,11 +195,7 @@ TEST_F(GlobalMethod, CesfWholeClusterDescribesTheCloudFromEachRegion) {
 TEST_F(GlobalMethod, EsfPoseFromNormalsKeepsTheMatchesAndMovesThePoses) {
   GlobalSettings normals;
   normals.esf_pose_from_normals = true;
-  auto a = make("esf"), b = make("esf", normals);
-  a->train(*views_, 5);
-  b->train(*views_, 5);
-  StageTimes t;
-  const auto ha = a->hypothesize(*scene_, *views_, 11, t), hb = b->hypothesize(*scene_, *views_, 11, t);
+  const auto ha = hypotheses("esf"), hb = hypotheses("esf", normals);
   ASSERT_FALSE(ha.empty());
   ASSERT_EQ(ha.size(), hb.size());
   std::vector<double> sa, sb;
@@ -221,11 +215,7 @@ TEST_F(GlobalMethod, TopKCountingRollsKeepsTheFirstTopKHypotheses) {
   GlobalSettings rolls = g;
   rolls.top_k_counts_rolls = true;
   for (const char* name : {"cvfh", "cesf"}) {
-    auto a = make(name, g), b = make(name, rolls);
-    a->train(*views_, 5);
-    b->train(*views_, 5);
-    StageTimes t;
-    const auto ha = a->hypothesize(*scene_, *views_, 11, t), hb = b->hypothesize(*scene_, *views_, 11, t);
+    const auto ha = hypotheses(name, g), hb = hypotheses(name, rolls);
     ASSERT_GT(ha.size(), 2u) << name << ": the fixture should give more than one roll per match";
     ASSERT_EQ(hb.size(), 2u) << name;
     EXPECT_TRUE(same({ha[0], ha[1]}, hb)) << name;
@@ -245,18 +235,12 @@ TEST_F(GlobalMethod, EsfSamplesFromPointsDrawsOneTriplePerPoint) {
   EXPECT_EQ(global::esf_triples(per_point, 0), 0);
   ASSERT_LT(scene_->size(), 20000u);
   for (const char* name : {"esf", "cesf"}) {
-    auto a = make(name, g), b = make(name, per_point);
-    a->train(*views_, 5);
-    b->train(*views_, 5);
-    StageTimes t;
-    const auto ha = a->hypothesize(*scene_, *views_, 11, t), hb = b->hypothesize(*scene_, *views_, 11, t);
+    const auto ha = hypotheses(name, g), hb = hypotheses(name, per_point);
     ASSERT_FALSE(ha.empty()) << name;
     ASSERT_FALSE(hb.empty()) << name;
     EXPECT_NE(ha[0].score, hb[0].score) << name;
     // Same settings, same hypotheses: the per-point count is deterministic.
-    auto c = make(name, per_point);
-    c->train(*views_, 5);
-    EXPECT_TRUE(same(hb, c->hypothesize(*scene_, *views_, 11, t))) << name;
+    EXPECT_TRUE(same(hb, hypotheses(name, per_point))) << name;
   }
 }
 

@@ -230,8 +230,6 @@ static nlohmann::json to_json(const YAML::Node& n, const std::string& file, cons
   return s;
 }
 
-nlohmann::json yaml_to_json(const YAML::Node& n) { return to_json(n, "", ""); }
-
 nlohmann::json YamlNode::json() const { return to_json(node_, file_, path_); }
 
 }  // namespace pb

@@ -66,22 +66,18 @@ class YamlNode {
   const std::string& path() const { return path_; }
   int line() const { return node_.Mark().line + 1; }
   const YAML::Node& raw() const { return node_; }
-  // This node as JSON (yaml_to_json), with input errors (a key given twice,
-  // a key that is not a plain name) naming this file and the key's path.
+  // This node as JSON, the project's one YAML -> JSON conversion. Scalars
+  // are typed as YAML 1.2's core schema reads them: true/false (also True,
+  // TRUE, False, FALSE), null (~, null, empty), integers, floats; anything
+  // else, and every quoted scalar, is a string. Maps keep their keys,
+  // sequences their order. A key given twice in a map (YAML keys are unique;
+  // yaml-cpp keeps both) or a key that is not a plain name is an InputError
+  // naming this file and the key's path.
   nlohmann::json json() const;
 
  private:
   YAML::Node node_;
   std::string file_, path_;
 };
-
-// YAML -> JSON, the project's one conversion. Scalars are typed as YAML 1.2's
-// core schema reads them: true/false (also True, TRUE, False, FALSE), null
-// (~, null, empty), integers, floats; anything else, and every quoted
-// scalar, is a string. Maps keep their keys, sequences their order. A key
-// given twice in a map is an InputError (YAML keys are unique; yaml-cpp
-// keeps both). Without a YamlNode the error names no file: prefer
-// YamlNode::json().
-nlohmann::json yaml_to_json(const YAML::Node& node);
 
 }  // namespace pb
