@@ -138,39 +138,52 @@ TEST(DescriptorIndex, CappedChecksAreExactUntilTheCapBindsAndKeepAHighRecall) {
 
 
 
-// FPFH-sized rows (33, a FLANN kd-tree): the search bounded by the threshold
-// from the start gives what an unbounded k-nearest search gives once the rows
-// at or above the threshold are dropped (the k nearest under a threshold are
-// the k nearest overall that are under it), for several k and thresholds.
-TEST(DescriptorIndex, KdTreeSearchBoundedByTheThresholdEqualsTheUnboundedOne) {
+// FPFH-sized rows (33: the lower bound from 32 of the 33 principal axes):
+// the blocked search equals the exact scan bit for bit, duplicate rows
+// (ties: the lower row) included, and the search bounded by the threshold
+// gives what an unbounded k-nearest search gives once the rows at or above
+// the threshold are dropped, for several k and thresholds.
+TEST(DescriptorIndex, FpfhSizedBlockedSearchEqualsExactScanUnderEveryThreshold) {
   constexpr int kFpfh = 33;
   pb::Rng rng(11);
   std::vector<float> data;
   for (int r = 0; r < 3000; ++r)
     for (int j = 0; j < kFpfh; ++j) data.push_back(static_cast<float>(rng.uniform(0, 30)));
+  for (int r = 0; r < 30; ++r) {  // exact duplicates
+    const int src = rng.uniform_int(0, 2999);
+    data.insert(data.end(), data.begin() + src * kFpfh, data.begin() + (src + 1) * kFpfh);
+  }
   pb::local::DescriptorIndex index;
   index.build(data, kFpfh);
   std::vector<float> queries;
   for (int q = 0; q < 300; ++q) {
-    const int src = rng.uniform_int(0, 2999);
+    const int src = rng.uniform_int(0, 3029);
+    const double sigma = q % 3 == 0 ? 0.0 : q % 3 == 1 ? 2.0 : 6.0;  // exact copies hit the duplicates' ties
     for (int j = 0; j < kFpfh; ++j)
-      queries.push_back(data[static_cast<size_t>(src) * kFpfh + j] + static_cast<float>(rng.normal(0, q % 2 ? 2 : 6)));
+      queries.push_back(data[static_cast<size_t>(src) * kFpfh + j] + static_cast<float>(rng.normal(0, sigma)));
   }
+  const int n = static_cast<int>(queries.size() / kFpfh);
+  const float inf = std::numeric_limits<float>::infinity();
   size_t found = 0, dropped = 0;
   for (int k : {1, 3, 10}) {
+    std::vector<std::vector<std::pair<int, float>>> unbounded(n);
+    index.knn_block(queries.data(), n, k, inf, unbounded.data());
     for (float thr : {300.f, 1500.f, 4000.f}) {
-      for (int i = 0; i < 300; ++i) {
-        const float* q = queries.data() + static_cast<size_t>(i) * kFpfh;
-        std::vector<std::pair<int, float>> bounded, all;
-        index.knn(q, k, thr, bounded);
-        index.knn(q, k, std::numeric_limits<float>::infinity(), all);
-        ASSERT_EQ(all.size(), static_cast<size_t>(k));
+      std::vector<std::vector<std::pair<int, float>>> bounded(n);
+      index.knn_block(queries.data(), n, k, thr, bounded.data());
+      for (int i = 0; i < n; ++i) {
+        std::vector<std::pair<int, float>> exact, exact_all;
+        index.knn(queries.data() + static_cast<size_t>(i) * kFpfh, k, thr, exact);
+        index.knn(queries.data() + static_cast<size_t>(i) * kFpfh, k, inf, exact_all);
+        ASSERT_EQ(bounded[i], exact) << "query " << i << " k " << k << " threshold " << thr;
+        ASSERT_EQ(unbounded[i], exact_all) << "query " << i << " k " << k;
+        ASSERT_EQ(exact_all.size(), static_cast<size_t>(k));
         std::vector<std::pair<int, float>> under;
-        for (const auto& e : all)
+        for (const auto& e : exact_all)
           if (e.second < thr) under.push_back(e);
-        ASSERT_EQ(bounded, under) << "query " << i << " k " << k << " threshold " << thr;
+        ASSERT_EQ(bounded[i], under) << "query " << i << " k " << k << " threshold " << thr;
         found += under.size();
-        dropped += all.size() - under.size();
+        dropped += exact_all.size() - under.size();
       }
     }
   }

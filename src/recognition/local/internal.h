@@ -119,9 +119,8 @@ class DescriptorIndex {
            std::vector<std::pair<int, float>>& out) const;
   // The same for `n` consecutive queries (row-major, n x dim); out[i] gets
   // query i's result, identical to knn(query i). The linear scan streams the
-  // indexed rows once per block of queries (cache blocking). max_checks > 0
-  // (the scan of high-dimensional rows only; the kd-tree stays exact): at
-  // most that many rows measured exactly per query, those of the lowest
+  // indexed rows once per block of queries (cache blocking). max_checks > 0:
+  // at most that many rows measured exactly per query, those of the lowest
   // projected bounds, so a row may be missed (approximate search).
   void knn_block(const float* queries, int n, int k, float max_sq_dist,
                  std::vector<std::pair<int, float>>* out, int max_checks = 0) const;

@@ -33,8 +33,8 @@ struct LocalSettings {
                                         // each, Figure 4.11's statue, 0 and 2 mm of added
                                         // noise): 97.7-97.9% of the matched keypoints in the
                                         // warehouse, 99.2-99.3% on the table; 96.8% at 25 mm
-                                        // (match stage 12.1 -> 4.6 s there). FPFH's kd-tree
-                                        // search stays exact
+                                        // (match stage 12.1 -> 4.6 s there). FPFH's search
+                                        // stays exact
   int matches_per_keypoint = 1;         // k: up to k nearest model descriptors (over all
                                         // views) under the threshold kept per scene keypoint
   double hough_bin_mm = 50.0;           // 3D Hough bin size (Table 4.2)

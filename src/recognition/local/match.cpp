@@ -1,26 +1,29 @@
 // Descriptor matching index over the descriptors of all training views:
-// exact nearest neighbours under squared L2 distance. Low-dimensional
-// descriptors (FPFH, 33) use a FLANN single kd-tree (the index
-// pcl::KdTreeFLANN builds). For high-dimensional ones (SHOT, 352) a kd-tree
-// visits nearly every leaf (measured: no faster than a linear scan), so they
-// use an exact scan with a lower bound: every descriptor is also projected on
-// the kProjDim principal axes of the indexed rows (an orthonormal basis P, so
-// |P q - P d| <= |q - d| for every pair). The bounds of a block of queries to
-// every row come from one small matrix product (|Pq|^2 + |Pd|^2 - 2 Pq.Pd,
-// Eigen's blocked GEMM); rows are then measured exactly in the order of
-// their bounds until the bound exceeds the k-th best exact distance (or the
-// threshold), with a margin for the product's rounding. Every row that can
-// be among the k nearest is measured exactly and offered in ascending row
-// order, so the result is the exact scan's, bit for bit. Approximate on
-// request (max_checks > 0): at most that many rows, those of the lowest
-// bounds, are measured exactly per query; the answer is still exact whenever
-// the early exit comes first (measured recall: LocalSettings'
-// match_max_checks). Searches are const and thread-safe, and deterministic
-// (no randomized trees).
-#include <flann/algorithms/dist.h>
-#include <flann/algorithms/kdtree_single_index.h>
-#include <flann/util/matrix.h>
-
+// exact nearest neighbours under squared L2 distance (ties: the lower row),
+// found by a scan with a lower bound, for FPFH (33) and SHOT (352) alike.
+// Every descriptor is also projected on the first principal axes of the
+// indexed rows (an orthonormal basis P, so |P q - P d| <= |q - d| for every
+// pair). The bounds of a block of queries to every row come from one small
+// matrix product (|Pq|^2 + |Pd|^2 - 2 Pq.Pd, Eigen's blocked GEMM); rows are
+// then measured exactly in the order of their bounds until the bound exceeds
+// the k-th best exact distance (or the threshold), with a margin for the
+// product's rounding. Every row that can be among the k nearest is measured
+// exactly and offered in ascending row order, so the result is the exact
+// scan's, bit for bit. Approximate on request (max_checks > 0): at most that
+// many rows, those of the lowest bounds, are measured exactly per query; the
+// answer is still exact whenever the early exit comes first (measured
+// recall: LocalSettings' match_max_checks). Searches are const and
+// thread-safe, and deterministic (no randomized trees).
+//
+// Why no kd-tree: for SHOT one visits nearly every leaf (measured: no faster
+// than a linear scan). FPFH used FLANN's single kd-tree (the index
+// pcl::KdTreeFLANN builds) until it measured slower than this scan: 2 to 3
+// times on Figure 4.11's noisy table frames, where a query far from every
+// model descriptor visits most leaves, and about as fast or slower on clean
+// frames (results/bench/README.md, twelfth round). The kd-tree also broke
+// ties by its own traversal order: a symmetric model's training views hold
+// identical descriptors, and a scene keypoint matched whichever of them the
+// tree met first; here the lowest row, i.e. the first view, wins.
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -35,23 +38,27 @@
 namespace pb::local {
 
 namespace {
-constexpr int kMaxKdTreeDim = 64;  // above this: linear scan with a projected lower bound
-constexpr int kProjDim = 32;       // principal axes of the lower bound
+// Principal axes of the lower bound: 32 for long rows (SHOT: match_max_checks'
+// measured recall is that of these bounds), 12 for short ones (FPFH). Fewer
+// axes make the product cheaper and the bound looser; FPFH's match stage on
+// bench_local's table image took 2.8 / 1.9 / 1.8 / 2.1 / 2.5 ms with 32 / 16 /
+// 12 / 8 / 6 axes (results/bench/README.md, twelfth round).
+constexpr int kProjDim = 32;
+constexpr int kProjDimShort = 12;
+constexpr int kShortRows = 64;  // rows of at most this many values are short
 constexpr size_t kPcaRows = 1000;  // at most this many (evenly spaced) rows estimate the axes
 using RowMat = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 }
 
 struct DescriptorIndex::Impl {
   std::vector<float> data;
-  std::vector<float> sq_norms;  // per row
-  float max_sq_norm = 0;
+  float max_sq_norm = 0;       // of the rows (the bound's rounding margin)
   int dim = 0;
   size_t rows = 0;
   int proj_dim = 0;
   std::vector<float> basis;    // proj_dim x dim, orthonormal rows (principal axes)
   std::vector<float> proj;     // rows x proj_dim: each row projected on the basis
   std::vector<float> proj_sq;  // squared norm of each projected row
-  std::unique_ptr<flann::KDTreeSingleIndex<flann::L2_Simple<float>>> index;
 };
 
 DescriptorIndex::DescriptorIndex() : impl_(new Impl) {}
@@ -63,22 +70,13 @@ void DescriptorIndex::build(const std::vector<float>& data, int dim) {
   impl_->data = data;
   impl_->dim = dim;
   impl_->rows = data.size() / static_cast<size_t>(dim);
-  if (dim > kMaxKdTreeDim) {
-    impl_->sq_norms.resize(impl_->rows);
-    for (size_t r = 0; r < impl_->rows; ++r) {
-      const float* d = impl_->data.data() + r * static_cast<size_t>(dim);
-      float s = 0;
-      for (int j = 0; j < dim; ++j) s += d[j] * d[j];
-      impl_->sq_norms[r] = s;
-      impl_->max_sq_norm = std::max(impl_->max_sq_norm, s);
-    }
-    build_projection();
-    return;
+  for (size_t r = 0; r < impl_->rows; ++r) {
+    const float* d = impl_->data.data() + r * static_cast<size_t>(dim);
+    float s = 0;
+    for (int j = 0; j < dim; ++j) s += d[j] * d[j];
+    impl_->max_sq_norm = std::max(impl_->max_sq_norm, s);
   }
-  flann::Matrix<float> m(impl_->data.data(), impl_->rows, static_cast<size_t>(dim));
-  impl_->index.reset(new flann::KDTreeSingleIndex<flann::L2_Simple<float>>(
-      m, flann::KDTreeSingleIndexParams(15)));
-  impl_->index->buildIndex();
+  build_projection();
 }
 
 // The kProjDim principal axes of (up to kPcaRows evenly spaced) rows, in
@@ -95,7 +93,7 @@ void DescriptorIndex::build_projection() {
   X.rowwise() -= X.colwise().mean();
   const Eigen::MatrixXd C = X.transpose() * X;
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(C);
-  m.proj_dim = static_cast<int>(std::min<Eigen::Index>(kProjDim, dim));
+  m.proj_dim = static_cast<int>(std::min<Eigen::Index>(dim > kShortRows ? kProjDim : kProjDimShort, dim));
   m.basis.resize(static_cast<size_t>(m.proj_dim) * dim);
   for (int a = 0; a < m.proj_dim; ++a)  // eigenvalues ascend: the largest last
     for (Eigen::Index j = 0; j < dim; ++j)
@@ -189,8 +187,8 @@ inline void offer(std::vector<std::pair<int, float>>& out, size_t kk, int row, f
 void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq_dist,
                                 std::vector<std::pair<int, float>>* out, int max_checks) const {
   const size_t dim = static_cast<size_t>(impl_->dim);
-  if (impl_->index || impl_->rows == 0 || k <= 0) {
-    for (int i = 0; i < n; ++i) knn(queries + static_cast<size_t>(i) * dim, k, max_sq_dist, out[i]);
+  if (impl_->rows == 0 || k <= 0) {
+    for (int i = 0; i < n; ++i) out[i].clear();
     return;
   }
   const Impl& m = *impl_;
@@ -258,43 +256,16 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
 
 void DescriptorIndex::knn(const float* query, int k, float max_sq_dist,
                           std::vector<std::pair<int, float>>& out) const {
+  // Exact linear scan; keeps the kk best under the threshold.
   out.clear();
   if (impl_->rows == 0 || k <= 0) return;
   const size_t kk = std::min<size_t>(static_cast<size_t>(k), impl_->rows);
   const size_t dim = static_cast<size_t>(impl_->dim);
-  if (!impl_->index) {
-    // Exact linear scan; keeps the kk best under the threshold.
-    const float* d = impl_->data.data();
-    for (size_t r = 0; r < impl_->rows; ++r, d += dim) {
-      const float s = sq_dist(query, d, dim);
-      if (s < max_sq_dist) offer(out, kk, static_cast<int>(r), s);
-    }
-    return;
+  const float* d = impl_->data.data();
+  for (size_t r = 0; r < impl_->rows; ++r, d += dim) {
+    const float s = sq_dist(query, d, dim);
+    if (s < max_sq_dist) offer(out, kk, static_cast<int>(r), s);
   }
-  std::vector<size_t> idx(kk);
-  std::vector<float> dist(kk);
-  flann::Matrix<float> q(const_cast<float*>(query), 1, dim);
-  flann::Matrix<size_t> mi(idx.data(), 1, kk);
-  flann::Matrix<float> md(dist.data(), 1, kk);
-  flann::SearchParams params(-1, 0.0f, true);
-  params.cores = 1;
-  int found = 0;
-  if (std::isfinite(max_sq_dist)) {
-    // Bounded from the start by the threshold (KNNRadiusResultSet: the kk
-    // nearest strictly below it): the tree prunes every branch beyond it,
-    // where an unbounded k-nearest search narrows only as it finds rows (a
-    // scene keypoint with no model descriptor under the threshold visited
-    // most leaves). The same rows.
-    params.max_neighbors = static_cast<int>(kk);
-    found = impl_->index->radiusSearch(q, mi, md, max_sq_dist, params);
-  } else {
-    found = impl_->index->knnSearch(q, mi, md, kk, params);
-  }
-  for (int i = 0; i < found && i < static_cast<int>(kk); ++i)
-    if (dist[i] < max_sq_dist) out.emplace_back(static_cast<int>(idx[i]), dist[i]);
-  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
-    return a.second < b.second || (a.second == b.second && a.first < b.first);
-  });
 }
 
 }  // namespace pb::local

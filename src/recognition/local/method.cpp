@@ -163,7 +163,7 @@ class LocalMethod : public Method {
     for (int b = 0; b < nblocks; ++b) {
       const int first = b * kMatchBlock, count = std::min(kMatchBlock, nkp - first);
       index_.knn_block(query + static_cast<size_t>(first) * dim, count, s.matches_per_keypoint, thr,
-                       nn.data() + first, s.match_max_checks);
+                       nn.data() + first, kind_ == Kind::Shot ? s.match_max_checks : 0);
     }
     times.match += timer.seconds();
 
