@@ -45,8 +45,9 @@
 // cluster, as CVFH does (ci: one CESF record, image 4, changed: 11 -> 15
 // hypotheses, wrong before and after; demo unchanged), and when FPFH matching
 // moved from FLANN's kd-tree to the bounded scan, which breaks exact ties
-// (identical descriptors of flat faces in several views) toward the lower
-// row where the tree took whichever it met first (ci: 9 FPFH estimates
+// (equal distances to rows 424 or 848 apart, seen on two of Table 4.1's
+// Astra images: identical descriptors in several training views) toward the
+// lower row where the tree took whichever it met first (ci: 9 FPFH estimates
 // moved, image 0 turned wrong, FPFH 9 -> 8 of 10; demo: the same image, 3 ->
 // 2 of 4; a tie-break flip, not a weakening: on Table 4.1's 220 FPFH trials
 // the scan is 202 correct against the tree's 201, the scan with ties toward
