@@ -21,9 +21,10 @@
 // times on Figure 4.11's noisy table frames, where a query far from every
 // model descriptor visits most leaves, and about as fast or slower on clean
 // frames (results/bench/README.md, twelfth round). The kd-tree also broke
-// ties by its own traversal order: a symmetric model's training views hold
-// identical descriptors, and a scene keypoint matched whichever of them the
-// tree met first; here the lowest row, i.e. the first view, wins.
+// exact ties by its own traversal order: training views can hold identical
+// descriptors (seen: equal distances to rows 424 or 848 apart on Table 4.1's
+// Astra images), and a scene keypoint matched whichever of them the tree met
+// first; here the lowest row wins.
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
