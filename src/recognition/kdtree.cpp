@@ -166,6 +166,18 @@ void sort_keys(std::vector<uint64_t>& keys) {
   }
   thread_local std::vector<uint64_t> tmp;
   tmp.resize(keys.size());
+  // Packed: the high words less their minimum, shifted down onto the low
+  // words' width (keys order as (high, low), and low < 2^width), so the
+  // digits to sort span the bits that vary (a distance's 20-odd and an
+  // index's 15-odd: four passes of 11 bits instead of six). Unpacked after.
+  uint32_t hi_min = ~uint32_t(0), lo_max = 0;
+  for (uint64_t k : keys) {
+    hi_min = std::min(hi_min, static_cast<uint32_t>(k >> 32));
+    lo_max = std::max(lo_max, static_cast<uint32_t>(k));
+  }
+  int width = 0;
+  while (width < 32 && (lo_max >> width) != 0) ++width;
+  for (uint64_t& k : keys) k = ((k >> 32) - hi_min) << width | (k & 0xffffffffull);
   uint64_t all_or = 0, all_and = ~uint64_t(0);
   for (uint64_t k : keys) {
     all_or |= k;
@@ -189,6 +201,8 @@ void sort_keys(std::vector<uint64_t>& keys) {
     for (uint64_t k : keys) tmp[count[(k >> shift) & mask]++] = k;
     keys.swap(tmp);
   }
+  const uint64_t low_mask = width == 0 ? 0 : (~uint64_t(0) >> (64 - width));
+  for (uint64_t& k : keys) k = ((k >> width) + hi_min) << 32 | (k & low_mask);
 }
 
 }  // namespace

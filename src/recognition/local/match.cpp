@@ -145,7 +145,13 @@ inline size_t first_argmin(const float* v, size_t n) {
   for (const float l : lanes) m = std::min(m, l);
 #endif
   for (; r < n; ++r) m = std::min(m, v[r]);
-  for (size_t i = 0; i < n; ++i)
+  size_t i = 0;
+#ifdef __SSE2__
+  const __m128 m4 = _mm_set1_ps(m);
+  for (; i + 4 <= n; i += 4)
+    if (_mm_movemask_ps(_mm_cmpeq_ps(_mm_loadu_ps(v + i), m4)) != 0) break;  // the first equal is in v[i..i+4)
+#endif
+  for (; i < n; ++i)
     if (v[i] == m) return i;
   size_t arg = 0;  // no finite value equals the minimum (NaN or infinity): the plain scan
   for (size_t i = 1; i < n; ++i)
@@ -168,6 +174,44 @@ inline void append_at_most(const float* v, size_t n, float limit, std::vector<st
 #endif
   for (; r < n; ++r)
     if (v[r] <= limit) out.emplace_back(v[r], static_cast<int>(r));
+}
+
+// The `cap` smallest (v[r], r) pairs (value, then index) among those with
+// v[r] <= limit, in any order: what taking every such pair and keeping the
+// cap smallest with nth_element gives, without building the full list (a
+// noisy query has thousands of rows under its limit). A max-heap of the cap
+// best so far; a value is offered only when it is below the heap's top
+// (rows arrive ascending, so an equal value loses to the row already kept),
+// found four at a time by SSE.
+inline void smallest_at_most(const float* v, size_t n, float limit, size_t cap,
+                             std::vector<std::pair<float, int>>& heap) {
+  heap.clear();
+  if (cap == 0) return;
+  const auto offer_row = [&](size_t r) {
+    const std::pair<float, int> e(v[r], static_cast<int>(r));
+    if (!(e.first <= limit)) return;  // NaN too
+    if (heap.size() < cap) {
+      heap.push_back(e);
+      std::push_heap(heap.begin(), heap.end());
+    } else if (e < heap.front()) {
+      std::pop_heap(heap.begin(), heap.end());
+      heap.back() = e;
+      std::push_heap(heap.begin(), heap.end());
+    }
+  };
+  size_t r = 0;
+#ifdef __SSE2__
+  for (; r + 4 <= n; r += 4) {
+    // Below the bar: at most the limit while the heap fills, then below its top.
+    const __m128 x = _mm_loadu_ps(v + r);
+    const int mask = heap.size() < cap ? _mm_movemask_ps(_mm_cmple_ps(x, _mm_set1_ps(limit)))
+                                       : _mm_movemask_ps(_mm_cmple_ps(x, _mm_set1_ps(heap.front().first)));
+    if (mask == 0) continue;
+    for (int k = 0; k < 4; ++k)
+      if (mask & (1 << k)) offer_row(r + static_cast<size_t>(k));
+  }
+#endif
+  for (; r < n; ++r) offer_row(r);
 }
 
 // Keeps the kk smallest (distance, then row) of the candidates offered, in
@@ -234,11 +278,10 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
     const float limit = std::min(tau0, max_sq_dist) + margin;
     // Second pass: the candidates, measured in the order of their bounds.
     cand.clear();
-    append_at_most(lbs, m.rows, limit, cand);
-    if (max_checks > 0 && cand.size() > static_cast<size_t>(max_checks)) {  // approximate: the lowest bounds
-      std::nth_element(cand.begin(), cand.begin() + max_checks, cand.end());
-      cand.resize(static_cast<size_t>(max_checks));
-    }
+    if (max_checks > 0)  // approximate: the lowest bounds
+      smallest_at_most(lbs, m.rows, limit, static_cast<size_t>(max_checks), cand);
+    else
+      append_at_most(lbs, m.rows, limit, cand);
     std::sort(cand.begin(), cand.end());
     best.clear();
     measured.clear();
