@@ -138,6 +138,37 @@ TEST(DescriptorIndex, CappedChecksAreExactUntilTheCapBindsAndKeepAHighRecall) {
 
 
 
+// The capped search's candidates: the cap smallest (value, index) pairs
+// under the limit, the same set as listing every pair under it and keeping
+// the cap smallest with nth_element (the way before), with ties, NaN and
+// lengths that are not a multiple of four.
+TEST(DescriptorIndex, SmallestAtMostEqualsListingThenNthElement) {
+  pb::Rng rng(5);
+  for (int trial = 0; trial < 200; ++trial) {
+    const size_t n = static_cast<size_t>(rng.uniform_int(0, 3001));
+    std::vector<float> v(n);
+    for (float& x : v) {
+      const double u = rng.uniform();
+      x = u < 0.02 ? std::numeric_limits<float>::quiet_NaN()
+                   : static_cast<float>(u < 0.3 ? rng.uniform_int(0, 20) : rng.uniform(0, 20));  // many ties
+    }
+    const float limit = static_cast<float>(rng.uniform(0, 25));
+    const size_t cap = static_cast<size_t>(rng.uniform_int(0, 100));
+    std::vector<std::pair<float, int>> want;
+    for (size_t r = 0; r < n; ++r)
+      if (v[r] <= limit) want.emplace_back(v[r], static_cast<int>(r));
+    if (want.size() > cap) {
+      std::nth_element(want.begin(), want.begin() + static_cast<long>(cap), want.end());
+      want.resize(cap);
+    }
+    std::vector<std::pair<float, int>> got;
+    pb::local::smallest_at_most(v.data(), n, limit, cap, got);
+    std::sort(want.begin(), want.end());
+    std::sort(got.begin(), got.end());
+    ASSERT_EQ(got, want) << "trial " << trial << ": n " << n << " cap " << cap << " limit " << limit;
+  }
+}
+
 // FPFH-sized rows (33: the lower bound from 32 of the 33 principal axes):
 // the blocked search equals the exact scan bit for bit, duplicate rows
 // (ties: the lower row) included, and the search bounded by the threshold

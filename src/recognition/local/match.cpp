@@ -176,6 +176,21 @@ inline void append_at_most(const float* v, size_t n, float limit, std::vector<st
     if (v[r] <= limit) out.emplace_back(v[r], static_cast<int>(r));
 }
 
+// Keeps the kk smallest (distance, then row) of the candidates offered, in
+// ascending order; rows arrive ascending, so equal distances keep the lower row.
+inline void offer(std::vector<std::pair<int, float>>& out, size_t kk, int row, float s) {
+  if (out.size() == kk) {
+    if (!(s < out.back().second)) return;
+    out.pop_back();
+  }
+  const std::pair<int, float> e(row, s);
+  out.insert(std::upper_bound(out.begin(), out.end(), e,
+                              [](const auto& a, const auto& b) { return a.second < b.second; }),
+             e);
+}
+
+}  // namespace
+
 // The `cap` smallest (v[r], r) pairs (value, then index) among those with
 // v[r] <= limit, in any order: what taking every such pair and keeping the
 // cap smallest with nth_element gives, without building the full list (a
@@ -183,7 +198,7 @@ inline void append_at_most(const float* v, size_t n, float limit, std::vector<st
 // best so far; a value is offered only when it is below the heap's top
 // (rows arrive ascending, so an equal value loses to the row already kept),
 // found four at a time by SSE.
-inline void smallest_at_most(const float* v, size_t n, float limit, size_t cap,
+void smallest_at_most(const float* v, size_t n, float limit, size_t cap,
                              std::vector<std::pair<float, int>>& heap) {
   heap.clear();
   if (cap == 0) return;
@@ -213,21 +228,6 @@ inline void smallest_at_most(const float* v, size_t n, float limit, size_t cap,
 #endif
   for (; r < n; ++r) offer_row(r);
 }
-
-// Keeps the kk smallest (distance, then row) of the candidates offered, in
-// ascending order; rows arrive ascending, so equal distances keep the lower row.
-inline void offer(std::vector<std::pair<int, float>>& out, size_t kk, int row, float s) {
-  if (out.size() == kk) {
-    if (!(s < out.back().second)) return;
-    out.pop_back();
-  }
-  const std::pair<int, float> e(row, s);
-  out.insert(std::upper_bound(out.begin(), out.end(), e,
-                              [](const auto& a, const auto& b) { return a.second < b.second; }),
-             e);
-}
-
-}  // namespace
 
 void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq_dist,
                                 std::vector<std::pair<int, float>>* out, int max_checks) const {
