@@ -216,14 +216,15 @@ void smallest_at_most(const float* v, size_t n, float limit, size_t cap,
   };
   size_t r = 0;
 #ifdef __SSE2__
+  // Below the bar: at most the limit while the heap fills, then at most its
+  // top (re-read only when the heap changes).
+  __m128 bar = _mm_set1_ps(limit);
   for (; r + 4 <= n; r += 4) {
-    // Below the bar: at most the limit while the heap fills, then below its top.
-    const __m128 x = _mm_loadu_ps(v + r);
-    const int mask = heap.size() < cap ? _mm_movemask_ps(_mm_cmple_ps(x, _mm_set1_ps(limit)))
-                                       : _mm_movemask_ps(_mm_cmple_ps(x, _mm_set1_ps(heap.front().first)));
+    const int mask = _mm_movemask_ps(_mm_cmple_ps(_mm_loadu_ps(v + r), bar));
     if (mask == 0) continue;
     for (int k = 0; k < 4; ++k)
       if (mask & (1 << k)) offer_row(r + static_cast<size_t>(k));
+    if (heap.size() == cap) bar = _mm_set1_ps(heap.front().first);
   }
 #endif
   for (; r < n; ++r) offer_row(r);
