@@ -17,10 +17,11 @@
 //
 // Why no kd-tree: for SHOT one visits nearly every leaf (measured: no faster
 // than a linear scan). FPFH used FLANN's single kd-tree (the index
-// pcl::KdTreeFLANN builds) until it measured slower than this scan: 2 to 3
-// times on Figure 4.11's noisy table frames, where a query far from every
-// model descriptor visits most leaves, and about as fast or slower on clean
-// frames (results/bench/README.md, twelfth round). The kd-tree also broke
+// pcl::KdTreeFLANN builds) until it measured slower than this scan: 3 times
+// on Figure 4.11's noisy table frames, where a query far from every model
+// descriptor visits most leaves, 1.3 times on its warehouse frames and 1.8
+// times on bench_local's table image (results/bench/README.md, twelfth
+// round). The kd-tree also broke
 // exact ties by its own traversal order: training views can hold identical
 // descriptors (seen: equal distances to rows 424 or 848 apart on Table 4.1's
 // Astra images), and a scene keypoint matched whichever of them the tree met
