@@ -166,10 +166,10 @@ void sort_keys(std::vector<uint64_t>& keys) {
   }
   thread_local std::vector<uint64_t> tmp;
   tmp.resize(keys.size());
-  // Packed: the high words less their minimum, shifted down onto the low
-  // words' width (keys order as (high, low), and low < 2^width), so the
-  // digits to sort span the bits that vary (a distance's 20-odd and an
-  // index's 15-odd: four passes of 11 bits instead of six). Unpacked after.
+  // Packed: the high words (distances) less their minimum, shifted down onto
+  // the low words' (indices') width; the order is the same (keys order as
+  // (high, low), and low < 2^width). The bits that vary then lie next to one
+  // another, so fewer 11-bit digits need a pass. Unpacked after.
   uint32_t hi_min = ~uint32_t(0), lo_max = 0;
   for (uint64_t k : keys) {
     hi_min = std::min(hi_min, static_cast<uint32_t>(k >> 32));

@@ -21,11 +21,10 @@
 // on Figure 4.11's noisy table frames, where a query far from every model
 // descriptor visits most leaves, 1.3 times on its warehouse frames and 1.8
 // times on bench_local's table image (results/bench/README.md, twelfth
-// round). The kd-tree also broke
-// exact ties by its own traversal order: training views can hold identical
-// descriptors (seen: equal distances to rows 424 or 848 apart on Table 4.1's
-// Astra images), and a scene keypoint matched whichever of them the tree met
-// first; here the lowest row wins.
+// round). The kd-tree also broke exact ties by its own traversal order:
+// training views can hold identical descriptors (seen: equal distances to
+// rows 424 or 848 apart on Table 4.1's Astra images), and a scene keypoint
+// matched whichever of them the tree met first; here the lowest row wins.
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -200,7 +199,7 @@ inline void offer(std::vector<std::pair<int, float>>& out, size_t kk, int row, f
 // (rows arrive ascending, so an equal value loses to the row already kept),
 // found four at a time by SSE.
 void smallest_at_most(const float* v, size_t n, float limit, size_t cap,
-                             std::vector<std::pair<float, int>>& heap) {
+                      std::vector<std::pair<float, int>>& heap) {
   heap.clear();
   if (cap == 0) return;
   const auto offer_row = [&](size_t r) {
