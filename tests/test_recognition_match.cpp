@@ -1,10 +1,11 @@
 // The descriptor index's blocked search (a projected lower bound, then exact
 // distances) against its exact linear scan (knn, one query at a time), on
-// SHOT-sized descriptors: clustered rows, exact duplicate rows (ties), noisy
-// copies of rows and unrelated queries, for several k and thresholds. The
-// results must be equal bit for bit: rows, order and distances. The
-// approximate search (max_checks) against the same scan: exact when the cap
-// cannot bind, a recall it must reach when it does.
+// SHOT-sized descriptors (clustered rows, exact duplicate rows (ties), noisy
+// copies of rows and unrelated queries) and FPFH-sized ones, for several k
+// and thresholds. The results must be equal bit for bit: rows, order and
+// distances. The approximate search (max_checks) against the same scan:
+// exact when the cap cannot bind, a recall it must reach when it does; its
+// candidate selection against the listing it replaced.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -4,8 +4,8 @@
 //   keypoints.cpp  keypoints (the shared voxel grid, PCL-free)
 //   fpfh.cpp       FPFH (our own, on KdTree3; fpfh_pcl.cpp: PCL's, the reference)
 //   shot.cpp       SHOT (our own, on KdTree3; shot_pcl.cpp: PCL's, the reference)
-//   match.cpp      exact descriptor search (FLANN kd-tree for FPFH, a
-//                  projected lower bound for SHOT)
+//   match.cpp      descriptor search: a scan with a projected lower bound
+//                  (exact for FPFH, SHOT capped by match_max_checks)
 //   board.cpp      BOARD reference frames (our own; board_pcl.cpp: PCL's, the reference)
 //   hough.cpp      pcl::Hough3DGrouping
 //   method.cpp     the Method (train, save/load, hypothesize)

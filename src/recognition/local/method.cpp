@@ -1,8 +1,9 @@
 // The local pipeline as a Method (THESIS.md "Local pipeline"): keypoints by a
-// second voxel grid, FPFH or SHOT descriptors, kd-tree matching against the
-// descriptors of every training view, 3D Hough voting per training view with
-// BOARD reference frames, a Procrustes (SVD) pose per cluster. PCL-free: the
-// PCL parts live in local_{fpfh,shot,match,hough}.cpp.
+// second voxel grid, FPFH or SHOT descriptors, nearest-descriptor matching
+// against the descriptors of every training view, 3D Hough voting per
+// training view with BOARD reference frames, a Procrustes (SVD) pose per
+// cluster. PCL-free: the building blocks are in the other files of this
+// folder (internal.h lists them).
 #include <Eigen/Geometry>
 #ifdef _OPENMP
 #include <omp.h>
