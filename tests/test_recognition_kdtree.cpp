@@ -131,33 +131,4 @@ TEST(KdTree3, LongNeighbourhoodsAreSortedByDistanceThenIndex) {
   }
 }
 
-// sort_by_distance is std::sort of the pairs, short lists and long (radix)
-// ones alike: ties in distance (zero included) broken by index, indices up
-// to INT_MAX, distances from subnormal to huge.
-TEST(SortByDistance, EqualsStdSortOfThePairs) {
-  pb::Rng rng(5);
-  for (size_t n : {0u, 1u, 2u, 7u, 255u, 256u, 511u, 512u, 513u, 3000u, 70000u}) {
-    std::vector<std::pair<float, int>> v;
-    std::vector<int> idx(n);
-    for (size_t i = 0; i < n; ++i) idx[i] = static_cast<int>(i) * 3;  // distinct
-    if (n > 1) idx.back() = std::numeric_limits<int>::max();
-    for (size_t i = 0; i < n; ++i) {
-      float d;
-      switch (rng.uniform_int(0, 4)) {
-        case 0: d = 0.f; break;
-        case 1: d = static_cast<float>(rng.uniform_int(0, 9)); break;  // many ties
-        case 2: d = std::numeric_limits<float>::denorm_min() * static_cast<float>(rng.uniform_int(1, 50)); break;
-        case 3: d = static_cast<float>(rng.uniform(0, 1e30)); break;
-        default: d = static_cast<float>(rng.uniform(0, 2500)); break;
-      }
-      v.emplace_back(d, idx[i]);
-    }
-    std::shuffle(v.begin(), v.end(), rng);
-    std::vector<std::pair<float, int>> want = v;
-    std::sort(want.begin(), want.end());
-    pb::sort_by_distance(v);
-    EXPECT_EQ(v, want) << n << " pairs";
-  }
-}
-
 }  // namespace

@@ -152,7 +152,7 @@ void KdTree3::radius(const Vec3f& q, float r, std::vector<int>& out) const {
   std::vector<std::pair<float, int>> found;
   auto add = [&found](float d, int i) { found.emplace_back(d, i); };
   visit_radius(0, q, r * r, add);
-  sort_by_distance(found);
+  std::sort(found.begin(), found.end());
   out.reserve(found.size());
   for (const auto& f : found) out.push_back(f.second);
 }
@@ -212,34 +212,37 @@ void sort_keys(std::vector<uint64_t>& keys) {
 
 }  // namespace
 
-void sort_by_distance(std::vector<std::pair<float, int>>& v) {
-  // One 64-bit key per pair: a squared distance is a non-negative float,
-  // whose bits order as the values do, so the key order is the pair order
-  // (one integer compare instead of two float ones, and long lists radix
-  // sorted).
-  thread_local std::vector<uint64_t> keys;
-  keys.resize(v.size());
-  for (size_t i = 0; i < v.size(); ++i) {
-    uint32_t bits;
-    std::memcpy(&bits, &v[i].first, sizeof bits);
-    keys[i] = (static_cast<uint64_t>(bits) << 32) | static_cast<uint32_t>(v[i].second);
-  }
-  sort_keys(keys);
-  for (size_t i = 0; i < v.size(); ++i) {
-    const uint32_t bits = static_cast<uint32_t>(keys[i] >> 32);
-    std::memcpy(&v[i].first, &bits, sizeof bits);
-    v[i].second = static_cast<int>(keys[i] & 0xffffffffu);
-  }
-}
-
 void KdTree3::within(const Vec3f& q, float max_sq_dist, std::vector<std::pair<float, int>>& out, bool sorted) const {
   out.clear();
   if (nodes_.empty() || !q.allFinite() || !(max_sq_dist > 0)) return;
-  auto add = [&out, max_sq_dist](float d, int i) {
-    if (d < max_sq_dist) out.emplace_back(d, i);
+  if (!sorted) {
+    auto add = [&out, max_sq_dist](float d, int i) {
+      if (d < max_sq_dist) out.emplace_back(d, i);
+    };
+    visit_radius(0, q, max_sq_dist, add);
+    return;
+  }
+  // Sorted by (distance, index) as one 64-bit key each: a squared distance
+  // is a non-negative float, whose bits order as the values do, so the key
+  // order is the pair order (one integer compare instead of two float ones).
+  thread_local std::vector<uint64_t> keys;
+  keys.clear();
+  auto add = [max_sq_dist](float d, int i) {
+    if (d < max_sq_dist) {
+      uint32_t bits;
+      std::memcpy(&bits, &d, sizeof bits);
+      keys.push_back((static_cast<uint64_t>(bits) << 32) | static_cast<uint32_t>(i));
+    }
   };
   visit_radius(0, q, max_sq_dist, add);
-  if (sorted) sort_by_distance(out);
+  sort_keys(keys);
+  out.reserve(keys.size());
+  for (uint64_t k : keys) {
+    const uint32_t bits = static_cast<uint32_t>(k >> 32);
+    float d;
+    std::memcpy(&d, &bits, sizeof d);
+    out.emplace_back(d, static_cast<int>(k & 0xffffffffu));
+  }
 }
 
 void KdTree3::radius_unsorted(const Vec3f& q, float r, std::vector<int>& out) const {

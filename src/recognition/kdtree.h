@@ -63,11 +63,6 @@ class KdTree3 {
   std::vector<Node> nodes_;
 };
 
-// Sorts (squared distance, index) pairs by distance, then index, as
-// std::sort on the pairs would (distances >= 0 and indices >= 0, the pairs
-// distinct); faster: packed into 64-bit keys, radix sorted when long.
-void sort_by_distance(std::vector<std::pair<float, int>>& v);
-
 // Thins a neighbour list to at most `max_points` entries evenly spaced in
 // its order (entry floor(i * n / max_points) for i < max_points): in order
 // of distance a sample even in rank, in tree order a spatially stratified

@@ -44,7 +44,7 @@ size_t CloudNeighbours::within(const Vec3f& q, float r2, std::vector<std::pair<f
   if (thin) {
     keep_evenly(out, max_points);
     // (squared distance, tree index) pairs order as the kd-tree's sorted keys
-    if (sorted) sort_by_distance(out);
+    if (sorted) std::sort(out.begin(), out.end());
   }
   // tree index -> cloud index keeps the order (finite_points keeps it)
   for (auto& e : out) e.second = cloud_index_[static_cast<size_t>(e.second)];
