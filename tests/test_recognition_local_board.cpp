@@ -11,9 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 
-#include "core/hash.h"
 #include "core/random.h"
 #include "core/rotation.h"
 #include "recognition/local/internal.h"
@@ -104,65 +102,6 @@ TEST(LocalBoard, DeterministicStartAxisIsRepeatableAndMovesWithTheSurface) {
   }
   ASSERT_GT(interior, 20u);
   EXPECT_GE(moved_with, interior * 95 / 100);
-}
-
-// The frames bit for bit as the implementation that computed every margin
-// point's angle (an acos each) computed them, before the sectors and the
-// extremes came from margin keys: a smooth noisy surface (holes at its
-// border) and the same surface made a noisy slab with random normals (full
-// margins, many points per sector), radii from about 10 to about 300
-// neighbours (on this toolchain: x86-64 without FMA contraction, glibc's
-// acosf).
-TEST(LocalBoard, SectorsFromTheKeyEqualThoseFromEveryAngle) {
-  PointSet slab = noisy_surface(8);
-  Rng rng(9);
-  for (size_t i = 0; i < slab.size(); ++i) {
-    slab.points[i].z() += static_cast<float>(rng.normal(0, 20));
-    slab.normals[i] = Vec3(rng.normal(), rng.normal(), rng.normal() - 2).normalized().cast<float>();
-  }
-  std::string bytes;
-  size_t frames = 0;
-  const PointSet surface = noisy_surface(4);
-  for (const PointSet* cloud : {&surface, static_cast<const PointSet*>(&slab)})
-    for (double radius : {8.0, 14.0, 40.0}) {
-      const std::vector<float> f = local::compute_board_lrf(*cloud, every_nth(cloud->size(), 5), radius);
-      for (size_t r = 0; r * 9 < f.size(); ++r) frames += local::finite_row(f.data() + r * 9, 9);
-      bytes.append(reinterpret_cast<const char*>(f.data()), f.size() * sizeof(float));
-    }
-  EXPECT_GT(frames, 1500u);
-  EXPECT_EQ(hash_hex(bytes), "f8b1ff6d4f057368");
-}
-
-// The premise of the margin keys: std::acos(float) never rises with its
-// argument on [-1, 1] (every 97th float checked here; all of them once, by
-// hand, with glibc 2.36) and acos(-1) is pi as a float.
-TEST(LocalBoard, FloatAcosNeverRisesOnItsDomain) {
-  EXPECT_EQ(std::acos(-1.0f), static_cast<float>(M_PI));
-  // The floats from -1 to 1 in order: -1 .. -0 by falling bit patterns, then
-  // +0 .. 1 by rising ones.
-  const auto at = [](int64_t i) {
-    const uint32_t neg = 0xbf800000u - 0x80000000u;  // -1's pattern less -0's
-    const uint32_t bits = i <= neg ? 0xbf800000u - static_cast<uint32_t>(i) : static_cast<uint32_t>(i - neg - 1);
-    float f;
-    std::memcpy(&f, &bits, sizeof f);
-    return f;
-  };
-  const int64_t last = int64_t(0xbf800000u - 0x80000000u) + 1 + 0x3f800000;
-  EXPECT_EQ(at(0), -1.0f);
-  EXPECT_EQ(at(last), 1.0f);
-  float prev = std::acos(-1.0f), prev_x = -1.0f;
-  size_t rises = 0, checked = 0;
-  for (int64_t i = 97; i <= last + 96; i += 97) {
-    const float x = at(std::min(i, last));
-    ASSERT_LT(prev_x, x);
-    const float a = std::acos(x);
-    rises += a > prev;
-    prev = a;
-    prev_x = x;
-    ++checked;
-  }
-  EXPECT_EQ(rises, 0u);
-  EXPECT_GT(checked, 20000000u);
 }
 
 }  // namespace

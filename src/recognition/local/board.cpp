@@ -17,12 +17,6 @@
 //     of the circle and whose bordering normals are steep enough (> 0.1)
 //     turns x into the hole, between its borders weighted by their normals;
 //   - y = z x x.
-// A margin point's angle about z (an acos) is needed only where it may be
-// its sector's smallest or largest: the sector and the comparisons come from
-// an integer key that orders the points as their angles do (MarginKey), and
-// the angle is computed only for a point whose key passes its sector's
-// extreme so far; the same sectors, extremes and frames as taking every
-// angle (test LocalBoard.SectorsFromTheKeyEqualThoseFromEveryAngle).
 // Differences from PCL: the plane normal comes from the 3x3 covariance (an
 // eigenvector, in double) instead of an SVD of the centred points (the same
 // vector up to rounding and sign, and the sign is then set by the normals);
@@ -33,9 +27,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdint>
 #include <cstdlib>
-#include <cstring>
 #include <limits>
 
 #include "recognition/local/internal.h"
@@ -59,117 +51,11 @@ Vec3f tangent_direction(const Vec3f& axis, const Vec3f& origin, const Vec3f& p) 
   return (projected - origin).normalized();
 }
 
-// The angle from unit vector a to unit vector b about `axis`, in [0, 2 pi),
-// from c = a.b (clamped to [-1, 1]) and whether a x b points against axis.
-float angle_of(float c, bool against) {
-  const float angle = std::acos(c);
-  return against ? kTwoPi - angle : angle;
+// The angle from unit vector a to unit vector b about `axis`, in [0, 2 pi).
+float angle_about(const Vec3f& a, const Vec3f& b, const Vec3f& axis) {
+  const float angle = std::acos(std::clamp(a.dot(b), -1.0f, 1.0f));
+  return a.cross(b).dot(axis) < 0.f ? kTwoPi - angle : angle;
 }
-
-// The sector (0..kSectors-1) of an angle in [0, 2 pi].
-int sector_of(float angle) {
-  return std::min(static_cast<int>(std::floor(angle / (kTwoPi / kSectors))), kSectors - 1);
-}
-
-// An integer that orders margin points as their angles about z do, without
-// the acos: for a x b along axis (angle acos(c) in [0, pi], falling with c)
-// 2^32 - 1 less c's order code, against it (2 pi - acos(c) in [pi, 2 pi],
-// rising with c) 2^32 plus the code. A smaller key never has a larger angle
-// and equal keys have equal angles, because std::acos(float) never rises
-// with its argument on [-1, 1] (checked for every float there with glibc
-// 2.36, and on a stride of them by the test) and acos(-1) is pi as a float.
-// The code of c: its bits, ordered as the values are.
-int64_t margin_key(float c, bool against) {
-  uint32_t bits;
-  std::memcpy(&bits, &c, sizeof bits);
-  const uint32_t code = (bits & 0x80000000u) ? ~bits : bits | 0x80000000u;
-  return against ? (int64_t(1) << 32) + code : int64_t(0xffffffffu) - code;
-}
-
-// The inverse of margin_key: (c, against) of a key.
-void key_value(int64_t key, float* c, bool* against) {
-  *against = key >= (int64_t(1) << 32);
-  const uint32_t code = static_cast<uint32_t>(*against ? key - (int64_t(1) << 32) : int64_t(0xffffffffu) - key);
-  const uint32_t bits = (code & 0x80000000u) ? code & 0x7fffffffu : ~code;
-  std::memcpy(c, &bits, sizeof bits);
-}
-
-// The keys where the sector changes: first[k] is the smallest key of a c
-// in [-1, 1] whose angle lies in sector k or later (a binary search over the
-// keys, each judged by its angle as sector_of computes it). The sector of a
-// key: how many of first[1..] it reaches.
-struct SectorBounds {
-  std::array<int64_t, kSectors> first{};
-  SectorBounds() {
-    const int64_t lo = margin_key(1.0f, false), hi = margin_key(1.0f, true);  // angle 0 .. 2 pi
-    for (int k = 1; k < kSectors; ++k) {
-      int64_t a = lo, b = hi + 1;  // the answer lies in (a, b]
-      while (b - a > 1) {
-        const int64_t m = a + (b - a) / 2;
-        float c;
-        bool against;
-        key_value(m, &c, &against);
-        // Between the keys of c = 1 along and c = 1 against, the only c
-        // outside [-1, 1] are below -1 (both sides): keys between those of
-        // c = -1 along and c = -1 against, both at angle pi.
-        const bool valid = c >= -1.0f && c <= 1.0f;
-        const float angle = valid ? angle_of(c, against) : angle_of(-1.0f, false);
-        if (sector_of(angle) >= k) b = m; else a = m;
-      }
-      first[static_cast<size_t>(k)] = b;
-    }
-  }
-  int sector(int64_t key) const {
-    return static_cast<int>(std::upper_bound(first.begin() + 1, first.end(), key) - (first.begin() + 1));
-  }
-};
-
-const SectorBounds& sector_bounds() {
-  static const SectorBounds b;
-  return b;
-}
-
-// Per sector: whether a margin point falls in it, and the smallest and
-// largest angle there with the normal cosine of the point at each (the
-// first point reaching it: strict comparisons). The keys of the points
-// holding them spare the acos of a point that cannot pass them.
-struct Sectors {
-  std::array<bool, kSectors> hit{};
-  std::array<float, kSectors> min_angle, max_angle, min_cos, max_cos;
-  std::array<int64_t, kSectors> min_key, max_key;
-  Sectors() {
-    min_angle.fill(std::numeric_limits<float>::max());
-    max_angle.fill(-std::numeric_limits<float>::max());
-    min_cos.fill(-1.0f);
-    max_cos.fill(-1.0f);
-    min_key.fill(std::numeric_limits<int64_t>::max());
-    max_key.fill(std::numeric_limits<int64_t>::min());
-  }
-  // A margin point at c = a.b (clamped) and side `against` (see angle_of),
-  // with normal cosine normal_cos.
-  void add(float c, bool against, float normal_cos) {
-    if (!(c >= -1.0f && c <= 1.0f)) return;  // NaN (a degenerate frame): no sector
-    const int64_t key = margin_key(c, against);
-    const size_t s = static_cast<size_t>(sector_bounds().sector(key));
-    hit[s] = true;
-    if (key < min_key[s]) {  // a larger or equal key has an angle at least the minimum's
-      const float angle = angle_of(c, against);
-      if (angle < min_angle[s]) {
-        min_angle[s] = angle;
-        min_cos[s] = normal_cos;
-        min_key[s] = key;
-      }
-    }
-    if (key > max_key[s]) {
-      const float angle = angle_of(c, against);
-      if (angle > max_angle[s]) {
-        max_angle[s] = angle;
-        max_cos[s] = normal_cos;
-        max_key[s] = key;
-      }
-    }
-  }
-};
 
 // A unit axis orthogonal to z: deterministic, or std::rand()'s as PCL draws
 // it (two coordinates uniform in [-1, 1], the third solved for).
@@ -191,6 +77,31 @@ Vec3f start_axis(const Vec3f& z, BoardStartAxis how) {
   }
   return a.normalized();
 }
+
+// Per sector: whether a margin point falls in it, and the smallest and
+// largest angle there with the normal cosine of the point at each.
+struct Sectors {
+  std::array<bool, kSectors> hit{};
+  std::array<float, kSectors> min_angle, max_angle, min_cos, max_cos;
+  Sectors() {
+    min_angle.fill(std::numeric_limits<float>::max());
+    max_angle.fill(-std::numeric_limits<float>::max());
+    min_cos.fill(-1.0f);
+    max_cos.fill(-1.0f);
+  }
+  void add(float angle, float normal_cos) {
+    const int s = std::min(static_cast<int>(std::floor(angle / (kTwoPi / kSectors))), kSectors - 1);
+    hit[static_cast<size_t>(s)] = true;
+    if (angle < min_angle[static_cast<size_t>(s)]) {
+      min_angle[static_cast<size_t>(s)] = angle;
+      min_cos[static_cast<size_t>(s)] = normal_cos;
+    }
+    if (angle > max_angle[static_cast<size_t>(s)]) {
+      max_angle[static_cast<size_t>(s)] = angle;
+      max_cos[static_cast<size_t>(s)] = normal_cos;
+    }
+  }
+};
 
 // The angle (from the start axis) of the widest qualifying hole, or false
 // when there is none. Runs of empty sectors are scanned from the first
@@ -248,8 +159,7 @@ bool board_frame(const Vec3f& q, const PointSet& cloud, const Neighbours& nn, Bo
       min_cos = c;
       steepest = i;
     }
-    const Vec3f dir = tangent_direction(z, q, cloud.points[static_cast<size_t>(i)]);
-    sectors.add(std::clamp(x0.dot(dir), -1.0f, 1.0f), x0.cross(dir).dot(z) < 0.f, c);
+    sectors.add(angle_about(x0, tangent_direction(z, q, cloud.points[static_cast<size_t>(i)]), z), c);
   }
   Vec3f x;
   float hole = 0;
