@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "core/hash.h"
 #include "core/random.h"
 #include "core/rotation.h"
 #include "recognition/local/internal.h"
@@ -102,6 +103,34 @@ TEST(LocalBoard, DeterministicStartAxisIsRepeatableAndMovesWithTheSurface) {
   }
   ASSERT_GT(interior, 20u);
   EXPECT_GE(moved_with, interior * 95 / 100);
+}
+
+// The frames bit for bit, as a fingerprint: a smooth noisy surface (holes at
+// its border) and the same surface made a noisy slab with random normals
+// (full margins, many points per sector), radii from about 10 to about 300
+// neighbours. A faster BOARD must keep it (on this toolchain: x86-64 without
+// FMA contraction, glibc's acosf). Tried in session 20 against it: the
+// sectors and extremes from an integer key ordered as the angles, acos only
+// for a point that may become its sector's extreme; the same bits, but no
+// fewer instructions (results/bench/README.md, thirteenth round).
+TEST(LocalBoard, FramesBitForBitAsFingerprinted) {
+  PointSet slab = noisy_surface(8);
+  Rng rng(9);
+  for (size_t i = 0; i < slab.size(); ++i) {
+    slab.points[i].z() += static_cast<float>(rng.normal(0, 20));
+    slab.normals[i] = Vec3(rng.normal(), rng.normal(), rng.normal() - 2).normalized().cast<float>();
+  }
+  const PointSet surface = noisy_surface(4);
+  std::string bytes;
+  size_t frames = 0;
+  for (const PointSet* cloud : {&surface, static_cast<const PointSet*>(&slab)})
+    for (double radius : {8.0, 14.0, 40.0}) {
+      const std::vector<float> f = local::compute_board_lrf(*cloud, every_nth(cloud->size(), 5), radius);
+      for (size_t r = 0; r * 9 < f.size(); ++r) frames += local::finite_row(f.data() + r * 9, 9);
+      bytes.append(reinterpret_cast<const char*>(f.data()), f.size() * sizeof(float));
+    }
+  EXPECT_GT(frames, 1500u);
+  EXPECT_EQ(hash_hex(bytes), "f8b1ff6d4f057368");
 }
 
 }  // namespace
