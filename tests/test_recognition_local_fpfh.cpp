@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <limits>
 
 #include "core/random.h"
 #include "core/rotation.h"
@@ -73,48 +72,6 @@ TEST(LocalFpfh, ThreadsAndRigidMotionDoNotChangeIt) {
   EXPECT_LT(max_diff, 0.05);
   // A wrong radius is no descriptor at all (not a crash).
   for (float v : local::compute_fpfh(cloud, kp, 0, 1)) EXPECT_TRUE(std::isnan(v));
-}
-
-// f1_bin against binning atan2f's value (PCL's binning): random directions of
-// every scale, the directions of the bin edges and the floats around them,
-// the axes, signed zeros, the +-pi cut, and non-finite arguments.
-TEST(LocalFpfh, F1BinIsTheBinOfAtan2) {
-  const double inv_2pi = static_cast<double>(1.0f / (2.0f * static_cast<float>(M_PI)));
-  const auto want = [&](float y, float x) {
-    const double v = 11 * ((std::atan2(y, x) + M_PI) * inv_2pi);
-    return v >= 0 ? std::min(static_cast<int>(std::floor(v)), 10) : 0;
-  };
-  size_t checked = 0, wrong = 0;
-  const auto check = [&](float y, float x) {
-    ++checked;
-    if (local::f1_bin(y, x) != want(y, x) && ++wrong <= 5)
-      ADD_FAILURE() << "y " << y << " x " << x << ": " << local::f1_bin(y, x) << " vs " << want(y, x);
-  };
-  Rng rng(3);
-  for (int i = 0; i < 2000000; ++i) {
-    const double s = std::pow(10.0, rng.uniform(-30, 30));
-    check(static_cast<float>(rng.normal() * s), static_cast<float>(rng.normal() * s));
-  }
-  // The edges: directions at each bin's lower angle, and the floats around
-  // their coordinates.
-  for (int k = 0; k <= 11; ++k) {
-    const double a = -M_PI + 2 * M_PI * k / 11.0;
-    for (double d : {-1e-6, -1e-7, 0.0, 1e-7, 1e-6}) {
-      const float y0 = static_cast<float>(std::sin(a + d)), x0 = static_cast<float>(std::cos(a + d));
-      float y = y0;
-      for (int j = 0; j < 8; ++j) y = std::nextafter(y, -2.0f);
-      for (int j = 0; j < 17; ++j, y = std::nextafter(y, 2.0f)) {
-        float x = x0;
-        for (int m = 0; m < 8; ++m) x = std::nextafter(x, -2.0f);
-        for (int m = 0; m < 17; ++m, x = std::nextafter(x, 2.0f)) check(y, x);
-      }
-    }
-  }
-  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
-  for (float y : {0.f, -0.f, 1.f, -1.f, 1e-30f, -1e-30f, inf, -inf, nan})
-    for (float x : {0.f, -0.f, 1.f, -1.f, 1e-30f, -1e-30f, inf, -inf, nan}) check(y, x);
-  EXPECT_EQ(wrong, 0u) << "of " << checked;
-  EXPECT_GT(checked, 2000000u);
 }
 
 }  // namespace

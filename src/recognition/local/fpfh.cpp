@@ -45,10 +45,8 @@ constexpr int kBins = 11;  // per angle
 // call (p2, p1) gives bit-identical features (and the same return value):
 // both cosines finite and of different magnitude, so both calls pick the
 // same source point and compute the same frame from exactly negated inputs.
-// f1 is returned as the two arguments of its atan2 (f1 = atan2(f1y, f1x)):
-// only its bin is needed (f1_bin).
-bool pair_features(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2, float& f1y, float& f1x,
-                   float& f2, float& f3, bool* symmetric) {
+bool pair_features(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2, float& f1, float& f2,
+                   float& f3, bool* symmetric) {
   Vec3f d = p2 - p1;
   const float dist = d.norm();
   *symmetric = false;
@@ -69,8 +67,7 @@ bool pair_features(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3
   v /= vn;
   const Vec3f w = u.cross(v);
   f2 = v.dot(target);
-  f1y = w.dot(target);
-  f1x = u.dot(target);
+  f1 = std::atan2(w.dot(target), u.dot(target));
   return true;
 }
 
@@ -80,64 +77,6 @@ inline int bin_of(double x) {
   if (!(x >= 0)) return 0;
   return std::min(static_cast<int>(std::floor(x)), kBins - 1);
 }
-
-const double kInv2Pi = static_cast<double>(1.0f / (2.0f * static_cast<float>(M_PI)));
-
-// The bin of an angle f1 in [-pi, pi] (PCL's: its float value shifted by pi
-// in double).
-inline int angle_bin(double f1) { return bin_of(kBins * ((f1 + M_PI) * kInv2Pi)); }
-
-// atan(a) for a in [0, 1] (Abramowitz and Stegun 4.4.49: error at most 2e-8).
-inline double atan_unit(double a) {
-  const double s = a * a;
-  return a * (1 + s * (-0.3333314528 + s * (0.1999355085 + s * (-0.1420889944 + s * (0.1065626393 +
-             s * (-0.0752896400 + s * (0.0429096138 + s * (-0.0161657367 + s * 0.0028662257))))))));
-}
-
-// edge[k]: the smallest float angle in bin k or above (k = 1 .. kBins-1),
-// found once by bisecting the floats of [-pi, pi] in order.
-struct F1Edges {
-  std::array<float, kBins> edge{};
-  F1Edges() {
-    const float lo = -static_cast<float>(M_PI), hi = static_cast<float>(M_PI);
-    for (int k = 1; k < kBins; ++k) {
-      float a = lo, b = hi;  // angle_bin(a) < k <= angle_bin(b)
-      while (std::nextafter(a, hi) < b) {
-        // The float halfway in order between a and b (both ends of one sign
-        // or a zero between them: the midpoint of values is close enough).
-        float m = a + (b - a) / 2;
-        if (!(m > a && m < b)) m = std::nextafter(a, hi);
-        (angle_bin(m) >= k ? b : a) = m;
-      }
-      edge[static_cast<size_t>(k)] = b;
-    }
-  }
-};
-
-}  // namespace
-
-int f1_bin(float y, float x) {
-  static const F1Edges e;
-  // Away from every bin edge (and from the +-pi cut, where the angle jumps
-  // from bin 0 to the last), by far more than the error of atan2f (a few
-  // 1e-7 rad) and of atan_unit, the bin of the double estimate is atan2f's.
-  constexpr double kMargin = 4e-6;
-  const double ax = std::abs(static_cast<double>(x)), ay = std::abs(static_cast<double>(y));
-  if (ax + ay > 0 && ax + ay < HUGE_VAL) {  // finite and not both zero
-    double r = ay > ax ? M_PI_2 - atan_unit(ax / ay) : atan_unit(ay / ax);
-    if (x < 0) r = M_PI - r;
-    if (r < M_PI - kMargin) {
-      const double angle = y < 0 ? -r : r;
-      const int k = angle_bin(angle);
-      if ((k == 0 || angle - e.edge[static_cast<size_t>(k)] > kMargin) &&
-          (k == kBins - 1 || e.edge[static_cast<size_t>(k + 1)] - angle > kMargin))
-        return k;
-    }
-  }
-  return angle_bin(std::atan2(y, x));
-}
-
-namespace {
 
 using Hist = std::array<float, kFpfhDim>;
 using Counts = std::array<uint32_t, kFpfhDim>;
@@ -151,9 +90,10 @@ inline int thread_num() {
 #endif
 }
 
-// The three bins of a pair's features (f1 as atan2(f1y, f1x)).
-inline void count_pair(float f1y, float f1x, float f2, float f3, uint32_t* c) {
-  ++c[f1_bin(f1y, f1x)];
+// The three bins of a pair's features.
+inline void count_pair(float f1, float f2, float f3, uint32_t* c) {
+  const double inv_2pi = static_cast<double>(1.0f / (2.0f * static_cast<float>(M_PI)));
+  ++c[bin_of(kBins * ((f1 + M_PI) * inv_2pi))];
   ++c[kBins + bin_of(kBins * ((f2 + 1.0) * 0.5))];
   ++c[2 * kBins + bin_of(kBins * ((f3 + 1.0) * 0.5))];
 }
@@ -260,15 +200,15 @@ std::vector<Hist> spfh_histograms(const PointSet& cloud, const CloudNeighbours& 
         int qrow = row_of[static_cast<size_t>(q)];
         if (alone || (qrow >= 0 && thinned[static_cast<size_t>(qrow)])) qrow = -1;  // q counts its own
         if (qrow >= 0 && q < p) continue;  // counted from q
-        float f1y, f1x, f2, f3;
+        float f1, f2, f3;
         bool symmetric = false;
-        if (pair_features(pts[p], cloud.normals[p], pts[q], cloud.normals[q], f1y, f1x, f2, f3, &symmetric)) {
-          count_pair(f1y, f1x, f2, f3, mine[r].data());
-          if (qrow >= 0 && symmetric) count_pair(f1y, f1x, f2, f3, mine[static_cast<size_t>(qrow)].data());
+        if (pair_features(pts[p], cloud.normals[p], pts[q], cloud.normals[q], f1, f2, f3, &symmetric)) {
+          count_pair(f1, f2, f3, mine[r].data());
+          if (qrow >= 0 && symmetric) count_pair(f1, f2, f3, mine[static_cast<size_t>(qrow)].data());
         }
         if (qrow >= 0 && !symmetric &&
-            pair_features(pts[q], cloud.normals[q], pts[p], cloud.normals[p], f1y, f1x, f2, f3, &symmetric))
-          count_pair(f1y, f1x, f2, f3, mine[static_cast<size_t>(qrow)].data());
+            pair_features(pts[q], cloud.normals[q], pts[p], cloud.normals[p], f1, f2, f3, &symmetric))
+          count_pair(f1, f2, f3, mine[static_cast<size_t>(qrow)].data());
       }
     }
   }

@@ -44,10 +44,6 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
                                 double radius_mm, int threads, int max_support = 0);
 std::vector<float> compute_shot(const PointSet& cloud, const std::vector<int>& keypoints,
                                 double radius_mm, int threads, int max_support = 0);
-// The bin (0..10) of FPFH's first pair angle f1 = atan2(y, x), the same as
-// binning the value std::atan2(y, x) gives (fpfh.cpp; atan2 is called only
-// near a bin edge).
-int f1_bin(float y, float x);
 // PCL's FPFHEstimationOMP with the same inputs: the reference of our FPFH
 // (tests and the stock-PCL benchmark only).
 std::vector<float> compute_fpfh_pcl(const PointSet& cloud, const std::vector<int>& keypoints,
