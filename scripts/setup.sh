@@ -7,7 +7,7 @@ cd "$ROOT"
 
 PACKAGES=(build-essential cmake pkg-config ccache libpcl-dev libeigen3-dev libosmesa6-dev
           libassimp-dev nlohmann-json3-dev libyaml-cpp-dev libbenchmark-dev libgtest-dev
-          libpng-dev libcli11-dev libspdlog-dev python3 python3-matplotlib python3-yaml python3-numpy
+          libpng-dev libdeflate-dev libcli11-dev libspdlog-dev python3 python3-matplotlib python3-yaml python3-numpy
           slurm-wlm munge  # a one-node Slurm for the sweep scripts' test (scripts/slurm)
           chromium)        # headless, for the HTML report's rendering test (scripts/html_screenshot.sh)
 missing=()

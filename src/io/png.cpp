@@ -1,9 +1,10 @@
-// PNG through libpng. libpng reports errors with longjmp: every call that
-// can fail runs inside a small C-style function holding the setjmp, with no
-// C++ object created between setjmp and the libpng calls, and the error text
-// is copied to a plain buffer before jumping. The C++ side then throws an
-// InputError naming the file. Images are encoded in memory and written with
-// atomic_write_bytes (temp + rename), so a reader never sees half a PNG.
+// PNG files: read through libpng, written by io/png_write.h. libpng reports
+// errors with longjmp: every call that can fail runs inside a small C-style
+// function holding the setjmp, with no C++ object created between setjmp and
+// the libpng calls, and the error text is copied to a plain buffer before
+// jumping. The C++ side then throws an InputError naming the file. Images are
+// encoded in memory and written with atomic_write_bytes (temp + rename), so a
+// reader never sees half a PNG.
 #include "io/png.h"
 
 #include <png.h>
@@ -17,6 +18,7 @@
 
 #include "core/error.h"
 #include "core/file_lock.h"
+#include "io/png_write.h"
 
 namespace pb {
 
@@ -46,12 +48,6 @@ void mem_read(png_structp png, png_bytep out, png_size_t n) {
   std::memcpy(out, r->data + r->pos, n);
   r->pos += n;
 }
-
-void mem_write(png_structp png, png_bytep in, png_size_t n) {
-  auto* v = static_cast<std::vector<unsigned char>*>(png_get_io_ptr(png));
-  v->insert(v->end(), in, in + n);
-}
-void mem_flush(png_structp) {}
 
 // Raw decoded image: header fields and 8-bit or big-endian 16-bit rows.
 struct Decoded {
@@ -106,37 +102,6 @@ bool decode(const MemReader& src, Decoded* out, PngErr* err) {
   return true;
 }
 
-// Encodes rows into `out`; returns false with err->msg set on error.
-bool encode(std::vector<unsigned char>* out, int width, int height, int bit_depth, int color_type,
-            png_bytep* rows, PngErr* err) {
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, err, on_error, on_warning);
-  if (!png) return fail(err, "cannot create the PNG writer");
-  png_infop info = png_create_info_struct(png);
-  if (!info) {
-    png_destroy_write_struct(&png, nullptr);
-    return fail(err, "cannot create the PNG writer");
-  }
-  if (setjmp(err->jump)) {
-    png_destroy_write_struct(&png, &info);
-    return false;
-  }
-  png_set_write_fn(png, out, mem_write, mem_flush);
-  png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), bit_depth,
-               color_type, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  // Fixed settings: same input, same bytes. No row filter and zlib level 1:
-  // measured on configs/scenes/table_astra.yaml (30 images, 234 PNGs), the
-  // generator went from 19 to 25-30 images/s and the files from 2.6 to 2.9 MB
-  // (libpng's adaptive filter choice and level 6 took a third of its time;
-  // noisy depth gains nothing from the filters).
-  png_set_compression_level(png, 1);
-  png_set_filter(png, 0, PNG_FILTER_NONE);
-  png_write_info(png, info);
-  png_write_image(png, rows);
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  return true;
-}
-
 std::vector<unsigned char> read_all(const std::string& path, const std::string& field) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, field, std::string("cannot open PNG file: ") + std::strerror(errno));
@@ -162,21 +127,22 @@ std::string color_name(int color_type) {
 }
 
 std::vector<unsigned char> encode_png(const std::string& path, int width, int height, int bit_depth, int color_type,
-                                      int channels, const unsigned char* data, const std::string& field) {
+                                      int channels, const unsigned char* data, const std::string& field,
+                                      PngCompression compression = PngCompression::deflate) {
   if (width <= 0 || height <= 0) throw InputError(path, field, "image has no pixels");
   const size_t rowbytes = static_cast<size_t>(width) * channels * (bit_depth / 8);
-  std::vector<png_bytep> rows(height);
-  for (int y = 0; y < height; ++y) rows[y] = const_cast<png_bytep>(data + y * rowbytes);
-  std::vector<unsigned char> out;
-  PngErr err{};
-  if (!encode(&out, width, height, bit_depth, color_type, rows.data(), &err))
-    throw InputError(path, field, std::string("cannot encode PNG: ") + err.msg);
-  return out;
+  try {
+    return encode_png_bytes(static_cast<uint32_t>(width), static_cast<uint32_t>(height), bit_depth, color_type, data,
+                            rowbytes, compression);
+  } catch (const std::exception& e) {
+    throw InputError(path, field, std::string("cannot encode PNG: ") + e.what());
+  }
 }
 
 void write_png(const std::string& path, int width, int height, int bit_depth, int color_type, int channels,
-               const unsigned char* data, const std::string& field) {
-  const auto out = encode_png(path, width, height, bit_depth, color_type, channels, data, field);
+               const unsigned char* data, const std::string& field,
+               PngCompression compression = PngCompression::deflate) {
+  const auto out = encode_png(path, width, height, bit_depth, color_type, channels, data, field, compression);
   atomic_write_bytes(path, out.data(), out.size());
 }
 
@@ -249,7 +215,7 @@ std::vector<uint8_t> read_gray8_png(const std::string& path, int* width, int* he
 void write_gray8_png(const std::string& path, int width, int height, const std::vector<uint8_t>& px) {
   if (px.size() != static_cast<size_t>(width) * height)
     throw InputError(path, "image", "pixel count does not match width x height");
-  write_png(path, width, height, 8, PNG_COLOR_TYPE_GRAY, 1, px.data(), "image");
+  write_png(path, width, height, 8, PNG_COLOR_TYPE_GRAY, 1, px.data(), "image", PngCompression::runs);
 }
 
 void write_rgb8_png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {

@@ -22,6 +22,7 @@ void write_depth_png(const std::string& path, const DepthImage& depth, double de
 // Reads an 8-bit gray PNG (e.g. a BOP mask); InputError(path, "image", ...)
 // for any other format.
 std::vector<uint8_t> read_gray8_png(const std::string& path, int* width, int* height);
+// Written for long runs of one value (masks): larger for noisy content.
 void write_gray8_png(const std::string& path, int width, int height, const std::vector<uint8_t>& px);
 void write_rgb8_png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
 // The same PNG's bytes, in memory (e.g. to embed in an HTML page).

@@ -189,20 +189,59 @@ DepthRenderer::~DepthRenderer() {
   if (impl_ && impl_->ctx) OSMesaDestroyContext(impl_->ctx);
 }
 
-RenderOutput DepthRenderer::render(const std::vector<RenderItem>& items) {
+std::vector<uint64_t> DepthRenderer::rasterize(const std::vector<RenderItem>& items, bool read_depth) {
   const int W = K_.width, H = K_.height;
-  const double n = settings_.near_mm, f = settings_.far_mm;
-  const std::vector<uint64_t> base = face_id_bases(items);
-
+  std::vector<uint64_t> base = face_id_bases(items);
   if (!OSMesaMakeCurrent(impl_->ctx, impl_->color.data(), GL_UNSIGNED_BYTE, W, H))
     throw std::runtime_error("OSMesaMakeCurrent failed");
   ReleaseCurrent release;
-  begin_frame(W, H, projection(K_, n, f));
+  begin_frame(W, H, projection(K_, settings_.near_mm, settings_.far_mm));
   impl_->draw(items, base);
   glFinish();
-  glReadPixels(0, 0, W, H, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, impl_->depth.data());
+  if (read_depth) glReadPixels(0, 0, W, H, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, impl_->depth.data());
   const GLenum err = glGetError();
   if (err != GL_NO_ERROR) throw std::runtime_error("OpenGL error " + std::to_string(err) + " while rendering");
+  return base;
+}
+
+namespace {
+
+// The face id of GL pixel gl of an RGBA id buffer (0 = background).
+inline uint32_t face_id(const uint8_t* col, size_t gl) {
+  return uint32_t(col[4 * gl]) | (uint32_t(col[4 * gl + 1]) << 8) | (uint32_t(col[4 * gl + 2]) << 16) |
+         (uint32_t(col[4 * gl + 3]) << 24);
+}
+
+}  // namespace
+
+std::vector<int32_t> DepthRenderer::render_labels(const std::vector<RenderItem>& items) {
+  const int W = K_.width, H = K_.height;
+  const std::vector<uint64_t> base = rasterize(items, /*read_depth=*/false);
+  std::vector<int32_t> labels(static_cast<size_t>(W) * H, -1);
+  uint64_t last_gid = ~uint64_t(0);
+  size_t item = 0;
+  const uint8_t* col = impl_->color.data();
+  for (int v = 0; v < H; ++v) {
+    const size_t gl_row = static_cast<size_t>(H - 1 - v) * W;  // GL row 0 is the bottom row
+    int32_t* out = labels.data() + static_cast<size_t>(v) * W;
+    for (int u = 0; u < W; ++u) {
+      const uint32_t id = face_id(col, gl_row + u);
+      if (id == 0) continue;
+      const uint64_t gid = id - 1;
+      if (gid != last_gid) {
+        item = std::upper_bound(base.begin(), base.end(), gid) - base.begin() - 1;
+        last_gid = gid;
+      }
+      if (item < items.size()) out[u] = items[item].label;
+    }
+  }
+  return labels;
+}
+
+RenderOutput DepthRenderer::render(const std::vector<RenderItem>& items) {
+  const int W = K_.width, H = K_.height;
+  const double n = settings_.near_mm, f = settings_.far_mm;
+  const std::vector<uint64_t> base = rasterize(items, /*read_depth=*/true);
 
   RenderOutput out;
   out.depth = DepthImage(W, H);
@@ -231,8 +270,7 @@ RenderOutput DepthRenderer::render(const std::vector<RenderItem>& items) {
     const int row = H - 1 - v;  // GL row 0 is the bottom row
     for (int u = 0; u < W; ++u) {
       const size_t gl = static_cast<size_t>(row) * W + u;
-      const uint32_t id = uint32_t(col[4 * gl]) | (uint32_t(col[4 * gl + 1]) << 8) |
-                          (uint32_t(col[4 * gl + 2]) << 16) | (uint32_t(col[4 * gl + 3]) << 24);
+      const uint32_t id = face_id(col, gl);
       if (id == 0) continue;
       const uint64_t gid = id - 1;
       if (gid != last_gid) {

@@ -57,6 +57,9 @@ class DepthRenderer {
   DepthRenderer& operator=(const DepthRenderer&) = delete;
 
   RenderOutput render(const std::vector<RenderItem>& items);
+  // The labels of render(items) alone, the same values: no depth read back,
+  // no face planes (silhouettes and visibility counts need nothing else).
+  std::vector<int32_t> render_labels(const std::vector<RenderItem>& items);
   const Intrinsics& intrinsics() const { return K_; }
   // Changes the intrinsics of the next renders; the image size must stay the
   // same (buffers are sized at construction). Lets one context render tiles
@@ -71,6 +74,9 @@ class DepthRenderer {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  // Rasterizes items into the colour (face ids) and depth buffers; returns
+  // the global face id bases (see renderer.cpp).
+  std::vector<uint64_t> rasterize(const std::vector<RenderItem>& items, bool read_depth);
   Intrinsics K_;
   RenderSettings settings_;
 };

@@ -136,10 +136,11 @@ struct SceneGenerator::Impl : scene_detail::GeneratorState {
   bool fits(const Layout& L, const Placed& p, const std::vector<const Placed*>& others) const;
 
   // generator_render.cpp.
-  // Renders items; GT objects get labels 0..n-1.
-  RenderOutput render(DepthRenderer& r, const std::vector<const Placed*>& objs,
-                      const std::vector<const Placed*>& extras, const Pose& T_cam_world, bool background,
-                      const std::vector<Placed>& bg);
+  // The render items of a layout's objects (labels 0..n-1), `extras`
+  // (occluder label) and, with `background`, bg (background label).
+  static std::vector<RenderItem> render_items(const std::vector<const Placed*>& objs,
+                                              const std::vector<const Placed*>& extras, const Pose& T_cam_world,
+                                              bool background, const std::vector<Placed>& bg);
   // Projected bounding box of the object's hull (pixels); false if some
   // vertex is behind the near plane (never for accepted layouts).
   bool project_bbox(const Placed& p, const Pose& T_cam_world, double& umin, double& umax, double& vmin,

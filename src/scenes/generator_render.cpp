@@ -13,16 +13,17 @@ namespace pb {
 
 using namespace scene_detail;
 
-RenderOutput SceneGenerator::Impl::render(DepthRenderer& r, const std::vector<const Placed*>& objs,
-                                          const std::vector<const Placed*>& extras, const Pose& T_cam_world,
-                                          bool background, const std::vector<Placed>& bg) {
+std::vector<RenderItem> SceneGenerator::Impl::render_items(const std::vector<const Placed*>& objs,
+                                                          const std::vector<const Placed*>& extras,
+                                                          const Pose& T_cam_world, bool background,
+                                                          const std::vector<Placed>& bg) {
   std::vector<RenderItem> items;
   for (size_t i = 0; i < objs.size(); ++i)
     items.push_back({objs[i]->mesh, T_cam_world * objs[i]->T_world_model, static_cast<int>(i)});
   for (const Placed* e : extras) items.push_back({e->mesh, T_cam_world * e->T_world_model, kOccluderLabel});
   if (background)
     for (const Placed& b : bg) items.push_back({b.mesh, T_cam_world * b.T_world_model, kBackgroundLabel});
-  return r.render(items);
+  return items;
 }
 
 bool SceneGenerator::Impl::project_bbox(const Placed& p, const Pose& T_cam_world, double& umin, double& umax,
@@ -50,10 +51,10 @@ bool SceneGenerator::Impl::alone(const Placed& p, const Pose& T_cam_world, Alone
   int bu0 = 1 << 30, bv0 = 1 << 30, bu1 = -(1 << 30), bv1 = -(1 << 30);
   // Counts the silhouette pixels of a render whose pixel (0, 0) is (u0, v0)
   // of the virtual image, up to (ub, vb).
-  auto scan = [&](const RenderOutput& out, int u0, int v0, int ub, int vb) {
+  auto scan = [&](const std::vector<int32_t>& labels, int u0, int v0, int ub, int vb) {
     for (int y = 0; y < H; ++y)
       for (int x = 0; x < W; ++x) {
-        if (out.labels[static_cast<size_t>(y) * W + x] != 0) continue;
+        if (labels[static_cast<size_t>(y) * W + x] != 0) continue;
         const int u = x + u0, v = y + v0;
         if (u > ub || v > vb) continue;
         ++st.px_all;
@@ -63,7 +64,7 @@ bool SceneGenerator::Impl::alone(const Placed& p, const Pose& T_cam_world, Alone
   };
   const bool inside = umin >= -0.5 && vmin >= -0.5 && umax <= W - 0.5 && vmax <= H - 0.5;
   if (inside) {
-    scan(renderer->render(items), 0, 0, INT_MAX, INT_MAX);
+    scan(renderer->render_labels(items), 0, 0, INT_MAX, INT_MAX);
   } else {
     // Pixels whose centres can be covered: [ceil(min - 0.5), floor(max + 0.5)],
     // limited to 3 image sizes around the image.
@@ -77,11 +78,11 @@ bool SceneGenerator::Impl::alone(const Placed& p, const Pose& T_cam_world, Alone
         Kt.cx -= u0;
         Kt.cy -= v0;
         renderer->set_intrinsics(Kt);
-        const RenderOutput out = renderer->render(items);
+        const std::vector<int32_t> labels = renderer->render_labels(items);
         renderer->set_intrinsics(K);
         // Tiles overlap the requested range only where they extend past
         // ub / vb: count each pixel once.
-        scan(out, u0, v0, ub, vb);
+        scan(labels, u0, v0, ub, vb);
       }
     std::sort(st.pixels.begin(), st.pixels.end());
   }
@@ -91,9 +92,9 @@ bool SceneGenerator::Impl::alone(const Placed& p, const Pose& T_cam_world, Alone
 
 double SceneGenerator::Impl::target_visib(const Layout& L, const AloneStats& target_alone,
                                           const std::vector<const Placed*>& extras) {
-  const RenderOutput out = render(*renderer, L.objects(), extras, L.T_cam_world, false, L.bg);
+  const std::vector<int32_t> labels = renderer->render_labels(render_items(L.objects(), extras, L.T_cam_world, false, L.bg));
   int n = 0;
-  for (int32_t l : out.labels) n += (l == 0);
+  for (int32_t l : labels) n += (l == 0);
   return static_cast<double>(n) / target_alone.px_all;
 }
 
@@ -208,11 +209,11 @@ void SceneGenerator::Impl::silhouettes(const Layout& L, const AloneStats& target
     std::vector<RenderItem> items;
     for (size_t j = 0; j < group.size(); ++j)
       items.push_back({objs[group[j]].mesh, L.T_cam_world * objs[group[j]].T_world_model, static_cast<int>(j)});
-    const RenderOutput out = renderer->render(items);
+    const std::vector<int32_t> labels = renderer->render_labels(items);
     std::vector<std::array<int, 4>> bb(group.size(), {{W, H, -1, -1}});
     for (int v = 0; v < H; ++v)
       for (int u = 0; u < W; ++u) {
-        const int32_t l = out.labels[static_cast<size_t>(v) * W + u];
+        const int32_t l = labels[static_cast<size_t>(v) * W + u];
         if (l < 0 || l >= static_cast<int32_t>(group.size())) continue;
         AloneStats& st = alone_stats[group[l]];
         ++st.px_all;
@@ -258,7 +259,7 @@ void SceneGenerator::Impl::annotate(const Layout& L, const AloneStats& target_al
   const std::vector<Placed>& objs = L.objs;
   std::vector<const Placed*> extras;
   if (L.occl.on) extras.push_back(&L.occl.placed);
-  RenderOutput full = render(*renderer, L.objects(), extras, L.T_cam_world, true, L.bg);
+  RenderOutput full = renderer->render(render_items(L.objects(), extras, L.T_cam_world, true, L.bg));
   const int W = K.width, H = K.height;
   const size_t npx = static_cast<size_t>(W) * H;
 
