@@ -10,6 +10,7 @@
 
 #include "core/rotation.h"
 #include "render/sensor.h"
+#include "render/window_sums.h"
 #include "test_render_util.h"
 
 using namespace pb;
@@ -179,7 +180,7 @@ DepthImage structured_light_by_definition(const RenderOutput& out, const SensorP
 }
 
 TEST(RenderNoise, StructuredLightEqualsItsDefinitionBitForBit) {
-  // The generator's version sums four pixels' windows side by side; every
+  // The generator's version sums several pixels' windows side by side; every
   // depth must be the plain definition's, on the Astra frame and on frames
   // narrower than a block of windows, for several window sizes, with and
   // without the edge test (an infinite edge).
@@ -207,6 +208,31 @@ TEST(RenderNoise, StructuredLightEqualsItsDefinitionBitForBit) {
         EXPECT_GT(measured, got.z.size() / 4) << sensor.K.width << " px wide, radius " << r << ", edge " << edge;
       }
   }
+}
+
+TEST(RenderNoise, WindowSumKernelsAgreeBitForBit) {
+  // The kernel the CPU picks (AVX2 where present) and SSE2 give the same
+  // sums and counts, bit for bit, on random disparities with unmeasured
+  // (+inf) pixels; the test above holds the picked one to the definition.
+  const int W = 61, H = 7;
+  Rng rng(3);
+  std::vector<double> d_cmp(static_cast<size_t>(W) * H), d_noisy(d_cmp.size());
+  for (size_t i = 0; i < d_cmp.size(); ++i) {
+    const bool measured = rng.uniform() < 0.8;
+    d_cmp[i] = measured ? 40.0 + rng.uniform(0.0, 3.0) : HUGE_VAL;
+    d_noisy[i] = measured ? d_cmp[i] + rng.normal(0.0, 0.3) : 0.0;
+  }
+  for (int r : {0, 1, 2, 3})
+    for (double edge : {1.0, HUGE_VAL}) {
+      const WindowSumRow row{d_cmp.data(), d_noisy.data(), 3 * static_cast<size_t>(W), W, 3 - r, 3 + r, r, edge};
+      std::vector<double> s_best(W, -1.0), n_best(W, -1.0), s_sse(W, -1.0), n_sse(W, -1.0);
+      const int end_best = window_sums(row, r, s_best.data(), n_best.data());
+      const int end_sse = window_sums(row, r, s_sse.data(), n_sse.data(), WindowSumIsa::sse2);
+      EXPECT_EQ(end_best, end_sse);
+      EXPECT_GE(end_best, W - r - 3);  // every column whose window fits a kernel step
+      EXPECT_EQ(std::memcmp(s_best.data(), s_sse.data(), W * sizeof(double)), 0) << "radius " << r;
+      EXPECT_EQ(std::memcmp(n_best.data(), n_sse.data(), W * sizeof(double)), 0) << "radius " << r;
+    }
 }
 
 TEST(RenderNoise, ProjectorShadowsLieLeftOfTheBox) {

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -206,10 +207,17 @@ std::vector<uint64_t> DepthRenderer::rasterize(const std::vector<RenderItem>& it
 
 namespace {
 
-// The face id of GL pixel gl of an RGBA id buffer (0 = background).
+// The face id of GL pixel gl of an RGBA id buffer (0 = background): R is
+// its lowest byte, A its highest.
 inline uint32_t face_id(const uint8_t* col, size_t gl) {
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+  uint32_t id;
+  std::memcpy(&id, col + 4 * gl, 4);
+  return id;
+#else
   return uint32_t(col[4 * gl]) | (uint32_t(col[4 * gl + 1]) << 8) | (uint32_t(col[4 * gl + 2]) << 16) |
          (uint32_t(col[4 * gl + 3]) << 24);
+#endif
 }
 
 }  // namespace

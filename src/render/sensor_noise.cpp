@@ -4,12 +4,10 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#ifdef __SSE2__
-#include <emmintrin.h>
-#endif
 
 #include "core/error.h"
 #include "render/sensor.h"
+#include "render/window_sums.h"
 
 namespace pb {
 
@@ -111,14 +109,17 @@ void apply_structured_light(DepthImage& depth, const std::vector<Vec3f>& normals
   // Each measured pixel: the mean noisy disparity of the window's pixels of
   // the same surface, summed in row-major window order; a pixel left out
   // adds +0.0, which leaves the sum as it is, bit for bit. A sum is a chain
-  // of dependent additions: four neighbouring pixels are summed side by side
-  // (SSE2, two lanes per register) so that their chains overlap, each in
-  // its own order.
+  // of dependent additions: neighbouring pixels are summed side by side in
+  // SIMD lanes (window_sums.h) so that their chains overlap, each in its own
+  // order.
+  thread_local std::vector<double> row_sum, row_count;
+  row_sum.resize(static_cast<size_t>(W));
+  row_count.resize(static_cast<size_t>(W));
   for (int v = 0; v < H; ++v) {
     const int v0 = std::max(0, v - r), v1 = std::min(H - 1, v + r);
     const size_t line = static_cast<size_t>(v) * W;
     // One pixel on its own (the windows cut by the border; every pixel
-    // without SSE2).
+    // without x86 SIMD).
     const auto single = [&](int u) {
       const size_t px = line + u;
       if (!ok[px]) {
@@ -140,36 +141,15 @@ void apply_structured_light(DepthImage& depth, const std::vector<Vec3f>& normals
       finish(px, sum, count);
     };
     int u = 0;
-#ifdef __SSE2__
     for (; u < std::min(r, W); ++u) single(u);
-    const __m128d sign = _mm_set1_pd(-0.0), lim = _mm_set1_pd(edge), one = _mm_set1_pd(1.0);
-    for (; u + 3 + r < W; u += 4) {
-      const __m128d c0 = _mm_loadu_pd(&d_cmp[line + u]), c1 = _mm_loadu_pd(&d_cmp[line + u + 2]);
-      __m128d s0 = _mm_setzero_pd(), s1 = s0, n0 = s0, n1 = s0;
-      for (int vv = v0; vv <= v1; ++vv) {
-        const size_t row = static_cast<size_t>(vv) * W + u;
-        for (int du = -r; du <= r; ++du) {
-          const size_t q = row + du;
-          const __m128d m0 = _mm_cmpngt_pd(_mm_andnot_pd(sign, _mm_sub_pd(_mm_loadu_pd(&d_cmp[q]), c0)), lim);
-          const __m128d m1 = _mm_cmpngt_pd(_mm_andnot_pd(sign, _mm_sub_pd(_mm_loadu_pd(&d_cmp[q + 2]), c1)), lim);
-          s0 = _mm_add_pd(s0, _mm_and_pd(m0, _mm_loadu_pd(&d_noisy[q])));
-          s1 = _mm_add_pd(s1, _mm_and_pd(m1, _mm_loadu_pd(&d_noisy[q + 2])));
-          n0 = _mm_add_pd(n0, _mm_and_pd(m0, one));
-          n1 = _mm_add_pd(n1, _mm_and_pd(m1, one));
-        }
-      }
-      alignas(16) double sum[4], count[4];
-      _mm_store_pd(sum, s0);
-      _mm_store_pd(sum + 2, s1);
-      _mm_store_pd(count, n0);
-      _mm_store_pd(count + 2, n1);
-      for (int k = 0; k < 4; ++k) {
-        const size_t px = line + u + k;
-        if (ok[px]) finish(px, sum[k], static_cast<int>(count[k]));
-        else depth.z[px] = 0.f;
-      }
+    const int u_simd = u;
+    u = window_sums(WindowSumRow{d_cmp.data(), d_noisy.data(), line, W, v0, v1, r, edge}, u, row_sum.data(),
+                    row_count.data());
+    for (int k = u_simd; k < u; ++k) {
+      const size_t px = line + k;
+      if (ok[px]) finish(px, row_sum[k], static_cast<int>(row_count[k]));
+      else depth.z[px] = 0.f;
     }
-#endif
     for (; u < W; ++u) single(u);
   }
 }

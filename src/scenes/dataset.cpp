@@ -62,8 +62,14 @@ void write_image_files(const fs::path& tmp, const fs::path& scene_dir, const Sce
   const int W = img.depth.width, H = img.depth.height;
   if (s.masks)
     for (size_t k = 0; k < img.info.gt.size(); ++k) {
+      // Label k's pixels all lie in its visible box (gt_info_of).
       std::vector<uint8_t> m(static_cast<size_t>(W) * H, 0);
-      for (size_t p = 0; p < m.size(); ++p) m[p] = img.labels[p] == static_cast<int>(k) ? 255 : 0;
+      const auto& box = img.info.gt_info[k].bbox_visib;  // x, y, w, h; w = 0 when none is visible
+      for (int v = box[1]; v < box[1] + box[3]; ++v)
+        for (int u = box[0]; u < box[0] + box[2]; ++u) {
+          const size_t p = static_cast<size_t>(v) * W + u;
+          if (img.labels[p] == static_cast<int>(k)) m[p] = 255;
+        }
       write_gray8_png((scene_dir / "mask_visib" / (iid + "_" + bop_id(static_cast<int>(k)) + ".png")).string(), W,
                       H, m);
     }

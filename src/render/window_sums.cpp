@@ -1,0 +1,93 @@
+// Window sums of the structured-light model, SSE2 and AVX2 (window_sums.h).
+#include "render/window_sums.h"
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define PB_WINDOW_SUMS_X86 1
+#endif
+
+namespace pb {
+
+namespace {
+
+#ifdef PB_WINDOW_SUMS_X86
+
+// Four pixels per step, two SSE2 registers of two lanes.
+int sums_sse2(const WindowSumRow& a, int u, double* sum, double* count) {
+  const __m128d sign = _mm_set1_pd(-0.0), lim = _mm_set1_pd(a.edge), one = _mm_set1_pd(1.0);
+  for (; u + 3 + a.r < a.width; u += 4) {
+    const double* c = a.d_cmp + a.line + u;
+    const __m128d c0 = _mm_loadu_pd(c), c1 = _mm_loadu_pd(c + 2);
+    __m128d s0 = _mm_setzero_pd(), s1 = s0, n0 = s0, n1 = s0;
+    for (int vv = a.v0; vv <= a.v1; ++vv) {
+      const size_t row = static_cast<size_t>(vv) * a.width + u;
+      for (int du = -a.r; du <= a.r; ++du) {
+        const size_t q = row + du;
+        const __m128d m0 = _mm_cmpngt_pd(_mm_andnot_pd(sign, _mm_sub_pd(_mm_loadu_pd(a.d_cmp + q), c0)), lim);
+        const __m128d m1 = _mm_cmpngt_pd(_mm_andnot_pd(sign, _mm_sub_pd(_mm_loadu_pd(a.d_cmp + q + 2), c1)), lim);
+        s0 = _mm_add_pd(s0, _mm_and_pd(m0, _mm_loadu_pd(a.d_noisy + q)));
+        s1 = _mm_add_pd(s1, _mm_and_pd(m1, _mm_loadu_pd(a.d_noisy + q + 2)));
+        n0 = _mm_add_pd(n0, _mm_and_pd(m0, one));
+        n1 = _mm_add_pd(n1, _mm_and_pd(m1, one));
+      }
+    }
+    _mm_storeu_pd(sum + u, s0);
+    _mm_storeu_pd(sum + u + 2, s1);
+    _mm_storeu_pd(count + u, n0);
+    _mm_storeu_pd(count + u + 2, n1);
+  }
+  return u;
+}
+
+// Eight pixels per step, two AVX registers of four lanes. _CMP_NGT_UQ is
+// SSE2's cmpngt: true when not greater, NaN included.
+__attribute__((target("avx2"))) int sums_avx2(const WindowSumRow& a, int u, double* sum, double* count) {
+  const __m256d sign = _mm256_set1_pd(-0.0), lim = _mm256_set1_pd(a.edge), one = _mm256_set1_pd(1.0);
+  for (; u + 7 + a.r < a.width; u += 8) {
+    const double* c = a.d_cmp + a.line + u;
+    const __m256d c0 = _mm256_loadu_pd(c), c1 = _mm256_loadu_pd(c + 4);
+    __m256d s0 = _mm256_setzero_pd(), s1 = s0, n0 = s0, n1 = s0;
+    for (int vv = a.v0; vv <= a.v1; ++vv) {
+      const size_t row = static_cast<size_t>(vv) * a.width + u;
+      for (int du = -a.r; du <= a.r; ++du) {
+        const size_t q = row + du;
+        const __m256d m0 = _mm256_cmp_pd(
+            _mm256_andnot_pd(sign, _mm256_sub_pd(_mm256_loadu_pd(a.d_cmp + q), c0)), lim, _CMP_NGT_UQ);
+        const __m256d m1 = _mm256_cmp_pd(
+            _mm256_andnot_pd(sign, _mm256_sub_pd(_mm256_loadu_pd(a.d_cmp + q + 4), c1)), lim, _CMP_NGT_UQ);
+        s0 = _mm256_add_pd(s0, _mm256_and_pd(m0, _mm256_loadu_pd(a.d_noisy + q)));
+        s1 = _mm256_add_pd(s1, _mm256_and_pd(m1, _mm256_loadu_pd(a.d_noisy + q + 4)));
+        n0 = _mm256_add_pd(n0, _mm256_and_pd(m0, one));
+        n1 = _mm256_add_pd(n1, _mm256_and_pd(m1, one));
+      }
+    }
+    _mm256_storeu_pd(sum + u, s0);
+    _mm256_storeu_pd(sum + u + 4, s1);
+    _mm256_storeu_pd(count + u, n0);
+    _mm256_storeu_pd(count + u + 4, n1);
+  }
+  return u;
+}
+
+using Kernel = int (*)(const WindowSumRow&, int, double*, double*);
+
+Kernel pick() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") ? sums_avx2 : sums_sse2;
+}
+
+#endif
+
+}  // namespace
+
+int window_sums(const WindowSumRow& row, int u_begin, double* sum, double* count, WindowSumIsa isa) {
+#ifdef PB_WINDOW_SUMS_X86
+  static const Kernel best = pick();
+  const int u = (isa == WindowSumIsa::best ? best : sums_sse2)(row, u_begin, sum, count);
+  return sums_sse2(row, u, sum, count);  // the last few that AVX2's eight do not fit
+#else
+  return u_begin;  // the caller sums every pixel on its own
+#endif
+}
+
+}  // namespace pb
