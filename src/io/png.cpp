@@ -18,6 +18,7 @@
 
 #include "core/error.h"
 #include "core/file_lock.h"
+#include "core/round.h"
 #include "io/png_write.h"
 
 namespace pb {
@@ -189,7 +190,7 @@ void write_depth_png(const std::string& path, const DepthImage& depth, double de
     const double z = depth.z[i];
     long v = 0;
     if (z != 0.0) {
-      const double q = std::round(z / depth_scale);
+      const double q = round_half_away(z / depth_scale);
       if (!std::isfinite(z) || z < 0 || q > 65535.0)
         throw InputError(path, "depth",
                          "pixel (" + std::to_string(i % depth.width) + ", " + std::to_string(i / depth.width) +

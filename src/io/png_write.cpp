@@ -108,11 +108,11 @@ struct CompressorDeleter {
 
 // The zlib stream of `raw` by libdeflate at level 1 (one compressor per
 // thread, reused).
-std::vector<unsigned char> zlib_deflate(const std::vector<unsigned char>& raw) {
+std::vector<unsigned char> zlib_deflate(const unsigned char* raw, size_t size) {
   thread_local std::unique_ptr<libdeflate_compressor, CompressorDeleter> comp(libdeflate_alloc_compressor(1));
   if (!comp) throw std::bad_alloc();
-  std::vector<unsigned char> z(libdeflate_zlib_compress_bound(comp.get(), raw.size()));
-  const size_t n = libdeflate_zlib_compress(comp.get(), raw.data(), raw.size(), z.data(), z.size());
+  std::vector<unsigned char> z(libdeflate_zlib_compress_bound(comp.get(), size));
+  const size_t n = libdeflate_zlib_compress(comp.get(), raw, size, z.data(), z.size());
   if (n == 0) throw std::runtime_error("libdeflate: compressed data larger than its bound");
   z.resize(n);
   return z;
@@ -120,10 +120,10 @@ std::vector<unsigned char> zlib_deflate(const std::vector<unsigned char>& raw) {
 
 // The zlib stream of `raw` by the run encoder: header (deflate, 32K window,
 // no dictionary), the DEFLATE stream, Adler-32 of the raw bytes.
-std::vector<unsigned char> zlib_runs(const std::vector<unsigned char>& raw) {
+std::vector<unsigned char> zlib_runs(const unsigned char* raw, size_t size) {
   std::vector<unsigned char> z{0x78, 0x01};
-  deflate_runs(raw.data(), raw.size(), z);
-  put_be32(z, static_cast<uint32_t>(libdeflate_adler32(1, raw.data(), raw.size())));
+  deflate_runs(raw, size, z);
+  put_be32(z, static_cast<uint32_t>(libdeflate_adler32(1, raw, size)));
   return z;
 }
 
@@ -137,6 +137,12 @@ void deflate_runs(const unsigned char* data, size_t n, std::vector<unsigned char
   while (i < n) {
     const unsigned char b = data[i];
     size_t j = i + 1;
+    // The run's end: eight bytes at a time, then byte by byte.
+    const uint64_t eight = 0x0101010101010101ull * b;
+    for (uint64_t w; j + 8 <= n; j += 8) {
+      std::memcpy(&w, data + j, 8);
+      if (w != eight) break;
+    }
     while (j < n && data[j] == b) ++j;
     put_symbol(w, b);
     size_t rest = j - i - 1;
@@ -159,13 +165,15 @@ std::vector<unsigned char> encode_png_bytes(uint32_t width, uint32_t height, int
     throw std::invalid_argument("PNG size must be 1..2^31-1 pixels, got " + std::to_string(width) + "x" +
                                 std::to_string(height));
   // Each row: its filter type (0, none), then its bytes.
-  std::vector<unsigned char> raw((rowbytes + 1) * height);
+  const size_t size = (rowbytes + 1) * height;
+  const std::unique_ptr<unsigned char[]> raw(new unsigned char[size]);  // every byte written below
   for (uint32_t y = 0; y < height; ++y) {
-    unsigned char* row = raw.data() + y * (rowbytes + 1);
+    unsigned char* row = raw.get() + y * (rowbytes + 1);
     row[0] = 0;
     std::memcpy(row + 1, data + y * rowbytes, rowbytes);
   }
-  const std::vector<unsigned char> z = c == PngCompression::runs ? zlib_runs(raw) : zlib_deflate(raw);
+  const std::vector<unsigned char> z =
+      c == PngCompression::runs ? zlib_runs(raw.get(), size) : zlib_deflate(raw.get(), size);
 
   std::vector<unsigned char> out{0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
   out.reserve(out.size() + 25 + z.size() + 12 + 12);

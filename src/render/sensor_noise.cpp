@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/round.h"
 #include "render/sensor.h"
 #include "render/window_sums.h"
 
@@ -50,15 +51,6 @@ std::vector<uint8_t> grazing_mask(const DepthImage& depth, const std::vector<Vec
     mask[px] = c < cos_max;
   }
   return mask;
-}
-
-// std::round (halves away from zero) for |x| < 2^52, without the library
-// call: x minus its truncation is exact.
-inline double round_half_away(double x) {
-  if (!(std::abs(x) < 4503599627370496.0)) return std::round(x);
-  const double t = static_cast<double>(static_cast<int64_t>(x));
-  const double f = x - t;
-  return f >= 0.5 ? t + 1.0 : f <= -0.5 ? t - 1.0 : t;
 }
 
 const std::vector<Vec3f>& normals_for(const DepthImage& depth, const RenderOutput& render, const Intrinsics& K,

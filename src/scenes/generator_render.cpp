@@ -2,6 +2,7 @@
 // silhouettes of single objects, the target's visibility and the occluder
 // height search, and the final annotated image.
 #include <algorithm>
+#include <array>
 #include <climits>
 #include <cmath>
 
@@ -230,25 +231,40 @@ void SceneGenerator::Impl::silhouettes(const Layout& L, const AloneStats& target
 
 namespace {
 
-// BOP's gt_info of annotated object k from its silhouette and the final
-// labels and depth.
-GtInfo gt_info_of(const AloneStats& st, int k, const GeneratedImage& img, int W, int H) {
+// The visible pixels of one label: count and box (u0, v0, u1, v1).
+struct Visible {
+  int count = 0;
+  std::array<int, 4> box{};
+};
+
+// Visible pixels of labels 0..n-1, in one pass over the final labels.
+std::vector<Visible> visible_of(const std::vector<int>& labels, int n, int W, int H) {
+  std::vector<Visible> vis(static_cast<size_t>(n));
+  for (auto& v : vis) v.box = {{W, H, -1, -1}};
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u) {
+      const int l = labels[static_cast<size_t>(v) * W + u];
+      if (l < 0 || l >= n) continue;
+      Visible& x = vis[static_cast<size_t>(l)];
+      ++x.count;
+      x.box[0] = std::min(x.box[0], u), x.box[1] = std::min(x.box[1], v);
+      x.box[2] = std::max(x.box[2], u), x.box[3] = std::max(x.box[3], v);
+    }
+  return vis;
+}
+
+// BOP's gt_info of an annotated object from its silhouette, its visible
+// pixels and the final depth.
+GtInfo gt_info_of(const AloneStats& st, const Visible& vis, const GeneratedImage& img) {
   GtInfo gi;
   gi.px_count_all = st.px_all;
   gi.bbox_obj = st.bbox;
   int valid = 0;
   for (int p : st.pixels) valid += img.depth.z[p] > 0.f;
   gi.px_count_valid = valid;
-  int visib = 0, u0 = W, v0 = H, u1 = -1, v1 = -1;
-  for (int v = 0; v < H; ++v)
-    for (int u = 0; u < W; ++u)
-      if (img.labels[static_cast<size_t>(v) * W + u] == k) {
-        ++visib;
-        u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v), v1 = std::max(v1, v);
-      }
-  gi.px_count_visib = visib;
-  gi.bbox_visib = bbox_of(u0, v0, u1, v1);
-  gi.visib_fract = gi.px_count_all > 0 ? static_cast<double>(visib) / gi.px_count_all : 0.0;
+  gi.px_count_visib = vis.count;
+  gi.bbox_visib = bbox_of(vis.box[0], vis.box[1], vis.box[2], vis.box[3]);
+  gi.visib_fract = gi.px_count_all > 0 ? static_cast<double>(vis.count) / gi.px_count_all : 0.0;
   return gi;
 }
 
@@ -297,7 +313,8 @@ void SceneGenerator::Impl::annotate(const Layout& L, const AloneStats& target_al
   const double zmax_png = 65535.0 * s.depth_scale;
   for (auto& z : img.depth.z)
     if (!(z > 0.f) || !std::isfinite(z) || z > zmax_png) z = 0.f;
-  for (size_t k = 0; k < stats.size(); ++k) img.info.gt_info.push_back(gt_info_of(stats[k], static_cast<int>(k), img, W, H));
+  const std::vector<Visible> vis = visible_of(img.labels, static_cast<int>(stats.size()), W, H);
+  for (size_t k = 0; k < stats.size(); ++k) img.info.gt_info.push_back(gt_info_of(stats[k], vis[k], img));
 }
 
 }  // namespace pb
