@@ -235,6 +235,40 @@ TEST(RenderNoise, WindowSumKernelsAgreeBitForBit) {
     }
 }
 
+TEST(RenderNoise, DepthsFromSumsSameBitsAsOneAtATime) {
+  // The depths of a row from its window sums, the picked kernel (AVX2
+  // where present) against the one-pixel path: disparities on exact
+  // halves of the step (both signs), near them, negative, beyond 2^52 and
+  // NaN, with pixels not measured in between.
+  const double step = 0.125, fb = 40000.0;
+  std::vector<double> sum, count;
+  std::vector<uint8_t> ok;
+  Rng rng(5);
+  const double specials[] = {2.5 * step, -2.5 * step, 3.5 * step, std::nextafter(2.5 * step, 0.0),
+                             -7.0, 0.0, 1e17, std::nan(""), 0.5 * step, -0.5 * step};
+  for (double x : specials) {
+    sum.push_back(x), count.push_back(1.0), ok.push_back(1);
+  }
+  for (int i = 0; i < 203; ++i) {
+    const double n = 1 + rng.uniform_int(0, 24);
+    sum.push_back(n * rng.uniform(-1.0, 60.0)), count.push_back(n), ok.push_back(rng.uniform() < 0.9);
+  }
+  const int W = static_cast<int>(sum.size());
+  for (int begin : {0, 1, 3}) {
+    std::vector<float> best(W, -1.f), plain(W, -1.f);
+    depths_from_sums(sum.data(), count.data(), ok.data(), begin, W, step, fb, best.data());
+    depths_from_sums(sum.data(), count.data(), ok.data(), begin, W, step, fb, plain.data(), WindowSumIsa::sse2);
+    EXPECT_EQ(std::memcmp(best.data(), plain.data(), W * sizeof(float)), 0) << "from column " << begin;
+    if (begin > 0) EXPECT_EQ(best[begin - 1], -1.f);  // columns before `begin` untouched
+  }
+  std::vector<float> z(W);
+  depths_from_sums(sum.data(), count.data(), ok.data(), 0, W, step, fb, z.data());
+  EXPECT_EQ(z[0], static_cast<float>(fb / (3 * step)));  // 2.5 steps round up to 3
+  EXPECT_EQ(z[2], static_cast<float>(fb / (4 * step)));
+  EXPECT_EQ(z[3], static_cast<float>(fb / (2 * step)));  // just under a half rounds down
+  EXPECT_EQ(z[1], 0.f);                                   // negative disparity: no depth
+}
+
 TEST(RenderNoise, ProjectorShadowsLieLeftOfTheBox) {
   const SensorProfile astra = sensor_profile("astra");
   const Intrinsics& K = astra.K;

@@ -6,7 +6,6 @@
 #include <limits>
 
 #include "core/error.h"
-#include "core/round.h"
 #include "render/sensor.h"
 #include "render/window_sums.h"
 
@@ -93,11 +92,6 @@ void apply_structured_light(DepthImage& depth, const std::vector<Vec3f>& normals
   // An infinite edge (average every measured pixel) as the largest finite
   // one: the +inf of unmeasured pixels must still fail the test.
   const double edge = std::min(s.smoothing_edge_px, std::numeric_limits<double>::max());
-  const auto finish = [&](size_t px, double sum, int count) {
-    const double d = sum / count;  // count >= 1: the pixel itself
-    const double dq = round_half_away(d / s.disparity_step_px) * s.disparity_step_px;
-    depth.z[px] = dq > 0 ? static_cast<float>(fb / dq) : 0.f;
-  };
   // Each measured pixel: the mean noisy disparity of the window's pixels of
   // the same surface, summed in row-major window order; a pixel left out
   // adds +0.0, which leaves the sum as it is, bit for bit. A sum is a chain
@@ -110,14 +104,11 @@ void apply_structured_light(DepthImage& depth, const std::vector<Vec3f>& normals
   for (int v = 0; v < H; ++v) {
     const int v0 = std::max(0, v - r), v1 = std::min(H - 1, v + r);
     const size_t line = static_cast<size_t>(v) * W;
-    // One pixel on its own (the windows cut by the border; every pixel
-    // without x86 SIMD).
+    // One pixel's sums on their own (the windows cut by the border; every
+    // pixel without x86 SIMD).
     const auto single = [&](int u) {
       const size_t px = line + u;
-      if (!ok[px]) {
-        depth.z[px] = 0.f;
-        return;
-      }
+      if (!ok[px]) return;
       const int u0 = std::max(0, u - r), u1 = std::min(W - 1, u + r);
       const double centre = d_cmp[px];
       double sum = 0.0;
@@ -130,19 +121,16 @@ void apply_structured_light(DepthImage& depth, const std::vector<Vec3f>& normals
           count += same;
         }
       }
-      finish(px, sum, count);
+      row_sum[u] = sum;
+      row_count[u] = count;  // >= 1: the pixel itself
     };
     int u = 0;
     for (; u < std::min(r, W); ++u) single(u);
-    const int u_simd = u;
     u = window_sums(WindowSumRow{d_cmp.data(), d_noisy.data(), line, W, v0, v1, r, edge}, u, row_sum.data(),
                     row_count.data());
-    for (int k = u_simd; k < u; ++k) {
-      const size_t px = line + k;
-      if (ok[px]) finish(px, row_sum[k], static_cast<int>(row_count[k]));
-      else depth.z[px] = 0.f;
-    }
     for (; u < W; ++u) single(u);
+    depths_from_sums(row_sum.data(), row_count.data(), ok.data() + line, 0, W, s.disparity_step_px, fb,
+                     depth.z.data() + line);
   }
 }
 

@@ -1,6 +1,8 @@
 // Window sums of the structured-light model, SSE2 and AVX2 (window_sums.h).
 #include "render/window_sums.h"
 
+#include "core/round.h"
+
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
 #define PB_WINDOW_SUMS_X86 1
@@ -71,14 +73,67 @@ __attribute__((target("avx2"))) int sums_avx2(const WindowSumRow& a, int u, doub
 
 using Kernel = int (*)(const WindowSumRow&, int, double*, double*);
 
-Kernel pick() {
+bool has_avx2() {
   __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") ? sums_avx2 : sums_sse2;
+  return __builtin_cpu_supports("avx2");
+}
+
+Kernel pick() { return has_avx2() ? sums_avx2 : sums_sse2; }
+
+#endif
+
+// One pixel's depth from its window sum (the reference for the AVX2 path).
+inline float depth_of(double sum, double count, double step, double fb) {
+  const double dq = round_half_away(sum / count / step) * step;
+  return dq > 0 ? static_cast<float>(fb / dq) : 0.f;
+}
+
+void depths_scalar(const double* sum, const double* count, const uint8_t* ok, int u, int end, double step,
+                   double fb, float* z) {
+  for (; u < end; ++u) z[u] = ok[u] ? depth_of(sum[u], count[u], step, fb) : 0.f;
+}
+
+#ifdef PB_WINDOW_SUMS_X86
+
+// Four lanes of depth_of: the same divisions (IEEE, exact in any width),
+// truncation by roundpd, and the halves decided as round_half_away does;
+// a group with a lane at or beyond 2^52 (or NaN) goes to the scalar path.
+__attribute__((target("avx2"))) void depths_avx2(const double* sum, const double* count, const uint8_t* ok, int u,
+                                                 int end, double step, double fb, float* z) {
+  const __m256d vstep = _mm256_set1_pd(step), vfb = _mm256_set1_pd(fb), zero = _mm256_setzero_pd();
+  const __m256d half = _mm256_set1_pd(0.5), mhalf = _mm256_set1_pd(-0.5), one = _mm256_set1_pd(1.0);
+  const __m256d big = _mm256_set1_pd(4503599627370496.0), sign = _mm256_set1_pd(-0.0);
+  for (; u + 4 <= end; u += 4) {
+    const __m256d x = _mm256_div_pd(_mm256_div_pd(_mm256_loadu_pd(sum + u), _mm256_loadu_pd(count + u)), vstep);
+    if (_mm256_movemask_pd(_mm256_cmp_pd(_mm256_andnot_pd(sign, x), big, _CMP_LT_OQ)) != 0xF) {
+      depths_scalar(sum, count, ok, u, u + 4, step, fb, z);
+      continue;
+    }
+    const __m256d t = _mm256_round_pd(x, _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC);
+    const __m256d f = _mm256_sub_pd(x, t);
+    __m256d r = _mm256_blendv_pd(t, _mm256_add_pd(t, one), _mm256_cmp_pd(f, half, _CMP_GE_OQ));
+    r = _mm256_blendv_pd(r, _mm256_sub_pd(t, one), _mm256_cmp_pd(f, mhalf, _CMP_LE_OQ));
+    const __m256d dq = _mm256_mul_pd(r, vstep);
+    alignas(16) float out[4];
+    _mm_store_ps(out, _mm256_cvtpd_ps(_mm256_div_pd(vfb, dq)));
+    const int positive = _mm256_movemask_pd(_mm256_cmp_pd(dq, zero, _CMP_GT_OQ));
+    for (int k = 0; k < 4; ++k) z[u + k] = ok[u + k] && ((positive >> k) & 1) ? out[k] : 0.f;
+  }
+  depths_scalar(sum, count, ok, u, end, step, fb, z);
 }
 
 #endif
 
 }  // namespace
+
+void depths_from_sums(const double* sum, const double* count, const uint8_t* ok, int begin, int end, double step,
+                      double fb, float* z, WindowSumIsa isa) {
+#ifdef PB_WINDOW_SUMS_X86
+  static const bool avx2 = has_avx2();
+  if (avx2 && isa == WindowSumIsa::best) return depths_avx2(sum, count, ok, begin, end, step, fb, z);
+#endif
+  depths_scalar(sum, count, ok, begin, end, step, fb, z);
+}
 
 int window_sums(const WindowSumRow& row, int u_begin, double* sum, double* count, WindowSumIsa isa) {
 #ifdef PB_WINDOW_SUMS_X86
