@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,7 @@ struct AloneStats {
   int px_all = 0;
   std::array<int, 4> bbox{{-1, -1, 0, 0}};
   std::vector<int> pixels;  // silhouette pixels inside the image (v * W + u)
+  bool tiled = false;       // crossed the border: rendered in shifted tiles, not with the image's own K
 };
 
 // The occluder of an occluded image: its footprint is placed with the
@@ -69,6 +71,9 @@ struct Layout {
   double r_t = 0;                // target footprint radius (mm)
   Vec2 wall_point = Vec2::Zero(), wall_n = Vec2::Zero();  // warehouse wall: a point and its normal
   Occluder occl;
+  // The final render (objects, occluder, background), when the visibility
+  // check already made it (no occluder); annotate() then reuses it.
+  std::optional<RenderOutput> full;
 
   const Placed& target() const { return objs[0]; }
   // Objects (and the occluder) that a new footprint must keep clear of.
@@ -153,6 +158,10 @@ struct SceneGenerator::Impl : scene_detail::GeneratorState {
   bool alone(const Placed& p, const Pose& T_cam_world, AloneStats& st);
   // The target's visible fraction with the objects and `extras`.
   double target_visib(const Layout& L, const AloneStats& target_alone, const std::vector<const Placed*>& extras);
+  // Without an occluder: the same fraction from the final render (kept in
+  // L.full), where it must be the same number (see the .cpp); false when
+  // it cannot be told from it.
+  bool target_visib_from_final(Layout& L, const AloneStats& target_alone, double& visib);
   // Without an occluder: the target must be visible enough. With one: its
   // height is searched so that the target's visible fraction meets the goal.
   bool reach_visibility(Layout& L, const AloneStats& target_alone, std::string& why);
@@ -163,7 +172,7 @@ struct SceneGenerator::Impl : scene_detail::GeneratorState {
   void silhouettes(const Layout& L, const AloneStats& target_alone, std::vector<AloneStats>& alone_stats,
                    std::vector<char>& present);
   // Final render with the background, ground truth, labels, noise, gt_info.
-  void annotate(const Layout& L, const AloneStats& target_alone, int im_id, GeneratedImage& img);
+  void annotate(Layout& L, const AloneStats& target_alone, int im_id, GeneratedImage& img);
 };
 
 }  // namespace pb

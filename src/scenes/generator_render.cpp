@@ -67,6 +67,7 @@ bool SceneGenerator::Impl::alone(const Placed& p, const Pose& T_cam_world, Alone
   if (inside) {
     scan(renderer->render_labels(items), 0, 0, INT_MAX, INT_MAX);
   } else {
+    st.tiled = true;
     // Pixels whose centres can be covered: [ceil(min - 0.5), floor(max + 0.5)],
     // limited to 3 image sizes around the image.
     const int ua = std::max(-W, static_cast<int>(std::floor(umin)) - 1);
@@ -107,10 +108,31 @@ void SceneGenerator::Impl::set_occluder_height(Layout& L, double h) const {
   oc.placed.height = h;
 }
 
+// The final render adds the background after the objects, and a fragment
+// replaces one only when strictly nearer: so each pixel's final label is its
+// label among the objects alone, or the background's. The target's pixels
+// among the objects alone are then its final pixels plus those of its own
+// silhouette that the background covers in the final render. Where the
+// background covers none of the silhouette (a table is never in front of
+// what stands on it), the two counts are equal. The silhouette must come
+// from a render with the image's own K (not tiles) to have the same pixels.
+bool SceneGenerator::Impl::target_visib_from_final(Layout& L, const AloneStats& target_alone, double& visib) {
+  if (target_alone.tiled) return false;
+  L.full = renderer->render(render_items(L.objects(), {}, L.T_cam_world, true, L.bg));
+  const std::vector<int32_t>& labels = L.full->labels;
+  for (int p : target_alone.pixels)
+    if (labels[static_cast<size_t>(p)] == kBackgroundLabel) return false;
+  int n = 0;
+  for (int32_t l : labels) n += (l == 0);
+  visib = static_cast<double>(n) / target_alone.px_all;
+  return true;
+}
+
 bool SceneGenerator::Impl::reach_visibility(Layout& L, const AloneStats& target_alone, std::string& why) {
   L.occl.height = 0;
   if (!L.occl.on) {
-    const double v = target_visib(L, target_alone, {});
+    double v;
+    if (!target_visib_from_final(L, target_alone, v)) v = target_visib(L, target_alone, {});
     if (v < s.min_target_visib) {
       why = "target not visible enough";
       return false;
@@ -270,12 +292,13 @@ GtInfo gt_info_of(const AloneStats& st, const Visible& vis, const GeneratedImage
 
 }  // namespace
 
-void SceneGenerator::Impl::annotate(const Layout& L, const AloneStats& target_alone, int im_id,
+void SceneGenerator::Impl::annotate(Layout& L, const AloneStats& target_alone, int im_id,
                                     GeneratedImage& img) {
   const std::vector<Placed>& objs = L.objs;
   std::vector<const Placed*> extras;
   if (L.occl.on) extras.push_back(&L.occl.placed);
-  RenderOutput full = renderer->render(render_items(L.objects(), extras, L.T_cam_world, true, L.bg));
+  RenderOutput full =
+      L.full ? std::move(*L.full) : renderer->render(render_items(L.objects(), extras, L.T_cam_world, true, L.bg));
   const int W = K.width, H = K.height;
   const size_t npx = static_cast<size_t>(W) * H;
 
