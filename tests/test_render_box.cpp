@@ -143,6 +143,16 @@ TEST(RenderBox, NearerOfTwoOverlappingItemsWins) {
     // counts) gives the same labels, pixel for pixel.
     EXPECT_TRUE(r.render_labels(items) == out.labels);
   }
+  // Without the depth test (items that cover no common pixel): each box
+  // alone, and the two boxes moved apart, label their pixels as the full
+  // render does; with the boxes overlapping, the depth test is what decides.
+  Pose T2_apart = T2;
+  T2_apart.t = Vec3(-250, 0, 1000);
+  const std::vector<std::vector<RenderItem>> apart = {
+      {{&b1, T1, 10}}, {{&b2, T2, 20}}, {{&b2, T2_apart, 20}, {&b1, T1, 10}}};
+  for (const auto& items : apart) EXPECT_TRUE(r.render_labels(items, /*overlap=*/false) == r.render(items).labels);
+  const std::vector<RenderItem> far_last = {{&b2, T2, 20}, {&b1, T1, 10}};
+  EXPECT_FALSE(r.render_labels(far_last, /*overlap=*/false) == r.render(far_last).labels);
 }
 
 TEST(RenderBox, RenderersInSeveralThreadsAgreeWithOne) {

@@ -89,8 +89,9 @@ std::vector<uint64_t> face_id_bases(const std::vector<RenderItem>& items) {
   return base;
 }
 
-// Fixed-function state for id rendering, cleared buffers, projection P.
-void begin_frame(int W, int H, const Mat4& P) {
+// Fixed-function state for id rendering, cleared buffers, projection P;
+// without depth_test no depth buffer is used (the last face drawn wins).
+void begin_frame(int W, int H, const Mat4& P, bool depth_test) {
   glViewport(0, 0, W, H);
   glDisable(GL_DITHER);
   glDisable(GL_LIGHTING);
@@ -98,15 +99,16 @@ void begin_frame(int W, int H, const Mat4& P) {
   glDisable(GL_CULL_FACE);
   glDisable(GL_MULTISAMPLE);
   glDisable(GL_TEXTURE_2D);
-  glEnable(GL_DEPTH_TEST);
+  if (depth_test) glEnable(GL_DEPTH_TEST);
+  else glDisable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
-  glDepthMask(GL_TRUE);
+  glDepthMask(depth_test ? GL_TRUE : GL_FALSE);
   glShadeModel(GL_FLAT);
   glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glClearColor(0.f, 0.f, 0.f, 0.f);
   glClearDepth(1.0);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glClear(depth_test ? GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT : GL_COLOR_BUFFER_BIT);
   glMatrixMode(GL_PROJECTION);
   glLoadMatrixd(P.data());  // Eigen is column-major, as GL expects
 }
@@ -190,13 +192,14 @@ DepthRenderer::~DepthRenderer() {
   if (impl_ && impl_->ctx) OSMesaDestroyContext(impl_->ctx);
 }
 
-std::vector<uint64_t> DepthRenderer::rasterize(const std::vector<RenderItem>& items, bool read_depth) {
+std::vector<uint64_t> DepthRenderer::rasterize(const std::vector<RenderItem>& items, bool depth_test,
+                                               bool read_depth) {
   const int W = K_.width, H = K_.height;
   std::vector<uint64_t> base = face_id_bases(items);
   if (!OSMesaMakeCurrent(impl_->ctx, impl_->color.data(), GL_UNSIGNED_BYTE, W, H))
     throw std::runtime_error("OSMesaMakeCurrent failed");
   ReleaseCurrent release;
-  begin_frame(W, H, projection(K_, settings_.near_mm, settings_.far_mm));
+  begin_frame(W, H, projection(K_, settings_.near_mm, settings_.far_mm), depth_test);
   impl_->draw(items, base);
   glFinish();
   if (read_depth) glReadPixels(0, 0, W, H, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, impl_->depth.data());
@@ -222,9 +225,9 @@ inline uint32_t face_id(const uint8_t* col, size_t gl) {
 
 }  // namespace
 
-std::vector<int32_t> DepthRenderer::render_labels(const std::vector<RenderItem>& items) {
+std::vector<int32_t> DepthRenderer::render_labels(const std::vector<RenderItem>& items, bool overlap) {
   const int W = K_.width, H = K_.height;
-  const std::vector<uint64_t> base = rasterize(items, /*read_depth=*/false);
+  const std::vector<uint64_t> base = rasterize(items, /*depth_test=*/overlap, /*read_depth=*/false);
   std::vector<int32_t> labels(static_cast<size_t>(W) * H, -1);
   uint64_t last_gid = ~uint64_t(0);
   size_t item = 0;
@@ -249,7 +252,7 @@ std::vector<int32_t> DepthRenderer::render_labels(const std::vector<RenderItem>&
 RenderOutput DepthRenderer::render(const std::vector<RenderItem>& items) {
   const int W = K_.width, H = K_.height;
   const double n = settings_.near_mm, f = settings_.far_mm;
-  const std::vector<uint64_t> base = rasterize(items, /*read_depth=*/true);
+  const std::vector<uint64_t> base = rasterize(items, /*depth_test=*/true, /*read_depth=*/true);
 
   RenderOutput out;
   out.depth = DepthImage(W, H);

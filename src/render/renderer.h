@@ -59,7 +59,10 @@ class DepthRenderer {
   RenderOutput render(const std::vector<RenderItem>& items);
   // The labels of render(items) alone, the same values: no depth read back,
   // no face planes (silhouettes and visibility counts need nothing else).
-  std::vector<int32_t> render_labels(const std::vector<RenderItem>& items);
+  // overlap = false promises that no two items cover a common pixel (one
+  // item, or items apart in the image): then every pixel's label is that of
+  // whichever item covers it, and no depth test is needed to find it.
+  std::vector<int32_t> render_labels(const std::vector<RenderItem>& items, bool overlap = true);
   const Intrinsics& intrinsics() const { return K_; }
   // Changes the intrinsics of the next renders; the image size must stay the
   // same (buffers are sized at construction). Lets one context render tiles
@@ -76,7 +79,7 @@ class DepthRenderer {
   std::unique_ptr<Impl> impl_;
   // Rasterizes items into the colour (face ids) and depth buffers; returns
   // the global face id bases (see renderer.cpp).
-  std::vector<uint64_t> rasterize(const std::vector<RenderItem>& items, bool read_depth);
+  std::vector<uint64_t> rasterize(const std::vector<RenderItem>& items, bool depth_test, bool read_depth);
   Intrinsics K_;
   RenderSettings settings_;
 };

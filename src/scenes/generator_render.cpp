@@ -65,7 +65,7 @@ bool SceneGenerator::Impl::alone(const Placed& p, const Pose& T_cam_world, Alone
   };
   const bool inside = umin >= -0.5 && vmin >= -0.5 && umax <= W - 0.5 && vmax <= H - 0.5;
   if (inside) {
-    scan(renderer->render_labels(items), 0, 0, INT_MAX, INT_MAX);
+    scan(renderer->render_labels(items, /*overlap=*/false), 0, 0, INT_MAX, INT_MAX);
   } else {
     st.tiled = true;
     // Pixels whose centres can be covered: [ceil(min - 0.5), floor(max + 0.5)],
@@ -80,7 +80,7 @@ bool SceneGenerator::Impl::alone(const Placed& p, const Pose& T_cam_world, Alone
         Kt.cx -= u0;
         Kt.cy -= v0;
         renderer->set_intrinsics(Kt);
-        const std::vector<int32_t> labels = renderer->render_labels(items);
+        const std::vector<int32_t> labels = renderer->render_labels(items, /*overlap=*/false);
         renderer->set_intrinsics(K);
         // Tiles overlap the requested range only where they extend past
         // ub / vb: count each pixel once.
@@ -232,7 +232,7 @@ void SceneGenerator::Impl::silhouettes(const Layout& L, const AloneStats& target
     std::vector<RenderItem> items;
     for (size_t j = 0; j < group.size(); ++j)
       items.push_back({objs[group[j]].mesh, L.T_cam_world * objs[group[j]].T_world_model, static_cast<int>(j)});
-    const std::vector<int32_t> labels = renderer->render_labels(items);
+    const std::vector<int32_t> labels = renderer->render_labels(items, /*overlap=*/false);
     std::vector<std::array<int, 4>> bb(group.size(), {{W, H, -1, -1}});
     for (int v = 0; v < H; ++v)
       for (int u = 0; u < W; ++u) {
