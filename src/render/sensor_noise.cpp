@@ -42,12 +42,24 @@ std::vector<uint8_t> grazing_mask(const DepthImage& depth, const std::vector<Vec
   std::vector<uint8_t> mask(N, 0);
   const double cos_max = std::cos(max_deg * kDeg);
   const std::vector<Vec3>& rays = unit_rays(K);
+  if (!(cos_max > 0)) return mask;  // |cos| < cos_max never holds
+  const double cos2 = cos_max * cos_max;
   for (size_t px = 0; px < N; ++px) {
     if (!valid_depth(depth.z[px])) continue;
     const Vec3 n = normals[px].cast<double>();
-    if (n.squaredNorm() < 1e-12) continue;
-    const double c = std::abs(n.normalized().dot(rays[px]));
-    mask[px] = c < cos_max;
+    const double n2 = n.squaredNorm();
+    if (n2 < 1e-12) continue;
+    // The cosine's square times |n|^2, without division or root: where it
+    // is clearly apart from cos_max's (errors are ~1e-16 relative), its side
+    // is the decision; near the threshold the exact expression decides.
+    const double d = n.dot(rays[px]);
+    const double gap = d * d - cos2 * n2;
+    if (std::abs(gap) > 1e-9 * n2) {
+      mask[px] = gap < 0;
+    } else {
+      const double c = std::abs(n.normalized().dot(rays[px]));
+      mask[px] = c < cos_max;
+    }
   }
   return mask;
 }
@@ -73,21 +85,21 @@ void apply_structured_light(DepthImage& depth, const std::vector<Vec3f>& normals
   // Per-thread scratch, reused from image to image (no fresh pages each
   // time). d_cmp: the true disparity of a measured pixel, +inf elsewhere (it
   // then fails every same-surface test); d_noisy: 0 where not measured.
+  // Every element is written below (no fill first).
   thread_local std::vector<double> d_cmp, d_noisy;
   thread_local std::vector<uint8_t> ok;
-  d_cmp.assign(N, std::numeric_limits<double>::infinity());
-  d_noisy.assign(N, 0.0);
-  ok.assign(N, 0);
+  d_cmp.resize(N);
+  d_noisy.resize(N);
+  ok.resize(N);
   std::vector<uint8_t> shadow;
   if (s.shadows) shadow = projector_shadow_mask(depth, K, s.baseline_mm);
   const std::vector<uint8_t> grazing = grazing_mask(depth, normals, K, s.max_incidence_deg);
   for (size_t px = 0; px < N; ++px) {
-    if (!valid_depth(depth.z[px])) continue;
-    ok[px] = !grazing[px] && !(s.shadows && shadow[px]);
-    if (ok[px]) d_cmp[px] = fb / depth.z[px];
+    ok[px] = valid_depth(depth.z[px]) && !grazing[px] && !(s.shadows && shadow[px]);
+    d_cmp[px] = ok[px] ? fb / depth.z[px] : std::numeric_limits<double>::infinity();
   }
   for (size_t px = 0; px < N; ++px)
-    if (ok[px]) d_noisy[px] = d_cmp[px] + rng.normal(0.0, s.disparity_sigma_px);
+    d_noisy[px] = ok[px] ? d_cmp[px] + rng.normal(0.0, s.disparity_sigma_px) : 0.0;
   const int r = std::max(0, s.smoothing_radius_px);
   // An infinite edge (average every measured pixel) as the largest finite
   // one: the +inf of unmeasured pixels must still fail the test.
