@@ -98,6 +98,8 @@ void depths_scalar(const double* sum, const double* count, const uint8_t* ok, in
 // Four lanes of depth_of: the same divisions (IEEE, exact in any width),
 // truncation by roundpd, and the halves decided as round_half_away does;
 // a group with a lane at or beyond 2^52 (or NaN) goes to the scalar path.
+// roundpd keeps the sign of a zero that the integer cast drops (-0.3 ->
+// -0.0): such a disparity is not positive either way, so its depth is 0.
 __attribute__((target("avx2"))) void depths_avx2(const double* sum, const double* count, const uint8_t* ok, int u,
                                                  int end, double step, double fb, float* z) {
   const __m256d vstep = _mm256_set1_pd(step), vfb = _mm256_set1_pd(fb), zero = _mm256_setzero_pd();
