@@ -81,6 +81,9 @@ seed fuzz_bop_scene "$scene/scene_gt_info.json" 2
 # A 24x18 crop of a generated depth image: the decoder's paths are those of a
 # full frame, at thousands rather than tens of inputs per second.
 seed fuzz_png16 fuzz/seeds/depth_24x18.png
+# The writer: a small mask (run encoder) and a small depth image (libdeflate).
+seed fuzz_png_write fuzz/seeds/png_write_mask.bin
+seed fuzz_png_write fuzz/seeds/png_write_depth.bin
 for f in models/generated/box_small.ply models/generated/cylinder.ply; do seed fuzz_mesh "$f" 0; done
 # Point clouds: the first byte's low bit picks .ply (1) or .pcd (0).
 for f in fuzz/seeds/cloud_*.pcd; do seed fuzz_cloud "$f" 0; done

@@ -1,4 +1,5 @@
-// PNG images through libpng: 16-bit depth in and out, 8-bit RGB out.
+// PNG images: 16-bit depth in and out, 8-bit gray in and out, 8-bit RGB
+// out. Read through libpng, written by io/png_write.h.
 #pragma once
 
 #include <cstdint>
