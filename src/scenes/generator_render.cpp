@@ -94,7 +94,8 @@ bool SceneGenerator::Impl::alone(const Placed& p, const Pose& T_cam_world, Alone
 
 double SceneGenerator::Impl::target_visib(const Layout& L, const AloneStats& target_alone,
                                           const std::vector<const Placed*>& extras) {
-  const std::vector<int32_t> labels = renderer->render_labels(render_items(L.objects(), extras, L.T_cam_world, false, L.bg));
+  const std::vector<int32_t> labels =
+      renderer->render_labels(render_items(L.objects(), extras, L.T_cam_world, false, L.bg));
   int n = 0;
   for (int32_t l : labels) n += (l == 0);
   return static_cast<double>(n) / target_alone.px_all;
