@@ -223,6 +223,12 @@ inline uint32_t face_id(const uint8_t* col, size_t gl) {
 #endif
 }
 
+// The item owning global face id gid (base: face_id_bases); items.size()
+// or more for an id past the last item's faces.
+inline size_t item_of_face(const std::vector<uint64_t>& base, uint64_t gid) {
+  return static_cast<size_t>(std::upper_bound(base.begin(), base.end(), gid) - base.begin() - 1);
+}
+
 }  // namespace
 
 std::vector<int32_t> DepthRenderer::render_labels(const std::vector<RenderItem>& items, bool overlap) {
@@ -240,7 +246,7 @@ std::vector<int32_t> DepthRenderer::render_labels(const std::vector<RenderItem>&
       if (id == 0) continue;
       const uint64_t gid = id - 1;
       if (gid != last_gid) {
-        item = std::upper_bound(base.begin(), base.end(), gid) - base.begin() - 1;
+        item = item_of_face(base, gid);
         last_gid = gid;
       }
       if (item < items.size()) out[u] = items[item].label;
@@ -285,7 +291,7 @@ RenderOutput DepthRenderer::render(const std::vector<RenderItem>& items) {
       if (id == 0) continue;
       const uint64_t gid = id - 1;
       if (gid != last_gid) {
-        item = std::upper_bound(base.begin(), base.end(), gid) - base.begin() - 1;
+        item = item_of_face(base, gid);
         pl = item < items.size() && need_planes ? &impl_->face_plane(items, base, item, gid) : nullptr;
         last_gid = gid;
       }

@@ -41,7 +41,9 @@ int sums_sse2(const WindowSumRow& a, int u, double* sum, double* count) {
   return u;
 }
 
-// Eight pixels per step, two AVX registers of four lanes. _CMP_NGT_UQ is
+// Eight pixels per step, two AVX registers of four lanes. The same loop as
+// sums_sse2 at twice the width, written out again: a function compiled for
+// AVX2 must not run on a CPU without it, so one template cannot serve both. _CMP_NGT_UQ is
 // SSE2's cmpngt: true when not greater, NaN included.
 __attribute__((target("avx2"))) int sums_avx2(const WindowSumRow& a, int u, double* sum, double* count) {
   const __m256d sign = _mm256_set1_pd(-0.0), lim = _mm256_set1_pd(a.edge), one = _mm256_set1_pd(1.0);
