@@ -222,6 +222,39 @@ TEST_F(GlobalMethod, TopKCountingRollsKeepsTheFirstTopKHypotheses) {
   }
 }
 
+TEST_F(GlobalMethod, MatchesPerSignatureKeepsEachSceneSignaturesNearest) {
+  // One object, so ESF has one scene signature: with one match per
+  // signature, every hypothesis comes from its nearest view (the default's
+  // best match), where the default's top 5 pairs span several views.
+  GlobalSettings nearest;
+  nearest.matches_per_signature = 1;
+  const auto ha = hypotheses("esf"), hb = hypotheses("esf", nearest);
+  ASSERT_FALSE(ha.empty());
+  ASSERT_FALSE(hb.empty());
+  std::vector<int> views_a;
+  for (const auto& h : ha) views_a.push_back(h.view);
+  std::sort(views_a.begin(), views_a.end());
+  ASSERT_GT(std::unique(views_a.begin(), views_a.end()) - views_a.begin(), 1)
+      << "the fixture should match the scene to more than one view";
+  for (const auto& h : hb) {
+    EXPECT_EQ(h.view, ha[0].view);
+    EXPECT_EQ(h.score, ha[0].score);
+  }
+  // The best match is the same, and so are its roll hypotheses.
+  size_t first_rolls = 0;
+  while (first_rolls < ha.size() && ha[first_rolls].view == ha[0].view && ha[first_rolls].score == ha[0].score)
+    ++first_rolls;
+  EXPECT_TRUE(same(std::vector<Hypothesis>(ha.begin(), ha.begin() + static_cast<std::ptrdiff_t>(first_rolls)), hb));
+  // CVFH: the overall best pair is some region's nearest, so it survives.
+  const auto hc = hypotheses("cvfh", nearest), hd = hypotheses("cvfh");
+  ASSERT_FALSE(hc.empty());
+  EXPECT_TRUE(same({hc[0]}, {hd[0]}));
+  // 0 is every pair (the default).
+  GlobalSettings all;
+  all.matches_per_signature = 0;
+  EXPECT_TRUE(same(hypotheses("cvfh", all), hd));
+}
+
 TEST_F(GlobalMethod, EsfSamplesFromPointsDrawsOneTriplePerPoint) {
   // The thesis's reading (section 3.2.3): as many triples as points. The
   // count follows the cloud; the hypotheses' scores are those of fewer
@@ -262,7 +295,9 @@ TEST(GlobalRegions, StableRegionsMatchPclCvfh) {
 TEST(GlobalSettingsYaml, ParsesAndRejects) {
   GlobalSettings g;
   parse_section(YamlNode::load_string("top_k: 7\nskip_crh: true\ncrh_max_peaks: 2\nesf_samples: 5000\n"
-                                      "top_k_counts_rolls: true\nesf_samples_from_points: true\n", "g.yaml"), g);
+                                      "top_k_counts_rolls: true\nesf_samples_from_points: true\n"
+                                      "matches_per_signature: 1\n", "g.yaml"), g);
+  EXPECT_EQ(g.matches_per_signature, 1);
   EXPECT_EQ(g.top_k, 7);
   EXPECT_TRUE(g.esf_samples_from_points);
   EXPECT_TRUE(g.top_k_counts_rolls);
@@ -285,6 +320,7 @@ TEST(GlobalSettingsYaml, ParsesAndRejects) {
   EXPECT_NE(msg("crh_peak_threshold: 2\n").find("crh_peak_threshold"), std::string::npos);
   EXPECT_NE(msg("cluster_min_points: 100\ncluster_max_points: 10\n").find("cluster_max_points"), std::string::npos);
   EXPECT_NE(msg("top_k: 0\n").find("bad.yaml"), std::string::npos);
+  EXPECT_NE(msg("matches_per_signature: -1\n").find("matches_per_signature"), std::string::npos);
 }
 
 }  // namespace

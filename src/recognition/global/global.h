@@ -29,6 +29,15 @@ struct GlobalSettings {
   // "the top five hypotheses" to refinement (section 4.2.1), and "multiple
   // distinguished peaks result in multiple new hypotheses" (section 3.2.4).
   bool top_k_counts_rolls = false;
+  // Matches each scene signature may take part in, before the top_k
+  // overall. 0: every (scene, model) signature pair competes. k > 0: each
+  // scene signature keeps only its k nearest model signatures (in the
+  // match order: distance, then view, model signature). 1 is the thesis's
+  // other reading (section 3.2.4: "For each cluster histogram in each
+  // segment of the scene, a nearest neighbour search is performed among
+  // the model histograms"): one match per scene histogram, so an ESF
+  // cluster gives one hypothesis, from its nearest training view.
+  int matches_per_signature = 0;
   double crh_peak_threshold = 0.3;      // distinct CRH peaks above this fraction of the max
   int crh_max_peaks = 3;                // at most this many roll hypotheses per match
   bool skip_crh = false;                // assume the object upright: roll from the view (Table 4.4)
@@ -67,6 +76,7 @@ struct GlobalSettings {
     f("esf_samples_from_points", s.esf_samples_from_points);
     f("top_k", s.top_k, fields::at_least(1));
     f("top_k_counts_rolls", s.top_k_counts_rolls);
+    f("matches_per_signature", s.matches_per_signature, fields::at_least(0));
     f("crh_peak_threshold", s.crh_peak_threshold, fields::in_range(0, 1));
     f("crh_max_peaks", s.crh_max_peaks, fields::at_least(1));
     f("skip_crh", s.skip_crh);

@@ -7,9 +7,10 @@
 //     method's signatures per cluster (CVFH / OUR-CVFH / CESF: one per stable
 //     region, or, without one, one of the whole cluster; ESF: one per
 //     cluster);
-//  2. match: L2 distance of every scene signature to every model signature;
-//     the top_k pairs overall, ordered by distance, then view, then model
-//     signature, then scene signature (deterministic);
+//  2. match: L2 distance of every scene signature to every model signature
+//     (or, with matches_per_signature k, to its k nearest only); the top_k
+//     pairs overall, ordered by distance, then view, then model signature,
+//     then scene signature (deterministic);
 //  3. initial pose per pair: translation from the centroid difference; two
 //     rotational DoF from aligning the axes (the negated mean normals of the
 //     regions, or the camera-to-centroid directions), the roll about that
@@ -246,23 +247,32 @@ class GlobalMethod : public Method {
     }
     times.describe += timer.seconds();
 
-    // 2. Matching: every pair, the top_k overall.
+    // 2. Matching: every pair (or each scene signature's nearest), the top_k
+    // overall.
     timer.reset();
     struct Match {
       double dist;
       int view, model, scene;
     };
-    std::vector<Match> matches;
-    for (size_t i = 0; i < scene_sigs.size(); ++i)
+    const auto order = [](const Match& a, const Match& b) {
+      return std::tie(a.dist, a.view, a.model, a.scene) < std::tie(b.dist, b.view, b.model, b.scene);
+    };
+    std::vector<Match> matches, own;
+    const size_t per_sig = static_cast<size_t>(g.matches_per_signature);
+    for (size_t i = 0; i < scene_sigs.size(); ++i) {
+      own.clear();
       for (size_t j = 0; j < sigs_.size(); ++j) {
         if (sigs_[j].hist.size() != scene_sigs[i].hist.size()) continue;
         const double d = l2(scene_sigs[i].hist, sigs_[j].hist);
         if (!std::isfinite(d)) continue;
-        matches.push_back({d, sigs_[j].source, static_cast<int>(j), static_cast<int>(i)});
+        own.push_back({d, sigs_[j].source, static_cast<int>(j), static_cast<int>(i)});
       }
-    const auto order = [](const Match& a, const Match& b) {
-      return std::tie(a.dist, a.view, a.model, a.scene) < std::tie(b.dist, b.view, b.model, b.scene);
-    };
+      if (per_sig > 0 && own.size() > per_sig) {  // this signature's nearest only
+        std::partial_sort(own.begin(), own.begin() + static_cast<std::ptrdiff_t>(per_sig), own.end(), order);
+        own.resize(per_sig);
+      }
+      matches.insert(matches.end(), own.begin(), own.end());
+    }
     const size_t k = std::min(matches.size(), static_cast<size_t>(std::max(g.top_k, 1)));
     std::partial_sort(matches.begin(), matches.begin() + k, matches.end(), order);
     matches.resize(k);
