@@ -522,7 +522,11 @@ DIFFERENCES = [
     "Global hypotheses: the top five matches (`global.top_k`) go on, each with up to three CRH roll peaks "
     "(`global.crh_max_peaks`), so up to 15 hypotheses are refined; the thesis passes \"the top five hypotheses\" "
     "to refinement and makes a new hypothesis of each distinguished CRH peak. The rolls ablation counts five "
-    "hypotheses after the CRH instead (`global.top_k_counts_rolls`).",
+    "hypotheses after the CRH instead (`global.top_k_counts_rolls`). The five are the nearest of every "
+    "(scene signature, model signature) pair of the image, so one scene cluster can bring several training views; "
+    "the thesis's section 3.2.4 runs \"a nearest neighbour search\" for each scene histogram among the model "
+    "histograms before keeping the top hypotheses. The nearest ablation keeps each scene signature's nearest model "
+    "signature only (`global.matches_per_signature: 1`).",
     "Times are wall-clock seconds of the online computation of one image (training views excluded: they are "
     "rendered and described once and cached), single-threaded; the load column of the experiments table says "
     "what else ran on the machine.",
