@@ -207,6 +207,24 @@ TEST_F(GlobalMethod, EsfPoseFromNormalsKeepsTheMatchesAndMovesThePoses) {
   EXPECT_FALSE(same(ha, hb));
 }
 
+// global.view_ray_axis: CVFH's and CESF's histograms and match distances
+// stay, their poses move (the camera-to-centroid rays are aligned and the
+// CRH is taken about them).
+TEST_F(GlobalMethod, ViewRayAxisKeepsTheMatchesAndMovesThePoses) {
+  GlobalSettings ray;
+  ray.view_ray_axis = true;
+  for (const char* name : {"cvfh", "cesf"}) {
+    const auto ha = hypotheses(name), hb = hypotheses(name, ray);
+    ASSERT_FALSE(ha.empty()) << name;
+    ASSERT_FALSE(hb.empty()) << name;
+    EXPECT_EQ(ha[0].score, hb[0].score) << name;  // the same best match
+    EXPECT_EQ(ha[0].view, hb[0].view) << name;
+    EXPECT_FALSE(ha[0].T_cam_model.R.isApprox(hb[0].T_cam_model.R, 1e-9)) << name;
+  }
+  // ESF and OUR-CVFH have no normal axis to replace: unchanged.
+  for (const char* name : {"esf", "ourcvfh"}) EXPECT_TRUE(same(hypotheses(name), hypotheses(name, ray))) << name;
+}
+
 TEST_F(GlobalMethod, TopKCountingRollsKeepsTheFirstTopKHypotheses) {
   // top_k 2 matches with up to 3 CRH rolls each; counting the rolls keeps
   // the first 2 of those hypotheses, in the same order.
@@ -296,8 +314,9 @@ TEST(GlobalSettingsYaml, ParsesAndRejects) {
   GlobalSettings g;
   parse_section(YamlNode::load_string("top_k: 7\nskip_crh: true\ncrh_max_peaks: 2\nesf_samples: 5000\n"
                                       "top_k_counts_rolls: true\nesf_samples_from_points: true\n"
-                                      "matches_per_signature: 1\n", "g.yaml"), g);
+                                      "matches_per_signature: 1\nview_ray_axis: true\n", "g.yaml"), g);
   EXPECT_EQ(g.matches_per_signature, 1);
+  EXPECT_TRUE(g.view_ray_axis);
   EXPECT_EQ(g.top_k, 7);
   EXPECT_TRUE(g.esf_samples_from_points);
   EXPECT_TRUE(g.top_k_counts_rolls);

@@ -54,6 +54,14 @@ struct GlobalSettings {
   // every global descriptor. Also CESF's fallback for a cloud without a
   // stable region, which is posed as ESF.
   bool esf_pose_from_normals = false;
+  // CVFH's and CESF's axis (the 2 DoF aligned, and the one the CRH is taken
+  // about). false: the region's negated mean normal, the CRH of the normals
+  // projected onto the plane orthogonal to it. true: the ray from the
+  // camera to the region's centroid, as pcl::CRHEstimation projects the
+  // normals (and the thesis's section 3.2.4: "onto the plane orthogonal to
+  // the vector given by the camera center and the centroid") and
+  // pcl::CRHAlignment aligns the two rays. OUR-CVFH keeps its frames.
+  bool view_ray_axis = false;
   // Added by the global pipeline (PCL's defaults where PCL has the value):
   double cvfh_normal_radius_mm = 20.0;  // normals recomputed on the low-curvature points (CVFH, CESF)
   bool cvfh_normalize_bins = false;     // CVFH bins count points (thesis, PCL default); true: percentages
@@ -82,6 +90,7 @@ struct GlobalSettings {
     f("skip_crh", s.skip_crh);
     f("cesf_whole_cluster", s.cesf_whole_cluster);
     f("esf_pose_from_normals", s.esf_pose_from_normals);
+    f("view_ray_axis", s.view_ray_axis);
     f("cvfh_normal_radius_mm", s.cvfh_normal_radius_mm, fields::length(fields::positive()));
     f("cvfh_normalize_bins", s.cvfh_normalize_bins);
     f("crh_peak_distance_deg", s.crh_peak_distance_deg, fields::nonnegative(180, " degrees"));

@@ -90,8 +90,23 @@ std::vector<float> whole_cloud_esf(const PointSet& cloud, const GlobalSettings& 
   return compute_esf(cloud.points, rng, global::esf_triples(g, cloud.points.size()));
 }
 
-// The method's signatures of one cloud (a training view or a scene cluster).
+std::vector<Signature> signatures(Kind kind, const PointSet& cloud, const GlobalSettings& g, uint64_t seed);
+
+// The method's signatures of one cloud (a training view or a scene cluster),
+// with view_ray_axis the camera-to-centroid ray for an axis taken from a
+// mean normal (CVFH, CESF).
 std::vector<Signature> describe(Kind kind, const PointSet& cloud, const GlobalSettings& g, uint64_t seed) {
+  std::vector<Signature> out = signatures(kind, cloud, g, seed);
+  if (g.view_ray_axis && (kind == Kind::kCvfh || kind == Kind::kCesf))
+    for (Signature& s : out)
+      if (s.from_normal && s.centroid.norm() > 0) {
+        s.axis = s.centroid.normalized();
+        s.from_normal = false;
+      }
+  return out;
+}
+
+std::vector<Signature> signatures(Kind kind, const PointSet& cloud, const GlobalSettings& g, uint64_t seed) {
   std::vector<Signature> out;
   switch (kind) {
     case Kind::kCvfh:
@@ -119,7 +134,7 @@ std::vector<Signature> describe(Kind kind, const PointSet& cloud, const GlobalSe
       // No stable region large enough: as CVFH (pcl::CVFHEstimation falls
       // back to the VFH of all the cloud's points), the ESF of the whole
       // cloud, posed like ESF's (centroid, camera-to-centroid axis).
-      if (regions.empty()) return describe(Kind::kEsf, cloud, g, seed);
+      if (regions.empty()) return signatures(Kind::kEsf, cloud, g, seed);
       // cesf_whole_cluster: one ESF of the whole cloud, shared by every
       // region's signature.
       const std::vector<float> whole = g.cesf_whole_cluster ? whole_cloud_esf(cloud, g, seed) : std::vector<float>{};
