@@ -526,7 +526,10 @@ DIFFERENCES = [
     "(scene signature, model signature) pair of the image, so one scene cluster can bring several training views; "
     "the thesis's section 3.2.4 runs \"a nearest neighbour search\" for each scene histogram among the model "
     "histograms before keeping the top hypotheses. The nearest ablation keeps each scene signature's nearest model "
-    "signature only (`global.matches_per_signature: 1`).",
+    "signature only (`global.matches_per_signature: 1`). CVFH's and CESF's initial pose aligns the regions' "
+    "negated mean normals and takes the CRH about them, where pcl::CRHEstimation (and the thesis's CRH text) "
+    "projects the normals about the camera-to-centroid ray; the rayaxis ablation uses that ray "
+    "(`global.view_ray_axis`).",
     "Times are wall-clock seconds of the online computation of one image (training views excluded: they are "
     "rendered and described once and cached), single-threaded; the load column of the experiments table says "
     "what else ran on the machine.",
