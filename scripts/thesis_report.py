@@ -498,7 +498,9 @@ DIFFERENCES = [
     "Table 4.9 and Figure 4.12: the thesis refined the hypotheses that some recognition method had made converge; "
     "here each method refines the ground-truth pose perturbed by a seeded random rotation and translation "
     "(`perturb_deg`, `perturb_mm` in the config: 15 degrees and 50 mm). The start ablation runs Table 4.9 from "
-    "30 degrees and 100 mm.",
+    "30 degrees and 100 mm. Registration keeps reciprocal nearest pairs within 0.1 d in a crop of the scene "
+    "around the hypothesis (ICP, ICP-LM, ICP-plane), where pcl::IterativeClosestPoint, which the thesis used, "
+    "pairs every point with its nearest at any distance in the whole target; the pclicp ablation runs it so.",
     "Figures 4.7 and 4.11: the thesis used one model view for CVFH/CESF and 12 for SHOT/FPFH. An experiment has "
     "one view count per scene set, so each figure is two experiments (`_global`, `_local`), drawn in one plot. "
     "The scenes are rendered without sensor noise and the noise of each level is added per trial.",
