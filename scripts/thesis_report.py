@@ -526,7 +526,7 @@ DIFFERENCES = [
     "to refinement and makes a new hypothesis of each distinguished CRH peak. The rolls ablation counts five "
     "hypotheses after the CRH instead (`global.top_k_counts_rolls`). The five are the nearest of every "
     "(scene signature, model signature) pair of the image, so one scene cluster can bring several training views; "
-    "the thesis's section 3.2.4 runs \"a nearest neighbour search\" for each scene histogram among the model "
+    "the thesis's section 3.2.3 runs \"a nearest neighbour search\" for each scene histogram among the model "
     "histograms before keeping the top hypotheses. The nearest ablation keeps each scene signature's nearest model "
     "signature only (`global.matches_per_signature: 1`). CVFH's and CESF's initial pose aligns the regions' "
     "negated mean normals and takes the CRH about them, where pcl::CRHEstimation (and the thesis's CRH text) "

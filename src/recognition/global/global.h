@@ -33,7 +33,7 @@ struct GlobalSettings {
   // overall. 0: every (scene, model) signature pair competes. k > 0: each
   // scene signature keeps only its k nearest model signatures (in the
   // match order: distance, then view, model signature). 1 is the thesis's
-  // other reading (section 3.2.4: "For each cluster histogram in each
+  // other reading (section 3.2.3: "For each cluster histogram in each
   // segment of the scene, a nearest neighbour search is performed among
   // the model histograms"): one match per scene histogram, so an ESF
   // cluster gives one hypothesis, from its nearest training view.
