@@ -267,10 +267,11 @@ TEST_F(GlobalMethod, MatchesPerSignatureKeepsEachSceneSignaturesNearest) {
   const auto hc = hypotheses("cvfh", nearest), hd = hypotheses("cvfh");
   ASSERT_FALSE(hc.empty());
   EXPECT_TRUE(same({hc[0]}, {hd[0]}));
-  // 0 is every pair (the default).
+  // A k no signature reaches keeps every pair: the default's hypotheses.
   GlobalSettings all;
-  all.matches_per_signature = 0;
+  all.matches_per_signature = 100000;
   EXPECT_TRUE(same(hypotheses("cvfh", all), hd));
+  EXPECT_TRUE(same(hypotheses("esf", all), ha));
 }
 
 TEST_F(GlobalMethod, EsfSamplesFromPointsDrawsOneTriplePerPoint) {
