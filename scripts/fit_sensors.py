@@ -19,9 +19,17 @@ generate` and measured identically, and the model parameters are searched:
     mean squared log ratio of simulated to real noise per depth bin; then
     max_incidence_deg over a grid minimizing the squared differences of the
     missing rate per incidence-angle bin.
-  time of flight: only when sources.json lists time-of-flight frames;
-    otherwise SENSOR's file records that it is not calibrated and why, with
-    the simulated statistics of the current model.
+  time of flight: sigma_base_mm and sigma_per_m2_mm scaled together by one
+    factor (the literature's shape of the noise over depth kept: the real
+    frames have enough planar patches only from 0.5 to 1.25 m to fix its
+    level, not its growth), over a grid minimizing the noise loss above on
+    the bins with at least TOF_MIN_PATCHES real patches; then
+    flying_fraction and edge_filter_span_mm over a grid minimizing the
+    squared differences of the flying (mixed-pixel) rate per depth bin,
+    weighted by the real triplets of the bin (bins with at least
+    TOF_MIN_TRIPLETS); then max_incidence_deg as for structured light.
+    Without time-of-flight frames in sources.json, SENSOR's file records
+    that it is not calibrated, with the simulated statistics of the model.
 Writes OUT/fit_SENSOR.json (provenance, real statistics, every evaluated
 candidate, the fitted parameters, the simulated statistics before and after)
 and OUT/fit_SENSOR.png. Deterministic: fixed scene seeds, no other
@@ -54,14 +62,16 @@ OLD_DEFAULTS = {
     "astra": {"model": "structured_light", "baseline_mm": 75.0, "disparity_step_px": 0.125,
               "disparity_sigma_px": 0.05, "smoothing_radius_px": 1, "smoothing_edge_px": 1.0,
               "max_incidence_deg": 75.0, "shadows": True},
-    # not fitted (no real frames): its current model, with the driver's edge
-    # filter (results/sensors/README.md)
+    # the model before its fit: literature noise, every edge pixel mixed, the
+    # driver's edge filter (results/sensors/README.md)
     "kinect_one": {"model": "tof", "sigma_base_mm": 1.5, "sigma_per_m2_mm": 0.75, "edge_jump_mm": 30.0,
                    "flying_fraction": 1.0, "max_incidence_deg": 80.0, "driver_edge_filter": True,
                    "edge_filter_close_mm": 50.0, "edge_filter_far_mm": 30.0, "edge_filter_span_mm": 100.0},
 }
 NOISE_BINS = (500.0, 4000.0)  # depth range the noise is fitted over
 QUANT_MIN_Z = 1500.0          # below, the real sensor's 1 mm output rounding hides the step
+TOF_MIN_PATCHES = 200         # time of flight: noise bins with fewer real patches are clutter, not planes
+TOF_MIN_TRIPLETS = 100        # time of flight: flying-rate bins with fewer real edge triplets are left out
 
 
 def load_sources(path, sensor):
@@ -75,7 +85,7 @@ def measure_real(sources, data_dir):
     for s in sources:
         path = os.path.join(data_dir, s["local"])
         print("real: %s  <- %s %s @ %s (%s)" % (s["local"], s["repo"], s["path"], s["commit"][:12], s["sensor"]))
-        depth, K, lum = sensor_io.read_pcd_depth(path, luminance=True)
+        depth, K, lum = sensor_io.read_frame(path, s)
         stats.add(depth, K, luminance=lum, geometry_only=s.get("role") == "geometry")
     return stats
 
@@ -126,6 +136,26 @@ def incidence_loss(sim, real):
     return sum((x - y) ** 2 for x, y in zip(a, b) if x is not None and y is not None)
 
 
+def noise_loss_min_patches(sim, real, min_patches):
+    """noise_loss over the bins with at least min_patches real patches."""
+    kept = dict(real, noise_mm=dict(real["noise_mm"], median=[
+        m if n >= min_patches else None for m, n in zip(real["noise_mm"]["median"], real["noise_mm"]["patches"])]))
+    return noise_loss(sim, kept)
+
+
+def flying_loss(sim, real, min_triplets):
+    """Squared differences of the flying rate per depth bin, weighted by the
+    real triplets, over the bins with at least min_triplets real triplets (a
+    bin the simulation has no rate for counts as rate 0)."""
+    num = den = 0.0
+    for s, r, n in zip(sim["flying"]["rate"], real["flying"]["rate"], real["flying"]["triplets"]):
+        if r is None or n < min_triplets:
+            continue
+        num += n * ((s or 0.0) - r) ** 2
+        den += n
+    return num / den if den else float("inf")
+
+
 def quant_per_z2(summary):
     """Median over bins (centre z >= QUANT_MIN_Z) of step / z^2, in 1/mm."""
     vals = [q / ((lo + hi) / 2) ** 2 for (lo, hi), q in zip(summary["bins_mm"], summary["quant_step_mm"]["median"])
@@ -170,15 +200,38 @@ def fit_astra(real, posebench, quick):
     return fitted, {"quant_step_per_z2_per_mm": q, "noise_search": table, "incidence_search": table_a}
 
 
-def plot(path, title, series):
-    """Noise, quantization, missing per depth and missing per incidence angle
-    of each (summary, label, colour, marker) in `series`."""
+def fit_tof(real, posebench, quick):
+    images = 6 if quick else 12
+    base = dict(OLD_DEFAULTS["kinect_one"])
+    evaluate = lambda c: simulate("kinect_one", dict(base, **c), posebench, images)  # noqa: E731
+    scales = (0.5, 0.75, 1.0) if quick else (0.4, 0.5, 0.55, 0.6, 0.65, 0.7, 0.8, 0.9, 1.0, 1.2)
+    noise = [{"sigma_base_mm": round(base["sigma_base_mm"] * k, 4),
+              "sigma_per_m2_mm": round(base["sigma_per_m2_mm"] * k, 4)} for k in scales]
+    best, table = search("noise", noise, evaluate, lambda s: noise_loss_min_patches(s, real, TOF_MIN_PATCHES))
+    edges = [{"flying_fraction": f, "edge_filter_span_mm": span}
+             for f in ((0.5, 1.0) if quick else (0.25, 0.5, 0.75, 1.0))
+             for span in ((100.0, 200.0) if quick else (100.0, 150.0, 200.0, 300.0))]
+    best_e, table_e = search("edges", edges, lambda c: evaluate(dict(best, **c)),
+                             lambda s: flying_loss(s, real, TOF_MIN_TRIPLETS))
+    angles = [{"max_incidence_deg": a} for a in ((75, 85, 90) if quick else (75, 78, 80, 82, 84, 86, 88, 90))]
+    best_a, table_a = search("incidence", angles, lambda c: evaluate(dict(best, **best_e, **c)),
+                             lambda s: incidence_loss(s, real))
+    fitted = dict(base, **best, **best_e, **best_a)
+    return fitted, {"noise_search": table, "edge_search": table_e, "incidence_search": table_a}
+
+
+def plot(path, title, series, flying=False):
+    """Noise, quantization (flying: the mixed-pixel rate at edges instead),
+    missing per depth and missing per incidence angle of each (summary,
+    label, colour, marker) in `series`."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(2, 2, figsize=(11, 8))
     z = [(lo + hi) / 2 for lo, hi in series[0][0]["bins_mm"]]
     panels = [(ax[0, 0], lambda s: s["noise_mm"]["median"], "noise: plane-fit residual RMS (mm)", True),
+              (ax[0, 1], lambda s: s["flying"]["rate"], "flying (mixed) pixels among edge triplets", False)
+              if flying else
               (ax[0, 1], lambda s: s["quant_step_mm"]["median"], "quantization step (mm)", True),
               (ax[1, 0], lambda s: s["missing"]["rate"], "missing fraction (8x8 blocks)", False)]
     for a, get, ylabel, log in panels:
@@ -235,16 +288,22 @@ def main(argv=None):
         real_stats = measure_real(sources, args.data)
         real = real_stats.summary()
         report["real"] = real
-        if args.sensor != "astra":
-            raise SystemExit("fitting %s is not implemented" % args.sensor)
-        fitted, search_log = fit_astra(real, args.posebench, args.quick)
+        fit = fit_astra if args.sensor == "astra" else fit_tof
+        fitted, search_log = fit(real, args.posebench, args.quick)
         report["status"] = "calibrated"
         report["fitted_noise"] = fitted
         report["search"] = search_log
         report["simulated_fitted"] = simulate(args.sensor, fitted, args.posebench, final_images, final_seed)
-        report["loss"] = {"noise_old": noise_loss(before, real), "noise_fitted": noise_loss(report["simulated_fitted"], real),
+        after = report["simulated_fitted"]
+        report["loss"] = {"noise_old": noise_loss(before, real), "noise_fitted": noise_loss(after, real),
                           "incidence_old": incidence_loss(before, real),
-                          "incidence_fitted": incidence_loss(report["simulated_fitted"], real)}
+                          "incidence_fitted": incidence_loss(after, real)}
+        if args.sensor == "kinect_one":
+            report["loss"].update({
+                "noise_fitted_bins_old": noise_loss_min_patches(before, real, TOF_MIN_PATCHES),
+                "noise_fitted_bins_fitted": noise_loss_min_patches(after, real, TOF_MIN_PATCHES),
+                "flying_old": flying_loss(before, real, TOF_MIN_TRIPLETS),
+                "flying_fitted": flying_loss(after, real, TOF_MIN_TRIPLETS)})
         print("fitted: %s" % noise_yaml(fitted))
     os.makedirs(args.out, exist_ok=True)
     out = os.path.join(args.out, "fit_%s.json" % args.sensor)
@@ -256,7 +315,7 @@ def main(argv=None):
     if real:
         series.append((report["simulated_fitted"], "simulated, fitted", "tab:blue", "s"))
     plot(os.path.join(args.out, "fit_%s.png" % args.sensor), "%s: real vs simulated depth statistics" % args.sensor,
-         series)
+         series, flying=args.sensor == "kinect_one")
     print("wrote " + out)
 
 

@@ -3,6 +3,7 @@
 local git snapshots of their repositories (never committed here):
 
     python3 scripts/sensor_data.py --mirrors DIR --out DATA [--sources FILE]
+        [--kind structured_light|time_of_flight]
 
 DIR holds one bare git directory per repository, DIR/OWNER+NAME/repo (the
 layout the project's snapshot tool writes); each frame is `git show
@@ -20,10 +21,13 @@ def main(argv=None):
     ap.add_argument("--mirrors", required=True)
     ap.add_argument("--out", required=True)
     ap.add_argument("--sources", default=os.path.join(ROOT, "results", "sensors", "sources.json"))
+    ap.add_argument("--kind", help="only the frames of this kind (a sensor's fit needs only its own)")
     args = ap.parse_args(argv)
     with open(args.sources) as f:
         frames = json.load(f)["frames"]
     for fr in frames:
+        if args.kind and fr["kind"] != args.kind:
+            continue
         git_dir = os.path.join(args.mirrors, fr["repo"].replace("/", "+"), "repo")
         dest = os.path.join(args.out, fr["local"])
         os.makedirs(os.path.dirname(dest), exist_ok=True)

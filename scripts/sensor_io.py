@@ -6,6 +6,9 @@ as a depth image in mm (0 = no measurement) with pinhole intrinsics.
     read_pcd_depth(path)  -> (depth_mm, K)   K = dict(fx, fy, cx, cy)
     read_png_depth(path, depth_scale, K) -> (depth_mm, K)
     read_bop_depth(scene_dir, im_id) -> (depth_mm, K) from scene_camera.json
+    read_txt_depth(path, width, height, K) -> (depth_mm, K)
+    read_frame(path, source) -> (depth_mm, K, luminance or None) as
+        results/sensors/sources.json describes the frame
 
 An organized PCD holds x, y, z per pixel (m; NaN where no depth). Its
 intrinsics are recovered by least squares from x = (u - cx) z / fx and
@@ -161,6 +164,35 @@ def read_png_depth(path, depth_scale, K):
     from PIL import Image
     a = np.array(Image.open(path)).astype(np.float64)
     return a * depth_scale, dict(K)
+
+
+def read_txt_depth(path, width, height, K):
+    """(depth_mm, K) of a depth image written as text, one value per line (mm,
+    0 = no depth), row by row: how the Kinect v2 SDK's depth buffer
+    (CopyFrameDataToArray) is dumped by a loop over it. The file holds no
+    intrinsics; K is given."""
+    with open(path) as f:
+        vals = [ln.strip() for ln in f if ln.strip()]
+    if len(vals) != width * height:
+        raise ValueError("%s: %d values, %d x %d = %d expected" % (path, len(vals), width, height, width * height))
+    depth = np.array(vals, dtype=np.float64).reshape(height, width)
+    if not np.all(np.isfinite(depth)) or (depth < 0).any():
+        raise ValueError("%s: negative or non-finite depth" % path)
+    return depth, dict(K)
+
+
+def read_frame(path, source):
+    """(depth_mm, K, luminance or None) of a real frame listed in
+    results/sensors/sources.json: `format` pcd (the default: an organized
+    PCD, intrinsics recovered from it) or txt (read_txt_depth with the
+    entry's width, height and intrinsics)."""
+    fmt = source.get("format", "pcd")
+    if fmt == "pcd":
+        return read_pcd_depth(path, luminance=True)
+    if fmt == "txt":
+        depth, K = read_txt_depth(path, source["width"], source["height"], source["intrinsics"])
+        return depth, K, None
+    raise ValueError("%s: unknown frame format %r" % (path, fmt))
 
 
 def read_bop_depth(scene_dir, im_id):

@@ -452,12 +452,13 @@ DIFFERENCES = [
     "they are simulated sensors (`astra`, `kinect_one`) rendering generated table scenes with ground truth. The "
     "`astra` model is calibrated on real structured-light frames (noise, depth steps and grazing-angle losses per "
     "distance: `results/sensors/`); it does not lose data on dark or shiny surfaces as real sensors do. The "
-    "`kinect_one` model is not calibrated (no public raw time-of-flight frames were found): distance-dependent "
-    "noise, and mixed (\"flying\") pixels at every depth edge of more than 30 mm, of which the driver's edge "
-    "filter drops those in the middle of a large jump, as the Kinect One's driver does (libfreenect2's "
-    "`EnableEdgeAwareFilter`, on by default; `TimeOfFlightNoise` in `src/render/sensor.h`). The sensor ablation "
-    "runs the Astra rows with the model before its calibration; the edges ablation runs the Kinect One rows "
-    "without mixed pixels.",
+    "`kinect_one` model is calibrated on two real Kinect v2 frames (its noise level and its mixed (\"flying\") "
+    "pixels at depth edges: `results/sensors/`): distance-dependent noise, and mixed pixels at three in four "
+    "pixels next to a depth edge of more than 30 mm, of which the driver's edge filter drops those in the middle "
+    "of a large jump, as the Kinect One's driver does (libfreenect2's `EnableEdgeAwareFilter`, on by default; "
+    "`TimeOfFlightNoise` in `src/render/sensor.h`); it loses far less data than the real frames, near edges and "
+    "away from them. The sensor ablation runs the Astra rows with the model before its calibration, the tof "
+    "ablation the Kinect One rows with theirs; the edges ablation runs the Kinect One rows without mixed pixels.",
     "Occlusion: the thesis's occluded sets had \"some small amount of occlusion\"; here the target is 70-95% "
     "visible in them (`occlusion.visib_fract` in the thesis configs). The occlusion ablation runs them at 40-90%, "
     "the set-up before issue 10.",

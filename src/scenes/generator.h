@@ -106,8 +106,9 @@ struct GenerateSummary {
 // config in its --scenes folder, generates the set again instead of reusing
 // an old one. 1 = the sets made before it existed; 2 = the astra sensor
 // calibrated on real frames (results/sensors/fit_astra.json); 3 = the
-// kinect_one sensor's driver edge filter (TimeOfFlightNoise).
-constexpr int kSceneSetVersion = 3;
+// kinect_one sensor's driver edge filter (TimeOfFlightNoise); 4 = the
+// kinect_one sensor calibrated on real frames (results/sensors/fit_kinect_one.json).
+constexpr int kSceneSetVersion = 4;
 
 // Generates the whole scene set into `out_dir` (BOP layout, see README):
 // written to `out_dir.partial` and renamed into place at the end, so an

@@ -6,6 +6,7 @@ about 2 mm, a depth quantized to 4 mm steps measures 4 mm steps, and so on.
 They need numpy. Where the interpreter running the suite has none but
 Debian's /usr/bin/python3 has (the project installs python3-numpy), the
 whole module is run again under /usr/bin/python3 and must pass there."""
+import math
 import os
 import struct
 import subprocess
@@ -161,6 +162,52 @@ class Io(unittest.TestCase):
         self.assertAlmostEqual(Kr["fx"], 525.0, places=2)
         self.assertAlmostEqual(Kr["cx"], 3.5, places=3)
         self.assertAlmostEqual(Kr["cy"], 2.5, places=3)
+
+    def test_txt_depth_frame_row_by_row_and_its_errors(self):
+        src = {"format": "txt", "width": 3, "height": 2, "intrinsics": {"fx": 365.0, "fy": 365.0, "cx": 1.0,
+                                                                          "cy": 0.5}}
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "d.txt")
+            with open(path, "w") as f:
+                f.write("0\n1000\n1001\n1500\n1501\n1502\n")
+            depth, Kr, lum = sensor_io.read_frame(path, src)
+            self.assertEqual(depth.shape, (2, 3))
+            self.assertEqual(depth[0, 0], 0.0)
+            self.assertEqual(depth[0, 2], 1001.0)
+            self.assertEqual(depth[1, 0], 1500.0)
+            self.assertEqual(Kr["fx"], 365.0)
+            self.assertIsNone(lum)
+            with open(path, "w") as f:
+                f.write("1\n2\n3\n")
+            with self.assertRaisesRegex(ValueError, "3 values, 3 x 2 = 6 expected"):
+                sensor_io.read_frame(path, src)
+            with self.assertRaisesRegex(ValueError, "unknown frame format"):
+                sensor_io.read_frame(path, dict(src, format="png16"))
+
+
+@unittest.skipIf(np is None, "numpy missing here (run under /usr/bin/python3 by NumpyElsewhere)")
+class FitLosses(unittest.TestCase):
+    """scripts/fit_sensors.py's time-of-flight losses."""
+
+    def setUp(self):
+        import fit_sensors
+        self.fit = fit_sensors
+
+    def test_flying_loss_weights_bins_by_real_triplets_and_skips_thin_ones(self):
+        real = {"flying": {"rate": [0.9, 0.3, 0.0, None], "triplets": [50, 300, 100, 0]}}
+        sim = {"flying": {"rate": [0.0, 0.2, None, 0.5]}}
+        # bin 0 has 50 < 100 triplets: left out; bin 2 without a simulated rate counts as 0
+        expected = (300 * 0.1 ** 2 + 100 * 0.0) / 400
+        self.assertAlmostEqual(self.fit.flying_loss(sim, real, 100), expected)
+        self.assertEqual(self.fit.flying_loss(sim, real, 1000), float("inf"))
+
+    def test_noise_loss_over_bins_with_enough_real_patches(self):
+        bins = [[500.0, 750.0], [750.0, 1000.0], [1000.0, 1250.0]]
+        real = {"bins_mm": bins, "noise_mm": {"median": [1.0, 1.0, 5.0], "patches": [300, 300, 50]}}
+        sim = {"noise_mm": {"median": [2.0, 1.0, 1.0]}}
+        # the 50-patch bin (clutter, noise 5 mm) is left out: mean of ln(2)^2 and 0
+        self.assertAlmostEqual(self.fit.noise_loss_min_patches(sim, real, 200), math.log(2) ** 2 / 2)
+        self.assertAlmostEqual(self.fit.noise_loss(sim, real), (math.log(2) ** 2 + math.log(5) ** 2) / 3)
 
 
 @unittest.skipIf(np is not None or not os.path.exists(SYSTEM_PYTHON), "numpy importable here")
