@@ -88,7 +88,10 @@ std::string experiment_yaml(const std::string& name, const AdviseOptions& opt, c
     << "scenes:\n  - name: advise\n    generate: scene.yaml\n    scenario: table\n"
     << "descriptors: " << list(descriptors) << "\nrefinements: " << list(refinements) << "\n"
     << "grid:\n  scale.length_factor: " << list(factors) << "\n"
-    << "settings:\n  preprocess: {max_range_mm: " << num(in.max_range_mm) << "}\n"
+    << "settings:\n  preprocess: {max_range_mm: " << num(in.max_range_mm)
+    << (in.veil_angle_deg > 0 ? ", veil_angle_deg: " + num(in.veil_angle_deg) +
+                                    "}   # time of flight: drop the mixed pixels at depth edges first\n"
+                              : "}\n")
     << "thresholds: {table_translation_mm: " << num(in.translation_mm) << "}   # a quarter of the diameter\n"
     << "timeout_s: 300\n";
   return y.str();
@@ -201,6 +204,7 @@ AdviceInputs write_advice_inputs(const AdviseOptions& opt, const std::string& ou
                                            " mm, too small to recognize. Is the file in mm? (--mesh-scale)");
   in.max_range_mm = hi + 2 * d;
   in.translation_mm = 0.25 * d;
+  in.veil_angle_deg = sensor.noise.model == "tof" ? 10.0 : 0.0;
 
   fs::create_directories(out_dir);
   atomic_write_text(out_dir + "/models.yaml", registry_yaml(opt, in.object, extent));

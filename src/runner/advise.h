@@ -43,6 +43,11 @@ struct AdviceInputs {
   double diameter_mm = 0;
   double max_range_mm = 0;     // preprocess.max_range_mm of the experiment
   double translation_mm = 0;   // the translation threshold: a quarter of the diameter
+  // preprocess.veil_angle_deg of the experiment: 10 for a time-of-flight
+  // sensor (its mixed pixels at depth edges join an object to what stands
+  // close before it: results/thesis/FINDINGS.md, "The Kinect One calibrated
+  // on real frames"), else 0 (off)
+  double veil_angle_deg = 0;
   std::vector<std::string> warnings;  // e.g. the mesh looks symmetric
 };
 AdviceInputs write_advice_inputs(const AdviseOptions& opt, const std::string& out_dir);
