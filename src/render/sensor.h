@@ -69,9 +69,11 @@ struct StructuredLightNoise {
 // frames (results/sensors/fit_kinect_one.json, results/sensors/README.md):
 // the noise's level (the literature's 1.5 + 0.75 (z/1 m)^2 mm scaled by 0.55;
 // the frames fix it from 0.5 to 1.25 m only), flying_fraction and
-// edge_filter_span_mm (the mixed-pixel rate at edges of the static table
-// frame), max_incidence_deg (unchanged by the fit). edge_jump_mm and the
-// filter's two other thresholds keep their literature / driver values.
+// edge_filter_span_mm (to the mixed-pixel rate at edges of the static table
+// frame, which does not determine them: 0.5-1 and 100-150 mm fit it alike,
+// and the search's seed decides), max_incidence_deg (unchanged by the fit).
+// edge_jump_mm and the filter's two other thresholds keep their literature /
+// driver values.
 struct TimeOfFlightNoise {
   double sigma_base_mm = 0.825;      // sigma = base + per_m2 * (z/1000)^2 (fitted: 0.55 x the literature's 1.5)
   double sigma_per_m2_mm = 0.4125;   // growth of sigma per squared metre of depth (0.55 x 0.75)
