@@ -30,6 +30,8 @@ generate` and measured identically, and the model parameters are searched:
     TOF_MIN_TRIPLETS); then max_incidence_deg as for structured light.
     Without time-of-flight frames in sources.json, SENSOR's file records
     that it is not calibrated, with the simulated statistics of the model.
+Frames of role holdout are not fitted to: their statistics are written
+beside the fit's ("holdout") to check it on data it did not see.
 Writes OUT/fit_SENSOR.json (provenance, real statistics, every evaluated
 candidate, the fitted parameters, the simulated statistics before and after)
 and OUT/fit_SENSOR.png. Deterministic: fixed scene seeds, no other
@@ -75,9 +77,12 @@ TOF_MIN_TRIPLETS = 100        # time of flight: flying-rate bins with fewer real
 
 
 def load_sources(path, sensor):
+    """The frames of SENSOR's kind that the fit uses (role full or geometry)
+    and those it leaves out to check it against (role holdout)."""
     with open(path) as f:
         src = json.load(f)
-    return [s for s in src["frames"] if s["kind"] == KIND[sensor]]
+    mine = [s for s in src["frames"] if s["kind"] == KIND[sensor]]
+    return [s for s in mine if s.get("role") != "holdout"], [s for s in mine if s.get("role") == "holdout"]
 
 
 def measure_real(sources, data_dir):
@@ -270,7 +275,7 @@ def main(argv=None):
     ap.add_argument("--out", default=os.path.join(ROOT, "results", "sensors"))
     ap.add_argument("--quick", action="store_true", help="fewer images and candidates (a smoke run)")
     args = ap.parse_args(argv)
-    sources = load_sources(args.sources, args.sensor)
+    sources, holdout = load_sources(args.sources, args.sensor)
     report = {"sensor": args.sensor, "kind": KIND[args.sensor], "sources": sources,
               "measurement": {k: getattr(sensor_stats, k) for k in
                               ("P", "JUMP_REL", "JUMP_MM", "B", "EDGE_R", "EDGE_REL", "EDGE_MM", "MIN_LEVELS")}}
@@ -305,12 +310,16 @@ def main(argv=None):
                 "flying_old": flying_loss(before, real, TOF_MIN_TRIPLETS),
                 "flying_fitted": flying_loss(after, real, TOF_MIN_TRIPLETS)})
         print("fitted: %s" % noise_yaml(fitted))
+        if holdout:  # frames the fit did not see: their statistics beside the fit's
+            report["holdout"] = measure_real(holdout, args.data).summary()
     os.makedirs(args.out, exist_ok=True)
     out = os.path.join(args.out, "fit_%s.json" % args.sensor)
     with open(out, "w") as f:
         json.dump(report, f, indent=1)
         f.write("\n")
     series = [(real, "real", "k", "o")] if real else []
+    if report.get("holdout"):
+        series.append((report["holdout"], "real, held out (not fitted)", "0.55", "D"))
     series.append((before, "simulated, " + before_label, "tab:red", "x"))
     if real:
         series.append((report["simulated_fitted"], "simulated, fitted", "tab:blue", "s"))

@@ -184,13 +184,17 @@ def read_txt_depth(path, width, height, K):
 def read_frame(path, source):
     """(depth_mm, K, luminance or None) of a real frame listed in
     results/sensors/sources.json: `format` pcd (the default: an organized
-    PCD, intrinsics recovered from it) or txt (read_txt_depth with the
-    entry's width, height and intrinsics)."""
+    PCD, intrinsics recovered from it), txt (read_txt_depth with the entry's
+    width, height and intrinsics) or png (a 16-bit depth PNG, value x the
+    entry's depth_scale, default 1, = mm; the entry's intrinsics)."""
     fmt = source.get("format", "pcd")
     if fmt == "pcd":
         return read_pcd_depth(path, luminance=True)
     if fmt == "txt":
         depth, K = read_txt_depth(path, source["width"], source["height"], source["intrinsics"])
+        return depth, K, None
+    if fmt == "png":
+        depth, K = read_png_depth(path, source.get("depth_scale", 1.0), source["intrinsics"])
         return depth, K, None
     raise ValueError("%s: unknown frame format %r" % (path, fmt))
 

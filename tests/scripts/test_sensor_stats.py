@@ -6,6 +6,7 @@ about 2 mm, a depth quantized to 4 mm steps measures 4 mm steps, and so on.
 They need numpy. Where the interpreter running the suite has none but
 Debian's /usr/bin/python3 has (the project installs python3-numpy), the
 whole module is run again under /usr/bin/python3 and must pass there."""
+import json
 import math
 import os
 import struct
@@ -184,6 +185,19 @@ class Io(unittest.TestCase):
             with self.assertRaisesRegex(ValueError, "unknown frame format"):
                 sensor_io.read_frame(path, dict(src, format="png16"))
 
+    def test_png_depth_frame_with_its_scale(self):
+        from PIL import Image
+        a = np.array([[0, 1000, 1001], [1500, 1501, 1502]], dtype=np.uint16)
+        src = {"format": "png", "depth_scale": 0.5, "intrinsics": {"fx": 365.0, "fy": 365.0, "cx": 1.0, "cy": 0.5}}
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "d.png")
+            Image.fromarray(a).save(path)
+            depth, Kr, lum = sensor_io.read_frame(path, src)
+        self.assertEqual(depth[0, 0], 0.0)
+        self.assertEqual(depth[1, 2], 751.0)
+        self.assertEqual(Kr["cx"], 1.0)
+        self.assertIsNone(lum)
+
 
 @unittest.skipIf(np is None, "numpy missing here (run under /usr/bin/python3 by NumpyElsewhere)")
 class FitLosses(unittest.TestCase):
@@ -200,6 +214,19 @@ class FitLosses(unittest.TestCase):
         expected = (300 * 0.1 ** 2 + 100 * 0.0) / 400
         self.assertAlmostEqual(self.fit.flying_loss(sim, real, 100), expected)
         self.assertEqual(self.fit.flying_loss(sim, real, 1000), float("inf"))
+
+    def test_held_out_frames_are_kept_apart(self):
+        frames = {"frames": [{"kind": "time_of_flight", "role": "full", "local": "a"},
+                             {"kind": "time_of_flight", "role": "holdout", "local": "b"},
+                             {"kind": "structured_light", "role": "full", "local": "c"},
+                             {"kind": "time_of_flight", "role": "geometry", "local": "d"}]}
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "sources.json")
+            with open(path, "w") as f:
+                json.dump(frames, f)
+            fitted, held = self.fit.load_sources(path, "kinect_one")
+        self.assertEqual([f["local"] for f in fitted], ["a", "d"])
+        self.assertEqual([f["local"] for f in held], ["b"])
 
     def test_noise_loss_over_bins_with_enough_real_patches(self):
         bins = [[500.0, 750.0], [750.0, 1000.0], [1000.0, 1250.0]]
