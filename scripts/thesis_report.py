@@ -1454,6 +1454,16 @@ def section_ablations(res, ablations, cells, path):
         o.append("Unexplained (ours vs the thesis): " + "; ".join(
             "%s %s %s %s vs %s" % (short_title(c.experiment), c.scenario, c.method, pct(c.ours), pct(c.thesis))
             for c, _ in unexplained) + ".\n")
+        chance = [c for c, _ in unexplained if c.p is not None and c.p >= 0.05]
+        sig = len(unexplained) - len(chance)
+        o.append("Of the %d unexplained, %d %s from the thesis's count at p < 0.05 (Fisher's exact test at the "
+                 "thesis's n, as the scorecard) and %d %s not: %s. A gap of the second kind can be chance at these "
+                 "sample sizes; it still counts as unexplained.\n" % (
+                     len(unexplained), sig, "differs" if sig == 1 else "differ", len(chance),
+                     "does" if len(chance) == 1 else "do",
+                     "; ".join("%s %s %s %d/%d vs %s (p = %.2g)" % (short_title(c.experiment), c.scenario, c.method,
+                                                                    c.k, c.n, pct(c.thesis), c.p)
+                               for c in chance) or "none"))
     return o
 
 
