@@ -262,6 +262,81 @@ TEST(PpfAlphaBins, EqualTheFormula) {
   }
 }
 
+// The bin of f1 without atan2f equals the bin of atan2f's angle: random
+// directions at every scale, directions within a few ulps of each bin edge,
+// axis directions with signed zeros, infinities and NaN, for the default 12
+// degrees, two steps that do not divide 360 and a fine one.
+TEST(PpfAtan2Bin, EqualsTheBinOfAtan2f) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<float> unit(-1.f, 1.f);
+  std::uniform_int_distribution<int> exponent(-40, 38);
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  for (const double deg : {12.0, 7.0, 25.3, 1.0}) {
+    const float step = static_cast<float>(deg * M_PI / 180.0);
+    size_t wrong = 0, checked = 0;
+    auto check = [&](float y, float x) {
+      ++checked;
+      const int64_t ours = ppf::atan2_bin(y, x, step), ref = ppf::feature_bin(std::atan2(y, x), step);
+      if (ours != ref && ++wrong <= 3) ADD_FAILURE() << deg << " deg, y " << y << " x " << x << ": " << ours << " vs " << ref;
+    };
+    for (int i = 0; i < 1000000; ++i) {
+      const float scale = std::ldexp(1.f, exponent(rng) / 2);
+      check(unit(rng) * scale, unit(rng) * scale);
+    }
+    const int edges = static_cast<int>(std::ceil(M_PI / step));
+    for (int k = -edges; k <= edges; ++k) {
+      const double edge = k * static_cast<double>(step);
+      for (const double off : {0.0, 1e-7, -1e-7, 3e-6, -3e-6, 2e-5, -2e-5}) {
+        float y = static_cast<float>(std::sin(edge + off)), x = static_cast<float>(std::cos(edge + off));
+        for (int u = 0; u < 6; ++u) {
+          check(y, x);
+          check(y * 1000.f, x * 1000.f);
+          y = std::nextafter(y, u % 2 ? 2.f : -2.f);
+          x = std::nextafter(x, u % 3 ? -2.f : 2.f);
+        }
+      }
+    }
+    const float special[] = {0.f, -0.f, 1.f, -1.f, 1e-30f, -1e-45f, 3e38f, inf, -inf, nan};
+    for (float y : special)
+      for (float x : special) check(y, x);
+    EXPECT_EQ(wrong, 0u) << deg << " deg, of " << checked;
+  }
+}
+
+// pcl_alpha's sign test without sinf equals sinf's: every float within 5000
+// ulps of +-3.14159274 (the float nearest pi, beyond it) and of +-1e-20,
+// tiny and subnormal angles, random ones, against z of both signs from
+// subnormal to large, and zeros, NaN, angles beyond the float pi.
+TEST(PpfSinSign, EqualsSinfTimesZ) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> angle(-3.2f, 3.2f);
+  const float zs[] = {1.f, -1.f, 1e-20f, -1e-20f, 9.99e-21f, 1e-30f, -1e-38f, 1e-45f, -1e-45f, 0.f, -0.f, 123.f,
+                      -3e38f, std::numeric_limits<float>::quiet_NaN()};
+  size_t wrong = 0, checked = 0;
+  auto check = [&](float a) {
+    for (float z : zs) {
+      ++checked;
+      if (ppf::sin_times_negative(a, z) != (std::sin(a) * z < 0.0f) && ++wrong <= 3)
+        ADD_FAILURE() << "a " << a << " z " << z;
+    }
+  };
+  const float pi = static_cast<float>(M_PI);
+  for (const float centre : {pi, -pi, 1e-20f, -1e-20f}) {
+    float a = centre;
+    for (int u = 0; u < 5000; ++u) a = std::nextafter(a, -4.f);
+    for (int u = 0; u < 10000; ++u, a = std::nextafter(a, 4.f)) check(a);
+  }
+  for (int e = -149; e < 2; ++e) {
+    check(std::ldexp(1.f, e));
+    check(-std::ldexp(1.f, e));
+  }
+  for (int i = 0; i < 300000; ++i) check(angle(rng));
+  for (const float a : {0.f, -0.f, 3.3f, -3.3f, std::numeric_limits<float>::infinity(),
+                        std::numeric_limits<float>::quiet_NaN()})
+    check(a);
+  EXPECT_EQ(wrong, 0u) << "of " << checked;
+}
+
 TEST(Ppf, ParseReadsEveryFieldAndRejectsBadOnes) {
   const YamlNode n = YamlNode::load_string(
       "ppf:\n  model_points: 200\n  angle_step_deg: 10\n  distance_step_fraction: 0.04\n"

@@ -29,7 +29,7 @@ Eigen::Affine3f to_reference_frame(const Vec3f& p, const Vec3f& n) {
 float pcl_alpha(const Eigen::Affine3f& T, const Vec3f& other) {
   const Vec3f q = T * other;
   float a = std::atan2(-q.z(), q.y());
-  if (std::sin(a) * q.z() < 0.0f) a = -a;
+  if (sin_times_negative(a, q.z())) a = -a;
   return -a;
 }
 
@@ -57,6 +57,14 @@ inline bool second_is_source(float c1, float c2) {
 }  // namespace
 
 bool pair_feature(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2, float f[4]) {
+  float y = 0, x = 0;
+  if (!pair_feature_parts(p1, n1, p2, n2, f, &y, &x)) return false;
+  f[0] = std::atan2(y, x);
+  return true;
+}
+
+bool pair_feature_parts(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2, float f[4], float* y,
+                        float* x) {
   Vec3f d = p2 - p1;
   f[3] = std::sqrt(dot4(d, d));
   if (f[3] == 0.0f) {
@@ -81,7 +89,8 @@ bool pair_feature(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f
   v /= vn;
   const Vec3f w = u.cross(v);
   f[1] = dot4(v, target);
-  f[0] = std::atan2(dot4(w, target), dot4(u, target));
+  *y = dot4(w, target);
+  *x = dot4(u, target);
   return true;
 }
 
@@ -313,11 +322,21 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
     flags.next_reference();
     for (int i : nn) {
       if (i == r) continue;
-      float f[4];
-      if (!pair_feature(sr, nr, scene.points[static_cast<size_t>(i)], scene.normals[static_cast<size_t>(i)], f))
+      float f[4], y0, x0;
+      if (!pair_feature_parts(sr, nr, scene.points[static_cast<size_t>(i)], scene.normals[static_cast<size_t>(i)], f,
+                              &y0, &x0))
         continue;
-      if (!std::isfinite(f[0]) || !std::isfinite(f[1]) || !std::isfinite(f[2]) || !std::isfinite(f[3])) continue;
-      const int n_keys = neighbour_keys(f, step, opt.margin, keys);
+      // f[0] = atan2(y0, x0) is finite unless an argument is NaN.
+      if (std::isnan(y0) || std::isnan(x0) || !std::isfinite(f[1]) || !std::isfinite(f[2]) || !std::isfinite(f[3]))
+        continue;
+      int n_keys = 1;
+      if (opt.margin > 0) {  // the bins' fractions count: the angle itself
+        f[0] = std::atan2(y0, x0);
+        n_keys = neighbour_keys(f, step, opt.margin, keys);
+      } else {  // its bin alone (neighbour_keys with no margin)
+        keys[0] = pack_key(atan2_bin(y0, x0, step[0]), feature_bin(f[1], step[1]), feature_bin(f[2], step[2]),
+                           feature_bin(f[3], step[3]));
+      }
       const float alpha_s = pcl_alpha(T_sg, scene.points[static_cast<size_t>(i)]);
       if (!std::isfinite(alpha_s)) continue;
       const int alpha_s_bin = static_cast<int>(std::floor((alpha_s + M_PI) / m.angle_step));
