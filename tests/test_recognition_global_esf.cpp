@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <thread>
 
 #include "core/hash.h"
@@ -117,6 +118,55 @@ TEST(GlobalEsf, HistogramsAreThoseOfTheSteppedLineTracing) {
     bytes.append(reinterpret_cast<const char*>(h.data()), h.size() * sizeof(float));
   }
   EXPECT_EQ(hash_hex(bytes), "ac09ddb762035115");
+}
+
+// A3's bin from the table of bin edges equals the formula (acos): every
+// float within 3000 ulps of each rounding edge (|cos| = cos((k + 1/2) / 63 x
+// 90 deg)), two million random ones in [0, 1], and the ends, values above 1,
+// infinity and NaN.
+TEST(GlobalEsf, AngleBinTableEqualsTheFormula) {
+  size_t wrong = 0, checked = 0;
+  auto check = [&](float c) {
+    ++checked;
+    if (esf_angle_bin(c) != esf_angle_bin_formula(c) && ++wrong <= 3)
+      ADD_FAILURE() << "|cos| " << c << ": " << esf_angle_bin(c) << " vs " << esf_angle_bin_formula(c);
+  };
+  for (int k = -1; k <= kEsfBinsPerHistogram; ++k) {
+    float c = static_cast<float>(std::cos((k + 0.5) / (kEsfBinsPerHistogram - 1) * M_PI / 2));
+    for (int u = 0; u < 3000; ++u) c = std::nextafter(c, -1.f);
+    for (int u = 0; u < 6000; ++u, c = std::nextafter(c, 2.f)) check(c);
+  }
+  Rng rng(5);
+  for (int i = 0; i < 2000000; ++i) check(static_cast<float>(rng.uniform()));
+  for (const float c : {0.f, -0.f, 1e-45f, 1.f, std::nextafter(1.f, 2.f), 2.f, -1e-30f,
+                        std::numeric_limits<float>::infinity(), std::numeric_limits<float>::quiet_NaN()})
+    check(c);
+  EXPECT_EQ(wrong, 0u) << "of " << checked;
+}
+
+// The rounding without std::lround equals it: exact halves of every bin and
+// their neighbouring doubles, random values, values outside [0, 1], NaN.
+TEST(GlobalEsf, UnitBinRoundsAsLround) {
+  auto ref = [](double v) {
+    return std::clamp(static_cast<int>(std::lround(v * (kEsfBinsPerHistogram - 1))), 0, kEsfBinsPerHistogram - 1);
+  };
+  size_t wrong = 0, checked = 0;
+  auto check = [&](double v) {
+    ++checked;
+    if (esf_unit_bin(v) != ref(v) && ++wrong <= 3) ADD_FAILURE() << "v " << v;
+  };
+  for (int k = -3; k <= kEsfBinsPerHistogram + 2; ++k) {
+    const double half = (k + 0.5) / (kEsfBinsPerHistogram - 1);
+    double v = half;
+    for (int u = 0; u < 50; ++u) v = std::nextafter(v, -10.0);
+    for (int u = 0; u < 100; ++u, v = std::nextafter(v, 10.0)) check(v);
+    check(k + 0.5);  // v * 63 lands on k + 0.5 exactly for some; these land on halves of 63 (k + 1/2) too
+    check(-(k + 0.5) / (kEsfBinsPerHistogram - 1));
+  }
+  Rng rng(6);
+  for (int i = 0; i < 1000000; ++i) check(rng.uniform(-2.0, 2.0));
+  for (const double v : {0.0, -0.0, 1.0, 1e300, -1e300, 3e7, std::numeric_limits<double>::quiet_NaN()}) check(v);
+  EXPECT_EQ(wrong, 0u) << "of " << checked;
 }
 
 TEST(GlobalEsf, DeterministicAndThreadSafe) {

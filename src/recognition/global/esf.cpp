@@ -6,6 +6,8 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <limits>
 
 namespace pb {
 namespace {
@@ -136,17 +138,78 @@ Line trace(const OccupancyGrid& g, const Eigen::Vector3i& a, const Eigen::Vector
   return L;
 }
 
-// Bin of a value in [0, 1] over 64 bins (rounded), clamped.
-inline int unit_bin(double v) {
-  return std::clamp(static_cast<int>(std::lround(v * (kB - 1))), 0, kB - 1);
+// The bins of A3's angles: for each bin k >= 1 the smallest |cos| (a float)
+// whose bin is below k, found once by bisection over the floats of [0, 1]
+// with the formula itself. The formula falls as |cos| grows (acos, glibc's
+// correctly rounded one, falls; the scaling and the rounding keep order), so
+// a |cos| has bin k or more exactly when it lies below edge k: six
+// comparisons instead of acos.
+class AngleBins {
+ public:
+  AngleBins() {
+    auto bits = [](float f) {  // non-negative floats order as their bit patterns
+      uint32_t b;
+      std::memcpy(&b, &f, sizeof b);
+      return b;
+    };
+    auto from_bits = [](uint32_t b) {
+      float f;
+      std::memcpy(&f, &b, sizeof f);
+      return f;
+    };
+    edge_[0] = std::numeric_limits<float>::infinity();
+    edge_[kB] = -std::numeric_limits<float>::infinity();
+    for (int k = 1; k < kB; ++k) {
+      uint32_t lo = bits(0.f), hi = bits(1.f);  // bin 63 at 0, bin 0 at 1
+      while (hi - lo > 1) {
+        const uint32_t mid = lo + (hi - lo) / 2;
+        (esf_angle_bin_formula(from_bits(mid)) < k ? hi : lo) = mid;
+      }
+      edge_[k] = from_bits(hi);
+    }
+  }
+  int operator()(float abs_cos) const {
+    if (std::isnan(abs_cos)) return esf_angle_bin_formula(abs_cos);
+    int lo = 0, hi = kB;  // abs_cos < edge_[lo], not < edge_[hi]
+    while (hi - lo > 1) {
+      const int mid = (lo + hi) / 2;
+      (abs_cos < edge_[mid] ? lo : hi) = mid;
+    }
+    return lo;
+  }
+
+ private:
+  std::array<float, kB + 1> edge_{};
+};
+
+}  // namespace
+
+int esf_unit_bin(double v) {
+  const double x = v * (kB - 1);
+  long r;
+  if (x > -1e9 && x < 1e9) {  // std::lround without the call: halves away from zero
+    const long t = static_cast<long>(x);      // toward zero
+    const double f = x - static_cast<double>(t);  // exact
+    r = t + (f >= 0.5 ? 1 : 0) - (f <= -0.5 ? 1 : 0);
+  } else {
+    r = std::lround(x);  // NaN, and values far outside [0, 1]
+  }
+  return std::clamp(static_cast<int>(r), 0, kB - 1);
 }
 
-// Bin of an angle from |cos|, folded to [0, 90] degrees.
-inline int angle_bin(float abs_cos) {
+int esf_angle_bin_formula(float abs_cos) {
   const double c = std::clamp(static_cast<double>(abs_cos), 0.0, 1.0);
-  return unit_bin(std::acos(c) / (M_PI / 2));
+  return esf_unit_bin(std::acos(c) / (M_PI / 2));
 }
 
+int esf_angle_bin(float abs_cos) {
+  static const AngleBins bins;
+  return bins(abs_cos);
+}
+
+namespace {
+inline int unit_bin(double v) { return esf_unit_bin(v); }
+inline int angle_bin(float abs_cos) { return esf_angle_bin(abs_cos); }
 }  // namespace
 
 std::vector<float> compute_esf(const std::vector<Vec3f>& points_in, Rng& rng, int samples) {

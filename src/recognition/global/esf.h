@@ -40,4 +40,14 @@ constexpr int kEsfGridSize = 64;                     // occupancy grid resolutio
 // points, or no valid triple: 640 zeros.
 std::vector<float> compute_esf(const std::vector<Vec3f>& points, Rng& rng, int samples = 20000);
 
+// Its binning, exposed for the tests:
+// a value in [0, 1] over 64 bins, rounded (std::lround's halves away from
+// zero), clamped;
+int esf_unit_bin(double v);
+// an angle's bin from its |cos|, folded to [0, 90] degrees: the formula,
+// esf_unit_bin(acos(clamp(|cos|, 0, 1)) / (pi / 2)), and the same from a
+// table of each bin's edge (what compute_esf uses).
+int esf_angle_bin_formula(float abs_cos);
+int esf_angle_bin(float abs_cos);
+
 }  // namespace pb
