@@ -9,6 +9,8 @@
 #include <cstring>
 #include <limits>
 
+#include "core/round.h"
+
 namespace pb {
 namespace {
 
@@ -186,14 +188,9 @@ class AngleBins {
 
 int esf_unit_bin(double v) {
   const double x = v * (kB - 1);
-  long r;
-  if (x > -1e9 && x < 1e9) {  // std::lround without the call: halves away from zero
-    const long t = static_cast<long>(x);      // toward zero
-    const double f = x - static_cast<double>(t);  // exact
-    r = t + (f >= 0.5 ? 1 : 0) - (f <= -0.5 ? 1 : 0);
-  } else {
-    r = std::lround(x);  // NaN, and values far outside [0, 1]
-  }
+  // std::lround without its call (core/round.h); NaN and values far outside
+  // [0, 1] take the call.
+  const long r = std::abs(x) < 1e9 ? static_cast<long>(round_half_away(x)) : std::lround(x);
   return std::clamp(static_cast<int>(r), 0, kB - 1);
 }
 

@@ -31,6 +31,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "core/atan2_bin.h"
 #include "recognition/local/internal.h"
 
 namespace pb::local {
@@ -45,8 +46,9 @@ constexpr int kBins = 11;  // per angle
 // call (p2, p1) gives bit-identical features (and the same return value):
 // both cosines finite and of different magnitude, so both calls pick the
 // same source point and compute the same frame from exactly negated inputs.
-bool pair_features(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2, float& f1, float& f2,
-                   float& f3, bool* symmetric) {
+// f1 = atan2(*f1_y, *f1_x): its arguments, binned by count_pair.
+bool pair_features(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2, float* f1_y, float* f1_x,
+                   float& f2, float& f3, bool* symmetric) {
   Vec3f d = p2 - p1;
   const float dist = d.norm();
   *symmetric = false;
@@ -67,7 +69,8 @@ bool pair_features(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3
   v /= vn;
   const Vec3f w = u.cross(v);
   f2 = v.dot(target);
-  f1 = std::atan2(w.dot(target), u.dot(target));
+  *f1_y = w.dot(target);
+  *f1_x = u.dot(target);
   return true;
 }
 
@@ -90,10 +93,12 @@ inline int thread_num() {
 #endif
 }
 
-// The three bins of a pair's features.
-inline void count_pair(float f1, float f2, float f3, uint32_t* c) {
+// The three bins of a pair's features, f1 = atan2(f1_y, f1_x) binned
+// without atan2f where the bin is in no doubt (core/atan2_bin.h; the bin
+// rises with f1).
+inline void count_pair(float f1_y, float f1_x, float f2, float f3, uint32_t* c) {
   const double inv_2pi = static_cast<double>(1.0f / (2.0f * static_cast<float>(M_PI)));
-  ++c[bin_of(kBins * ((f1 + M_PI) * inv_2pi))];
+  ++c[binned_atan2(f1_y, f1_x, [inv_2pi](float f1) { return bin_of(kBins * ((f1 + M_PI) * inv_2pi)); })];
   ++c[kBins + bin_of(kBins * ((f2 + 1.0) * 0.5))];
   ++c[2 * kBins + bin_of(kBins * ((f3 + 1.0) * 0.5))];
 }
@@ -200,15 +205,15 @@ std::vector<Hist> spfh_histograms(const PointSet& cloud, const CloudNeighbours& 
         int qrow = row_of[static_cast<size_t>(q)];
         if (alone || (qrow >= 0 && thinned[static_cast<size_t>(qrow)])) qrow = -1;  // q counts its own
         if (qrow >= 0 && q < p) continue;  // counted from q
-        float f1, f2, f3;
+        float f1_y, f1_x, f2, f3;
         bool symmetric = false;
-        if (pair_features(pts[p], cloud.normals[p], pts[q], cloud.normals[q], f1, f2, f3, &symmetric)) {
-          count_pair(f1, f2, f3, mine[r].data());
-          if (qrow >= 0 && symmetric) count_pair(f1, f2, f3, mine[static_cast<size_t>(qrow)].data());
+        if (pair_features(pts[p], cloud.normals[p], pts[q], cloud.normals[q], &f1_y, &f1_x, f2, f3, &symmetric)) {
+          count_pair(f1_y, f1_x, f2, f3, mine[r].data());
+          if (qrow >= 0 && symmetric) count_pair(f1_y, f1_x, f2, f3, mine[static_cast<size_t>(qrow)].data());
         }
         if (qrow >= 0 && !symmetric &&
-            pair_features(pts[q], cloud.normals[q], pts[p], cloud.normals[p], f1, f2, f3, &symmetric))
-          count_pair(f1, f2, f3, mine[static_cast<size_t>(qrow)].data());
+            pair_features(pts[q], cloud.normals[q], pts[p], cloud.normals[p], &f1_y, &f1_x, f2, f3, &symmetric))
+          count_pair(f1_y, f1_x, f2, f3, mine[static_cast<size_t>(qrow)].data());
       }
     }
   }

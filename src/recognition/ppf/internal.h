@@ -10,6 +10,7 @@
 #include <tuple>
 #include <vector>
 
+#include "core/atan2_bin.h"
 #include "core/types.h"
 #include "recognition/cloud.h"
 #include "recognition/ppf/ppf.h"
@@ -81,42 +82,10 @@ inline uint64_t feature_key(float f1, float f2, float f3, float f4, float angle_
                   feature_bin(f4, distance_step));
 }
 
-// atan2(y, x) in double from its series, within 2e-8 of the true angle
-// (not libm's value): the octant's ratio t in [0, 1], brought to |t| <=
-// tan(pi / 8) by atan t = pi / 4 + atan((t - 1) / (t + 1)), where the
-// alternating series to t^15 leaves less than |t|^17 / 17.
-inline double series_atan2(float yf, float xf) {
-  const double y = yf, x = xf, ay = std::fabs(y), ax = std::fabs(x);
-  const bool steep = ay > ax;
-  double t = steep ? ax / ay : ay / ax;
-  double base = 0;
-  if (t > 0.41421356237309503) {
-    t = (t - 1) / (t + 1);
-    base = M_PI / 4;
-  }
-  const double t2 = t * t;
-  double s = -1.0 / 15;
-  for (const double c : {1.0 / 13, -1.0 / 11, 1.0 / 9, -1.0 / 7, 1.0 / 5, -1.0 / 3, 1.0}) s = s * t2 + c;
-  double r = base + t * s;
-  if (steep) r = M_PI / 2 - r;
-  if (x < 0) r = M_PI - r;
-  return y < 0 ? -r : r;
-}
-
 // feature_bin(std::atan2(y, x), step) without atan2f where the bin is in no
-// doubt: the series' angle is within 2e-8 of the true one and atan2f's
-// within 1 ulp (under 4e-7 on [-pi, pi]), so atan2f's value lies within
-// 1e-5 of the series' both ways, and the bin, non-decreasing in the angle,
-// is the same at both ends of that window. Otherwise (an edge within the
-// window, a zero argument with its sign, a non-finite one) atan2f decides.
+// doubt (core/atan2_bin.h).
 inline int64_t atan2_bin(float y, float x, float step) {
-  if (y != 0.0f && x != 0.0f && std::isfinite(y) && std::isfinite(x)) {
-    const double a = series_atan2(y, x);
-    constexpr double kWindow = 1e-5;
-    const int64_t lo = feature_bin(static_cast<float>(a - kWindow), step);
-    if (lo == feature_bin(static_cast<float>(a + kWindow), step)) return lo;
-  }
-  return feature_bin(std::atan2(y, x), step);
+  return binned_atan2(y, x, [step](float a) { return feature_bin(a, step); });
 }
 
 // std::sin(a) * z < 0.0f for an angle a of atan2f (|a| <= the float nearest
