@@ -1,9 +1,9 @@
 // core/atan2_bin.h: binned_atan2 gives bin(std::atan2(y, x)) for bin
 // functions non-decreasing in the angle: FPFH's 11 bins (floor in double of
-// (f1 + pi) / 2 pi), a fine one of 3600 bins, and a coarse one whose edges
-// lie off every multiple of pi; on random directions at every scale,
-// directions within a few ulps of each edge, and signed zeros, infinities
-// and NaN. PPF's feature bins are tested in test_recognition_ppf.cpp.
+// (f1 + pi) / 2 pi), a fine one of 3600 bins, a coarse one whose edges lie
+// off every multiple of pi, and PPF's (floor(f1 / step) in float, four
+// steps); on random directions at every scale, directions within a few ulps
+// of each edge, and signed zeros, infinities and NaN.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -67,6 +67,11 @@ TEST(BinnedAtan2, EqualsTheBinOfAtan2f) {
              edges_every(-M_PI, 0.00174532925 * 97, M_PI));
   check_bins("off pi", [](float a) { return static_cast<int>(std::floor((a + 0.3f) / 0.7f)); },
              edges_every(-0.3 - 4 * 0.7, 0.7, M_PI));
+  for (const double deg : {12.0, 7.0, 25.3, 1.0}) {  // PPF's feature bins: floor(f1 / step) in float
+    const float step = static_cast<float>(deg * M_PI / 180.0);
+    check_bins("ppf", [step](float a) { return static_cast<int>(std::floor(a / step)); },
+               edges_every(-std::ceil(M_PI / step) * step, step, M_PI));
+  }
 }
 
 // The series alone: within 2e-8 of the double atan2 everywhere.
