@@ -7,6 +7,7 @@
 #include <cstring>
 #include <limits>
 
+#include "core/random.h"
 #include "recognition/preprocess/preprocess.h"
 #include "recognition/preprocess/internal.h"
 #include "recognition/preprocess/voxel_grid.h"
@@ -102,6 +103,44 @@ TEST(Ransac, SubsetScoringSelectsThePlaneAmongAllPoints) {
 
 // A floor and a wall (the warehouse): max_planes 1 removes the larger one,
 // max_planes 2 both; the object stays.
+// RANSAC's scoring count equals the test written with Eigen (|n . p + d| <=
+// thr, Vector3d dot product): random planes and points, thresholds equal to
+// some points' own distances as Eigen computes them and the doubles either
+// side (where another summation order would put a point on the other side),
+// and zero and huge coordinates. The candidate planes score as before, bit
+// for bit.
+TEST(Ransac, CountWithinEqualsEigensTest) {
+  using pb::Vec3;
+  namespace detail = pb::detail;
+  pb::Rng rng(9);
+  size_t checked = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    Vec3 n(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+    if (n.norm() < 1e-3) continue;
+    n.normalize();
+    Eigen::Vector4d plane;
+    plane << n, rng.uniform(-3000, 3000);
+    std::vector<Vec3f> pts;
+    for (int i = 0; i < 1000; ++i)
+      pts.emplace_back(static_cast<float>(rng.uniform(-3000, 3000)), static_cast<float>(rng.uniform(-3000, 3000)),
+                       static_cast<float>(rng.uniform(0, 5000)));
+    pts.emplace_back(0.f, 0.f, 0.f);
+    pts.emplace_back(-0.f, 1e30f, -1e30f);
+    const detail::PlanePoints soa(pts);
+    auto eigen_distance = [&](const Vec3f& p) { return std::abs(plane.head<3>().dot(p.cast<double>()) + plane[3]); };
+    for (int k = 0; k < 20; ++k) {
+      const double at = eigen_distance(pts[static_cast<size_t>(rng.uniform_int(0, 999))]);
+      for (const double thr : {at, std::nextafter(at, 0.0), std::nextafter(at, 1e300)}) {
+        size_t eigen = 0;
+        for (const Vec3f& p : pts) eigen += eigen_distance(p) <= thr ? 1 : 0;
+        EXPECT_EQ(detail::count_within(soa, plane, thr), eigen) << "trial " << trial << " thr " << thr;
+        checked += pts.size();
+      }
+    }
+  }
+  EXPECT_GT(checked, 10000000u);
+}
+
 TEST(Preprocess, MaxPlanesRemovesFloorAndWall) {
   pb::OrganizedCloud cloud;
   cloud.width = 200;

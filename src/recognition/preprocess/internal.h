@@ -2,8 +2,11 @@
 // .cpp files (not part of the public contract). PCL-free.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
+
+#include <Eigen/Core>
 
 #include "core/types.h"
 #include "recognition/cloud.h"
@@ -25,6 +28,21 @@ namespace pb::detail {
 std::vector<char> ransac_plane(const std::vector<Vec3f>& points, double threshold_mm, int iterations,
                                uint64_t seed, Eigen::Vector4d* plane = nullptr, int sample_points = 0,
                                double probability = 1.0);
+
+// Points as three arrays of doubles (the float coordinates widened), for
+// RANSAC's scoring loop.
+struct PlanePoints {
+  std::vector<double> x, y, z;
+  explicit PlanePoints(const std::vector<Vec3f>& pts);
+  size_t size() const { return x.size(); }
+};
+
+// How many points lie within `thr` of `plane`: |n . p + d| <= thr, in
+// double with n . p summed as Eigen's Vector3d dot product sums it, (n0 p0
+// + n1 p1) + n2 p2, so the count is that of the same test written with
+// Eigen (test PreprocessPlane.CountWithinEqualsEigensTest). A plain loop
+// over three arrays, which the compiler vectorizes.
+size_t count_within(const PlanePoints& pts, const Eigen::Vector4d& plane, double thr);
 
 // The depth noise of an organized cloud (mm, along the viewing ray): over
 // every triple of horizontally adjacent valid pixels of every `row_step`-th

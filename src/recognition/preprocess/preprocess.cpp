@@ -85,6 +85,27 @@ size_t within(const std::vector<Vec3f>& pts, const Eigen::Vector4d& plane, doubl
 
 }  // namespace
 
+PlanePoints::PlanePoints(const std::vector<Vec3f>& pts) {
+  x.reserve(pts.size());
+  y.reserve(pts.size());
+  z.reserve(pts.size());
+  for (const Vec3f& p : pts) {
+    x.push_back(p.x());
+    y.push_back(p.y());
+    z.push_back(p.z());
+  }
+}
+
+size_t count_within(const PlanePoints& pts, const Eigen::Vector4d& plane, double thr) {
+  const double a = plane[0], b = plane[1], c = plane[2], d = plane[3];
+  const double* x = pts.x.data();
+  const double* y = pts.y.data();
+  const double* z = pts.z.data();
+  size_t cnt = 0;
+  for (size_t i = 0; i < pts.size(); ++i) cnt += std::abs((a * x[i] + (b * y[i] + c * z[i])) + d) <= thr ? 1 : 0;
+  return cnt;
+}
+
 std::vector<char> ransac_plane(const std::vector<Vec3f>& all, double thr, int iterations, uint64_t seed,
                                Eigen::Vector4d* plane_out, int sample_points, double probability) {
   const size_t n = all.size();
@@ -99,6 +120,7 @@ std::vector<char> ransac_plane(const std::vector<Vec3f>& all, double thr, int it
     for (int k = 0; k < sample_points; ++k) subset.push_back(all[static_cast<size_t>(rng.uniform_int(0, max_i))]);
   }
   const std::vector<Vec3f>& pts = subset.empty() ? all : subset;
+  const PlanePoints scored(pts);
   Eigen::Vector4d best = Eigen::Vector4d::Zero();
   size_t best_count = 0;
   const int max_n = static_cast<int>(pts.size()) - 1;
@@ -112,7 +134,7 @@ std::vector<char> ransac_plane(const std::vector<Vec3f>& all, double thr, int it
     nrm /= l;
     Eigen::Vector4d plane;
     plane << nrm, -nrm.dot(pa);
-    const size_t cnt = within(pts, plane, thr, nullptr);
+    const size_t cnt = count_within(scored, plane, thr);
     if (cnt > best_count) {
       best_count = cnt;
       best = plane;
