@@ -127,7 +127,10 @@ TEST(Ransac, CountWithinEqualsEigensTest) {
     pts.emplace_back(0.f, 0.f, 0.f);
     pts.emplace_back(-0.f, 1e30f, -1e30f);
     const detail::PlanePoints soa(pts);
-    auto eigen_distance = [&](const Vec3f& p) { return std::abs(plane.head<3>().dot(p.cast<double>()) + plane[3]); };
+    auto eigen_distance = [&](const Vec3f& p) {  // as RANSAC's scoring wrote it before
+      const Vec3 pd = p.cast<double>();
+      return std::abs(plane.head<3>().dot(pd) + plane[3]);
+    };
     for (int k = 0; k < 20; ++k) {
       const double at = eigen_distance(pts[static_cast<size_t>(rng.uniform_int(0, 999))]);
       for (const double thr : {at, std::nextafter(at, 0.0), std::nextafter(at, 1e300)}) {

@@ -102,7 +102,7 @@ size_t count_within(const PlanePoints& pts, const Eigen::Vector4d& plane, double
   const double* y = pts.y.data();
   const double* z = pts.z.data();
   size_t cnt = 0;
-  for (size_t i = 0; i < pts.size(); ++i) cnt += std::abs((a * x[i] + (b * y[i] + c * z[i])) + d) <= thr ? 1 : 0;
+  for (size_t i = 0; i < pts.size(); ++i) cnt += std::abs(((a * x[i] + b * y[i]) + c * z[i]) + d) <= thr ? 1 : 0;
   return cnt;
 }
 
