@@ -142,10 +142,11 @@ Line trace(const OccupancyGrid& g, const Eigen::Vector3i& a, const Eigen::Vector
 
 // The bins of A3's angles: for each bin k >= 1 the smallest |cos| (a float)
 // whose bin is below k, found once by bisection over the floats of [0, 1]
-// with the formula itself. The formula falls as |cos| grows (acos, glibc's
-// correctly rounded one, falls; the scaling and the rounding keep order), so
-// a |cos| has bin k or more exactly when it lies below edge k: six
-// comparisons instead of acos.
+// with the formula itself. The formula falls as |cos| grows (acos falls;
+// the scaling and the rounding keep order), so a |cos| has bin k or more
+// exactly when it lies below edge k: six comparisons instead of acos.
+// Checked once over every float from 0 to 1 (session 24, results/bench/
+// README.md): the table and the formula agree on all 1,065,353,217.
 class AngleBins {
  public:
   AngleBins() {
