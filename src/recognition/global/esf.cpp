@@ -200,18 +200,18 @@ int esf_angle_bin_formula(float abs_cos) {
   return esf_unit_bin(std::acos(c) / (M_PI / 2));
 }
 
-int esf_angle_bin(float abs_cos) {
-  static const AngleBins bins;
-  return bins(abs_cos);
-}
-
 namespace {
-inline int unit_bin(double v) { return esf_unit_bin(v); }
-inline int angle_bin(float abs_cos) { return esf_angle_bin(abs_cos); }
+const AngleBins& angle_bins() {
+  static const AngleBins bins;
+  return bins;
+}
 }  // namespace
+
+int esf_angle_bin(float abs_cos) { return angle_bins()(abs_cos); }
 
 std::vector<float> compute_esf(const std::vector<Vec3f>& points_in, Rng& rng, int samples) {
   std::vector<float> out(kEsfBins, 0.f);
+  const AngleBins& angle_bin = angle_bins();
   std::vector<Vec3f> pts;
   pts.reserve(points_in.size());
   for (const auto& p : points_in)
@@ -277,7 +277,7 @@ std::vector<float> compute_esf(const std::vector<Vec3f>& points_in, Rng& rng, in
     d2.push_back(cc);
     d2_cls.push_back(static_cast<uint8_t>(l23.cls));
     for (const Line* l : {&l12, &l13, &l23})
-      if (l->cls == kMixed) ratio[unit_bin(l->ratio)] += 1;
+      if (l->cls == kMixed) ratio[esf_unit_bin(l->ratio)] += 1;
 
     const int occ = l12.occupied + l13.occupied + l23.occupied;
     const int cnt = l12.count + l13.count + l23.count;
@@ -299,8 +299,8 @@ std::vector<float> compute_esf(const std::vector<Vec3f>& points_in, Rng& rng, in
   const float max_d2 = *std::max_element(d2.begin(), d2.end());
   const float max_d3 = *std::max_element(d3.begin(), d3.end());
   std::array<std::array<double, kB>, 3> h2{}, h3{};
-  for (size_t i = 0; i < d2.size(); ++i) h2[d2_cls[i]][unit_bin(d2[i] / max_d2)] += 1;
-  for (size_t i = 0; i < d3.size(); ++i) h3[d3_cls[i]][unit_bin(d3[i] / max_d3)] += 1;
+  for (size_t i = 0; i < d2.size(); ++i) h2[d2_cls[i]][esf_unit_bin(d2[i] / max_d2)] += 1;
+  for (size_t i = 0; i < d3.size(); ++i) h3[d3_cls[i]][esf_unit_bin(d3[i] / max_d3)] += 1;
 
   // Concatenation and weights as PCL: A3 on/off/mixed, D3 on/off/mixed, D2
   // on/off/mixed, D2 ratio.

@@ -72,13 +72,20 @@ bool fit_plane(const std::vector<Vec3f>& pts, const std::vector<char>& use, Eige
   return true;
 }
 
+// |n . p + d| <= thr for the plane (n, d), n . p summed (n0 p0 + n1 p1) +
+// n2 p2 in double: how Eigen sums an evaluated Vector3d's dot product, the
+// form this test had (test Ransac.CountWithinEqualsEigensTest).
+inline bool on_plane(const Eigen::Vector4d& plane, double x, double y, double z, double thr) {
+  return std::abs(((plane[0] * x + plane[1] * y) + plane[2] * z) + plane[3]) <= thr;
+}
+
+// The points within thr of the plane, flagged.
 size_t within(const std::vector<Vec3f>& pts, const Eigen::Vector4d& plane, double thr, std::vector<char>* flags) {
   size_t cnt = 0;
   for (size_t i = 0; i < pts.size(); ++i) {
-    const Vec3 p = pts[i].cast<double>();
-    const bool in = std::abs(plane.head<3>().dot(p) + plane[3]) <= thr;
+    const bool in = on_plane(plane, pts[i].x(), pts[i].y(), pts[i].z(), thr);
     cnt += in;
-    if (flags) (*flags)[i] = in;
+    (*flags)[i] = in;
   }
   return cnt;
 }
@@ -97,12 +104,8 @@ PlanePoints::PlanePoints(const std::vector<Vec3f>& pts) {
 }
 
 size_t count_within(const PlanePoints& pts, const Eigen::Vector4d& plane, double thr) {
-  const double a = plane[0], b = plane[1], c = plane[2], d = plane[3];
-  const double* x = pts.x.data();
-  const double* y = pts.y.data();
-  const double* z = pts.z.data();
   size_t cnt = 0;
-  for (size_t i = 0; i < pts.size(); ++i) cnt += std::abs(((a * x[i] + b * y[i]) + c * z[i]) + d) <= thr ? 1 : 0;
+  for (size_t i = 0; i < pts.size(); ++i) cnt += on_plane(plane, pts.x[i], pts.y[i], pts.z[i], thr) ? 1 : 0;
   return cnt;
 }
 
