@@ -20,6 +20,7 @@
 #include "core/random.h"
 #include "recognition/preprocess/preprocess.h"
 #include "recognition/preprocess/voxel_grid.h"
+#include "recognition/preprocess/voxel_keys.h"
 #include "test_recognition_pipeline_util.h"
 
 namespace {
@@ -172,9 +173,11 @@ PointSet random_cloud(pb::Rng& rng, int n, double extent, double centre, double 
 TEST(VoxelGrid, EqualsThePlainReferenceForEveryOption) {
   pb::Rng rng(21);
   int cases = 0;
-  // (extent, centre, leaf): 1e-3 mm over 4 m spans more than 2^21 cells.
-  for (const auto& [extent, centre, leaf] : {std::array<double, 3>{400, 0, 10}, std::array<double, 3>{300, 1500, 7.3},
-                                             std::array<double, 3>{50, -20, 0.37}, std::array<double, 3>{4000, 0, 1e-3}}) {
+  // (extent, centre, leaf): 2e-3 mm over 2 m gives packed keys of more than
+  // 32 bits; 1e-3 mm over 4 m spans more than 2^21 cells (the triple keys).
+  for (const auto& [extent, centre, leaf] :
+       {std::array<double, 3>{400, 0, 10}, std::array<double, 3>{300, 1500, 7.3}, std::array<double, 3>{50, -20, 0.37},
+        std::array<double, 3>{2000, 0, 2e-3}, std::array<double, 3>{4000, 0, 1e-3}}) {
     const PointSet full = random_cloud(rng, 3000, extent, centre, leaf);
     for (const auto order : {VoxelGridOptions::Order::kZYX, VoxelGridOptions::Order::kXYZ})
       for (const auto index : {VoxelGridOptions::CellIndex::kTimesInverse, VoxelGridOptions::CellIndex::kDivide})
@@ -200,7 +203,7 @@ TEST(VoxelGrid, EqualsThePlainReferenceForEveryOption) {
             }
         }
   }
-  EXPECT_EQ(cases, 4 * 2 * 2 * 4 * 2 * 2);
+  EXPECT_EQ(cases, 5 * 2 * 2 * 4 * 2 * 2);
   // The degenerate inputs: no points, every point non-finite, no leaf.
   PointSet nan;
   nan.points.assign(5, Vec3f::Constant(std::numeric_limits<float>::quiet_NaN()));
@@ -209,6 +212,63 @@ TEST(VoxelGrid, EqualsThePlainReferenceForEveryOption) {
   EXPECT_TRUE(pb::voxel_nearest_points(nan, {10.0}).empty());
   EXPECT_TRUE(pb::voxel_downsample(PointSet{}, {10.0}).empty());
   EXPECT_EQ(pb::voxel_downsample(nan, {0.0}).size(), 5u);  // leaf 0: the input as is
+}
+
+// The four-point kernels equal the one-point loops: the box of the finite
+// points (any n, NaN and infinities in single coordinates), and the packed
+// keys for both orders and both cell index forms (with AVX2 where the CPU
+// has it; elsewhere both sides run the same loop), cell borders included.
+TEST(VoxelGrid, FourPointKernelsEqualTheOnePointLoops) {
+  namespace detail = pb::detail;
+  pb::Rng rng(33);
+  size_t compared = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const int n = trial < 40 ? trial % 10 : rng.uniform_int(10, 2000);
+    const double leaf = trial % 3 == 0 ? 10.0 : rng.uniform(0.5, 30);
+    const PointSet ps = random_cloud(rng, n, rng.uniform(10, 3000), rng.uniform(-500, 2000), leaf);
+    float lo[3], hi[3];
+    const bool any = detail::finite_box(ps.points.data(), ps.points.size(), lo, hi);
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    float want_lo[3] = {kInf, kInf, kInf}, want_hi[3] = {-kInf, -kInf, -kInf};
+    for (const Vec3f& p : ps.points)
+      if (p.allFinite())
+        for (int d = 0; d < 3; ++d) {
+          want_lo[d] = std::min(want_lo[d], p[d]);
+          want_hi[d] = std::max(want_hi[d], p[d]);
+        }
+    ASSERT_EQ(any, want_lo[0] <= want_hi[0]) << "trial " << trial;
+    if (!any) continue;
+    for (int d = 0; d < 3; ++d) {
+      ASSERT_EQ(lo[d], want_lo[d]) << "trial " << trial << " axis " << d;
+      ASSERT_EQ(hi[d], want_hi[d]) << "trial " << trial << " axis " << d;
+    }
+    for (const bool zyx : {true, false})
+      for (const bool divide : {false, true}) {
+        detail::PackedGrid g;
+        g.leaf = leaf;
+        g.divide = divide;
+        g.int32_cells = true;
+        int width[3];
+        for (int f = 0; f < 3; ++f) {
+          g.axis[f] = f == 1 ? 1 : (zyx == (f == 0) ? 2 : 0);
+          const int a = g.axis[f];
+          auto cell = [&](float v) { return detail::floor_to_int(divide ? v / leaf : v * (1.0 / leaf)); };
+          g.lo[f] = cell(lo[a]);
+          width[f] = 0;
+          while (width[f] < 63 && (cell(hi[a]) - g.lo[f]) >> width[f]) ++width[f];
+        }
+        g.shift[0] = width[1] + width[2];
+        g.shift[1] = width[2];
+        std::vector<uint64_t> best(ps.size()), scalar(ps.size());
+        detail::packed_cell_keys(ps.points.data(), ps.size(), g, best.data(), detail::KeyIsa::best);
+        detail::packed_cell_keys(ps.points.data(), ps.size(), g, scalar.data(), detail::KeyIsa::scalar);
+        ASSERT_EQ(best, scalar) << "trial " << trial << " zyx " << zyx << " divide " << divide;
+        for (size_t i = 0; i < ps.size(); ++i)
+          EXPECT_EQ(scalar[i] == detail::kNoCell, !ps.points[i].allFinite()) << "trial " << trial << " point " << i;
+        compared += ps.size();
+      }
+  }
+  EXPECT_GT(compared, 1000000u);
 }
 
 // A rendered table frame, range-cut as the scene preprocessing cuts it

@@ -1,6 +1,7 @@
 // Window sums of the structured-light model, SSE2 and AVX2 (window_sums.h).
 #include "render/window_sums.h"
 
+#include "core/cpu.h"
 #include "core/round.h"
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -75,12 +76,8 @@ __attribute__((target("avx2"))) int sums_avx2(const WindowSumRow& a, int u, doub
 
 using Kernel = int (*)(const WindowSumRow&, int, double*, double*);
 
-bool has_avx2() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2");
-}
 
-Kernel pick() { return has_avx2() ? sums_avx2 : sums_sse2; }
+Kernel pick() { return cpu_has_avx2() ? sums_avx2 : sums_sse2; }
 
 #endif
 
@@ -133,7 +130,7 @@ __attribute__((target("avx2"))) void depths_avx2(const double* sum, const double
 void depths_from_sums(const double* sum, const double* count, const uint8_t* ok, int begin, int end, double step,
                       double fb, float* z, WindowSumIsa isa) {
 #ifdef PB_WINDOW_SUMS_X86
-  static const bool avx2 = has_avx2();
+  const bool avx2 = cpu_has_avx2();
   if (avx2 && isa == WindowSumIsa::best) return depths_avx2(sum, count, ok, begin, end, step, fb, z);
 #endif
   depths_scalar(sum, count, ok, begin, end, step, fb, z);

@@ -4,7 +4,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <memory>
+
+#include "recognition/preprocess/voxel_keys.h"
 
 namespace pb {
 
@@ -40,14 +44,6 @@ struct Cells {
   std::vector<int> order;
   size_t size() const { return first.size(); }
 };
-
-// floor(x) as an integer, for finite x in range: the same value as
-// std::floor without a libm call (baseline x86-64 has no rounding
-// instruction).
-inline int64_t floor_to_int(double x) {
-  const int64_t i = static_cast<int64_t>(x);  // truncates toward zero
-  return static_cast<double>(i) > x ? i - 1 : i;
-}
 
 // Open addressing over the cell keys (linear probing, power-of-two
 // capacity, grown at half load): no allocation per cell.
@@ -127,55 +123,90 @@ Cells group_by(size_t n, KeyOf key_of, Skip skip, std::vector<K>& keys) {
   return c;
 }
 
-// Groups the points by cell, with the key order of the cells (PCL's: z, then y, then x
-// for kZYX). When every axis spans fewer than 2^21 cells (always, for images
-// at sensor range and millimetre-scale leaves) the key is one integer, 21
-// bits per axis above the minimum cell, in priority order: hashing,
-// comparing and sorting it is cheap, and its order is the triple's.
+// Sorts the cells by their packed keys (unique, below 2^bits): for keys of
+// at most 32 bits an LSD radix sort of key << 32 | cell on the key's bits,
+// 11 at a time; longer keys are sorted as (key, cell) pairs.
+void sorted_order(const std::vector<uint64_t>& keys, int bits, std::vector<int>& order) {
+  const size_t m = keys.size();
+  order.resize(m);
+  if (bits > 32) {
+    std::vector<std::pair<uint64_t, int>> keyed(m);
+    for (size_t k = 0; k < m; ++k) keyed[k] = {keys[k], static_cast<int>(k)};
+    std::sort(keyed.begin(), keyed.end());
+    for (size_t k = 0; k < m; ++k) order[k] = keyed[k].second;
+    return;
+  }
+  std::vector<uint64_t> a(m), b(m);
+  for (size_t k = 0; k < m; ++k) a[k] = keys[k] << 32 | static_cast<uint64_t>(k);
+  constexpr int kDigit = 11;
+  for (int shift = 32; shift < 32 + bits; shift += kDigit) {
+    size_t count[(1 << kDigit) + 1] = {};
+    for (const uint64_t v : a) ++count[((v >> shift) & ((1u << kDigit) - 1)) + 1];
+    for (int d = 0; d < (1 << kDigit); ++d) count[d + 1] += count[d];
+    for (const uint64_t v : a) b[count[(v >> shift) & ((1u << kDigit) - 1)]++] = v;
+    a.swap(b);
+  }
+  for (size_t k = 0; k < m; ++k) order[k] = static_cast<int>(a[k] & 0xffffffffu);
+}
+
+// Bits needed for the values 0..v.
+inline int bit_width(uint64_t v) {
+  int b = 0;
+  while (b < 64 && (v >> b) != 0) ++b;
+  return b;
+}
+
+inline bool finite3(const Vec3f& p) { return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z()); }
+
+// Groups the points by cell, with the key order of the cells (PCL's: z, then
+// y, then x for kZYX). When every axis spans fewer than 2^21 cells (always,
+// for images at sensor range and millimetre-scale leaves) the key is one
+// integer (voxel_keys.h): hashing, comparing and sorting it is cheap.
 // Otherwise the triple itself is the key.
 Cells group(const std::vector<Vec3f>& pts, const VoxelGridOptions& opt) {
   const size_t n = pts.size();
   const double inv = 1.0 / opt.leaf_mm;
   const bool divide = opt.cell_index == VoxelGridOptions::CellIndex::kDivide;
-  auto cell = [&](float v) { return floor_to_int(divide ? v / opt.leaf_mm : v * inv); };
-  const int ax[3] = {opt.order == VoxelGridOptions::Order::kZYX ? 2 : 0, 1,
-                     opt.order == VoxelGridOptions::Order::kZYX ? 0 : 2};  // priority order of the axes
-  auto skip = [&](size_t i) { return !pts[i].allFinite(); };
-  Eigen::AlignedBox3f box;
-  for (size_t i = 0; i < n; ++i)
-    if (!skip(i)) box.extend(pts[i]);
-  if (box.isEmpty()) return Cells{std::vector<int>(n, -1), {}, {}, {}};
-  int64_t lo[3], span = 0;
+  const bool zyx = opt.order == VoxelGridOptions::Order::kZYX;
+  auto cell = [&](float v) { return detail::floor_to_int(divide ? v / opt.leaf_mm : v * inv); };
+  const int ax[3] = {zyx ? 2 : 0, 1, zyx ? 0 : 2};  // priority order of the axes
+  float mn[3], mx[3];  // the box of the finite points
+  if (!detail::finite_box(pts.data(), n, mn, mx)) return Cells{std::vector<int>(n, -1), {}, {}, {}};
+  detail::PackedGrid g;
+  g.leaf = opt.leaf_mm;
+  g.divide = divide;
+  g.int32_cells = true;
+  int64_t span = 0;
+  int width[3];
   for (int d = 0; d < 3; ++d) {
-    lo[d] = cell(box.min()[ax[d]]);  // the cell index is monotonic in the coordinate
-    span = std::max(span, cell(box.max()[ax[d]]) - lo[d]);
+    g.axis[d] = ax[d];
+    g.lo[d] = cell(mn[ax[d]]);  // the cell index is monotonic in the coordinate
+    const int64_t hi = cell(mx[ax[d]]);
+    span = std::max(span, hi - g.lo[d]);
+    width[d] = bit_width(static_cast<uint64_t>(hi - g.lo[d]));
+    g.int32_cells = g.int32_cells && g.lo[d] >= std::numeric_limits<int32_t>::min() &&
+                    hi <= std::numeric_limits<int32_t>::max();
   }
-  auto sorted_order = [](auto& keyed, Cells& c) {
-    std::sort(keyed.begin(), keyed.end());
-    c.order.resize(keyed.size());
-    for (size_t k = 0; k < keyed.size(); ++k) c.order[k] = keyed[k].second;
-  };
   if (span < (int64_t(1) << 21)) {
+    g.shift[0] = width[1] + width[2];
+    g.shift[1] = width[2];
+    const std::unique_ptr<uint64_t[]> point_key(new uint64_t[n]);  // every one written
+    detail::packed_cell_keys(pts.data(), n, g, point_key.get());
     std::vector<uint64_t> keys;
     Cells c = group_by<uint64_t>(
-        n,
-        [&](size_t i) {
-          const Vec3f& p = pts[i];
-          return (static_cast<uint64_t>(cell(p[ax[0]]) - lo[0]) << 42) |
-                 (static_cast<uint64_t>(cell(p[ax[1]]) - lo[1]) << 21) | static_cast<uint64_t>(cell(p[ax[2]]) - lo[2]);
-        },
-        skip, keys);
-    std::vector<std::pair<uint64_t, int>> keyed(keys.size());
-    for (size_t k = 0; k < keys.size(); ++k) keyed[k] = {keys[k], static_cast<int>(k)};
-    sorted_order(keyed, c);
+        n, [&](size_t i) { return point_key[i]; }, [&](size_t i) { return point_key[i] == detail::kNoCell; }, keys);
+    sorted_order(keys, width[0] + width[1] + width[2], c.order);
     return c;
   }
   std::vector<Key> keys;
   Cells c = group_by<Key>(
-      n, [&](size_t i) { return Key{cell(pts[i][ax[0]]), cell(pts[i][ax[1]]), cell(pts[i][ax[2]])}; }, skip, keys);
+      n, [&](size_t i) { return Key{cell(pts[i][ax[0]]), cell(pts[i][ax[1]]), cell(pts[i][ax[2]])}; },
+      [&](size_t i) { return !finite3(pts[i]); }, keys);
   std::vector<std::pair<Key, int>> keyed(keys.size());
   for (size_t k = 0; k < keys.size(); ++k) keyed[k] = {keys[k], static_cast<int>(k)};
-  sorted_order(keyed, c);
+  std::sort(keyed.begin(), keyed.end());
+  c.order.resize(keyed.size());
+  for (size_t k = 0; k < keyed.size(); ++k) c.order[k] = keyed[k].second;
   return c;
 }
 
@@ -229,21 +260,29 @@ PointSet voxel_downsample(const PointSet& in, const VoxelGridOptions& opt) {
                       ? split_by_normal(group(in.points, opt), in.normals, opt.normal_cluster_deg)
                       : group(in.points, opt);
   const std::vector<Vec3> centroid = centroids(in.points, c);
+  // Each field in its own pass over the points (input order, as the sums'
+  // order must be).
   std::vector<Vec3> nsum(has_n ? c.size() : 0, Vec3::Zero());
   std::vector<double> csum(has_c ? c.size() : 0, 0.0);
   std::vector<int> best_px(has_px ? c.size() : 0, -1);
-  std::vector<double> best_d(has_px ? c.size() : 0, std::numeric_limits<double>::infinity());
-  for (size_t i = 0; i < n; ++i) {
-    const int k = c.cell_of[i];
-    if (k < 0) continue;
-    if (has_n) nsum[static_cast<size_t>(k)] += in.normals[i].cast<double>();
-    if (has_c) csum[static_cast<size_t>(k)] += in.curvature[i];
-    if (has_px) {  // the point nearest the centroid; ties: the smaller pixel
+  if (has_n)
+    for (size_t i = 0; i < n; ++i)
+      if (const int k = c.cell_of[i]; k >= 0) nsum[static_cast<size_t>(k)] += in.normals[i].cast<double>();
+  if (has_c)
+    for (size_t i = 0; i < n; ++i)
+      if (const int k = c.cell_of[i]; k >= 0) csum[static_cast<size_t>(k)] += in.curvature[i];
+  if (has_px) {  // the point nearest the centroid; ties: the smaller pixel
+    std::vector<double> best_d(c.size(), std::numeric_limits<double>::infinity());
+    for (size_t i = 0; i < n; ++i) {
+      const int k = c.cell_of[i];
+      if (k < 0) continue;
       const double d = (in.points[i].cast<double>() - centroid[static_cast<size_t>(k)]).squaredNorm();
       const int px = in.pixel[i];
-      if (d < best_d[static_cast<size_t>(k)] || (d == best_d[static_cast<size_t>(k)] && px < best_px[static_cast<size_t>(k)])) {
-        best_d[static_cast<size_t>(k)] = d;
-        best_px[static_cast<size_t>(k)] = px;
+      double& bd = best_d[static_cast<size_t>(k)];
+      int& bp = best_px[static_cast<size_t>(k)];
+      if (d < bd || (d == bd && px < bp)) {
+        bd = d;
+        bp = px;
       }
     }
   }
