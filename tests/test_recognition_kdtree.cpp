@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "core/random.h"
@@ -128,6 +129,64 @@ TEST(KdTree3, LongNeighbourhoodsAreSortedByDistanceThenIndex) {
       tree.within(q, max2, got);
       EXPECT_EQ(got, want);
     }
+  }
+}
+
+// The thinned searches give what the full ones give after keep_evenly, entry
+// for entry and in order, with the full count: random clouds, a surface
+// (a plane's grid, where whole subtrees lie inside the ball), duplicates,
+// points exactly at the radius, every thinning from none to beyond the count.
+TEST(KdTree3, ThinnedSearchesEqualTheFullOnesThinned) {
+  pb::Rng rng(5);
+  std::vector<std::vector<Vec3f>> clouds = {random_cloud(5000, 3, 200.f), random_cloud(37, 4, 10.f)};
+  std::vector<Vec3f> grid;
+  for (int i = 0; i < 120; ++i)
+    for (int j = 0; j < 120; ++j) grid.emplace_back(2.5f * static_cast<float>(i), 2.5f * static_cast<float>(j), 700.f);
+  for (int i = 0; i < 400; ++i) grid.push_back(grid[static_cast<size_t>(i) * 29]);  // duplicates
+  clouds.push_back(grid);
+  size_t compared = 0, thinned = 0;
+  for (const auto& pts : clouds) {
+    const pb::KdTree3 tree(pts);
+    for (int t = 0; t < 60; ++t) {
+      const Vec3f q = t % 3 == 0 ? pts[static_cast<size_t>(rng.uniform_int(0, static_cast<int>(pts.size()) - 1))]
+                                 : Vec3f(static_cast<float>(rng.uniform(-50, 300)), static_cast<float>(rng.uniform(-50, 300)),
+                                         static_cast<float>(rng.uniform(-50, 800)));
+      // A radius exactly at some point's distance (the bound's edge) or random.
+      const float edge = (pts[static_cast<size_t>(rng.uniform_int(0, static_cast<int>(pts.size()) - 1))] - q).squaredNorm();
+      for (const float r2 : {edge, static_cast<float>(rng.uniform(1, 40000)), 1e9f}) {
+        for (const int max_points : {0, 1, 5, 64, 256, 100000}) {
+          std::vector<std::pair<float, int>> full, got;
+          tree.within(q, r2, full, false);
+          const size_t n = full.size();
+          pb::keep_evenly(full, max_points);
+          std::vector<int> all, ids;
+          tree.radius_unsorted(q, std::sqrt(r2), all);
+          const size_t m = all.size();
+          pb::keep_evenly(all, max_points);
+          using How = pb::KdTree3::Thinning;
+          for (const How how : {How::counted, How::point_by_point, How::automatic}) {
+            EXPECT_EQ(tree.within_thinned(q, r2, max_points, got, how), n);
+            ASSERT_EQ(got, full) << "within, r2 " << r2 << " max " << max_points << " way " << static_cast<int>(how);
+            EXPECT_EQ(tree.radius_thinned(q, std::sqrt(r2), max_points, ids, how), m);
+            ASSERT_EQ(ids, all) << "radius, r " << std::sqrt(r2) << " max " << max_points << " way "
+                                << static_cast<int>(how);
+          }
+          ++compared;
+          thinned += max_points > 0 && n > static_cast<size_t>(max_points);
+        }
+      }
+    }
+  }
+  EXPECT_GT(thinned, 500u);
+  EXPECT_GT(compared, 3000u);
+  // Empty tree, non-finite query, no radius: nothing.
+  std::vector<std::pair<float, int>> out{{1.f, 1}};
+  for (const auto how : {pb::KdTree3::Thinning::counted, pb::KdTree3::Thinning::point_by_point}) {
+    EXPECT_EQ(pb::KdTree3().within_thinned(Vec3f(0, 0, 0), 1.f, 5, out, how), 0u);
+    EXPECT_TRUE(out.empty());
+    const pb::KdTree3 tree(grid);
+    EXPECT_EQ(tree.within_thinned(Vec3f(std::nanf(""), 0, 0), 1e6f, 5, out, how), 0u);
+    EXPECT_EQ(tree.within_thinned(grid[0], 0.f, 5, out, how), 0u);
   }
 }
 

@@ -12,6 +12,7 @@ namespace pb {
 KdTree3::KdTree3(const std::vector<Vec3f>& points, int leaf_size) {
   if (points.empty()) return;
   nodes_.reserve(2 * points.size() / static_cast<size_t>(std::max(1, leaf_size)) + 2);
+  boxes_.reserve(nodes_.capacity());
   std::vector<Entry> entries(points.size());
   for (size_t i = 0; i < points.size(); ++i) entries[i] = {points[i], static_cast<int>(i)};
   build(entries, 0, static_cast<int>(points.size()), std::max(1, leaf_size));
@@ -38,13 +39,14 @@ int KdTree3::build(std::vector<Entry>& e, int begin, int end, int leaf_size) {
   nodes_.emplace_back();
   nodes_[static_cast<size_t>(id)].begin = begin;
   nodes_[static_cast<size_t>(id)].end = end;
-  if (end - begin <= leaf_size) return id;
   Vec3f lo = e[static_cast<size_t>(begin)].point, hi = lo;
   for (int i = begin + 1; i < end; ++i) {
     const Vec3f& p = e[static_cast<size_t>(i)].point;
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
+  boxes_.push_back({{lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}});
+  if (end - begin <= leaf_size) return id;
   int dim = 0;
   (hi - lo).maxCoeff(&dim);
   if (!(hi[dim] > lo[dim])) return id;  // all points equal: one leaf
@@ -250,6 +252,153 @@ void KdTree3::radius_unsorted(const Vec3f& q, float r, std::vector<int>& out) co
   if (nodes_.empty() || !q.allFinite() || !(r > 0)) return;
   auto add = [&out](float, int i) { out.push_back(i); };
   visit_radius(0, q, r * r, add);
+}
+
+inline void KdTree3::emit(const Vec3f& q, int position, std::vector<std::pair<float, int>>& out) const {
+  // The squared distance as leaf_distances computes it: x^2 + (y^2 + z^2) of
+  // the point minus q.
+  const size_t k = static_cast<size_t>(position);
+  const float dx = xyz_[0][k] - q.x(), dy = xyz_[1][k] - q.y(), dz = xyz_[2][k] - q.z();
+  out.emplace_back(dx * dx + (dy * dy + dz * dz), order_[k]);
+}
+
+// The margin of the box tests: a squared distance as leaf_distances rounds
+// it is within 5 float roundings (relative 3e-7) of the exact one, so a box
+// whose farthest corner is below bound x (1 - 1e-6) holds only points
+// within, and one whose nearest point is beyond bound x (1 + 1e-6) none. Bounds this small are left to the point-by-point search (no
+// subnormal rounding to reason about), and so are subtrees of fewer than
+// kWholeFrom points (their test would cost more than it saves).
+constexpr double kBoxMargin = 1e-6, kSmallestBound = 1e-20;
+constexpr int kWholeFrom = 8;
+
+template <bool kStrict>
+void KdTree3::runs_of(int node, const Vec3f& q, float bound, std::vector<Run>& runs, std::vector<int>& hits) const {
+  const Node& n = nodes_[static_cast<size_t>(node)];
+  if (n.end - n.begin >= kWholeFrom && bound > kSmallestBound) {
+    const Box& b = boxes_[static_cast<size_t>(node)];
+    double near2 = 0, far2 = 0;
+    for (int d = 0; d < 3; ++d) {
+      const double below = static_cast<double>(b.lo[d]) - q[d], above = static_cast<double>(q[d]) - b.hi[d];
+      const double gap = std::max({below, above, 0.0}), reach = std::max(-below, -above);
+      near2 += gap * gap;
+      far2 += reach * reach;
+    }
+    if (near2 > bound * (1 + kBoxMargin)) return;  // no point within: visit_radius finds none here
+    if (far2 <= bound * (1 - kBoxMargin)) {        // every point within
+      runs.push_back({node, -1, n.end - n.begin});
+      return;
+    }
+  }
+  if (n.dim < 0) {
+    const int first = static_cast<int>(hits.size());
+    float d4[4];
+    for (int i = n.begin; i < n.end; i += 4) {
+      const int m = std::min(4, n.end - i);
+      for (int mask = leaf_distances(q, i, m, bound, d4); mask != 0; mask &= mask - 1) {
+        const int k = __builtin_ctz(static_cast<unsigned>(mask));
+        if (!kStrict || d4[k] < bound) hits.push_back(i + k);
+      }
+    }
+    const int count = static_cast<int>(hits.size()) - first;
+    if (count > 0) runs.push_back({node, first, count});
+    return;
+  }
+  // The order and the pruning of visit_radius.
+  const float diff = q[n.dim] - n.split;
+  const int near = diff < 0 ? n.left : n.right, far = diff < 0 ? n.right : n.left;
+  runs_of<kStrict>(near, q, bound, runs, hits);
+  if (diff * diff <= bound) runs_of<kStrict>(far, q, bound, runs, hits);
+}
+
+void KdTree3::pick_ranks(int node, const Vec3f& q, size_t base, Ranks& ranks,
+                         std::vector<std::pair<float, int>>& out) const {
+  const Node& n = nodes_[static_cast<size_t>(node)];
+  if (!ranks.below(base + static_cast<size_t>(n.end - n.begin))) return;  // none chosen in this subtree
+  if (n.dim < 0) {
+    for (; ranks.below(base + static_cast<size_t>(n.end - n.begin)); ranks.next())
+      emit(q, n.begin + static_cast<int>(ranks.rank - base), out);
+    return;
+  }
+  // Inside the ball visit_radius goes near first and visits both children.
+  const float diff = q[n.dim] - n.split;
+  const int near = diff < 0 ? n.left : n.right, far = diff < 0 ? n.right : n.left;
+  const Node& nn = nodes_[static_cast<size_t>(near)];
+  pick_ranks(near, q, base, ranks, out);
+  pick_ranks(far, q, base + static_cast<size_t>(nn.end - nn.begin), ranks, out);
+}
+
+template <bool kStrict>
+size_t KdTree3::thinned(const Vec3f& q, float bound, int max_points, std::vector<std::pair<float, int>>& out) const {
+  out.clear();
+  if (nodes_.empty() || !q.allFinite()) return 0;
+  thread_local std::vector<Run> runs;
+  thread_local std::vector<int> hits;
+  runs.clear();
+  hits.clear();
+  runs_of<kStrict>(0, q, bound, runs, hits);
+  size_t n = 0;
+  for (const Run& r : runs) n += static_cast<size_t>(r.count);
+  // keep_evenly's choice: entry floor(i n / m) of the n, i < m.
+  const size_t m = max_points > 0 && n > static_cast<size_t>(max_points) ? static_cast<size_t>(max_points) : n;
+  out.reserve(m);
+  Ranks ranks(n, m);
+  size_t start = 0;
+  for (const Run& r : runs) {
+    const size_t end = start + static_cast<size_t>(r.count);
+    if (r.first >= 0) {
+      for (; ranks.below(end); ranks.next())
+        emit(q, hits[static_cast<size_t>(r.first) + (ranks.rank - start)], out);
+    } else {
+      pick_ranks(r.node, q, start, ranks, out);
+    }
+    start = end;
+  }
+  return n;
+}
+
+namespace {
+// The count of the thread's last thinned search: a neighbourhood of at most
+// kCountedFrom x max_points is found faster point by point, as within does
+// (the counted runs pay their box tests and a second pass). Both ways give
+// the same list; the count only picks the faster.
+thread_local size_t last_found = 0;
+constexpr size_t kCountedFrom = 4;
+
+bool point_by_point(KdTree3::Thinning how, int max_points) {
+  if (how != KdTree3::Thinning::automatic) return how == KdTree3::Thinning::point_by_point;
+  return max_points <= 0 || last_found <= kCountedFrom * static_cast<size_t>(max_points);
+}
+}  // namespace
+
+size_t KdTree3::within_thinned(const Vec3f& q, float max_sq_dist, int max_points,
+                               std::vector<std::pair<float, int>>& out, Thinning how) const {
+  if (point_by_point(how, max_points)) {
+    within(q, max_sq_dist, out, false);
+    last_found = out.size();
+    keep_evenly(out, max_points);
+    return last_found;
+  }
+  if (!(max_sq_dist > 0)) {  // as within
+    out.clear();
+    return last_found = 0;
+  }
+  return last_found = thinned<true>(q, max_sq_dist, max_points, out);
+}
+
+size_t KdTree3::radius_thinned(const Vec3f& q, float r, int max_points, std::vector<int>& out, Thinning how) const {
+  if (point_by_point(how, max_points)) {
+    radius_unsorted(q, r, out);
+    last_found = out.size();
+    keep_evenly(out, max_points);
+    return last_found;
+  }
+  out.clear();
+  if (!(r > 0)) return last_found = 0;
+  thread_local std::vector<std::pair<float, int>> found;
+  last_found = thinned<false>(q, r * r, max_points, found);
+  out.reserve(found.size());
+  for (const auto& f : found) out.push_back(f.second);
+  return last_found;
 }
 
 }  // namespace pb

@@ -33,6 +33,21 @@ class KdTree3 {
   void within(const Vec3f& q, float max_sq_dist, std::vector<std::pair<float, int>>& out, bool sorted = true) const;
   // The same set in tree order (no sort: for sums over the neighbourhood).
   void radius_unsorted(const Vec3f& q, float r, std::vector<int>& out) const;
+  // The lists of within(q, max_sq_dist, out, false) and radius_unsorted
+  // thinned by keep_evenly(out, max_points), the same entries in the same
+  // order, found without visiting every point of a large neighbourhood: a
+  // subtree whose box lies inside the ball (with a margin that covers the
+  // distances' rounding) is counted whole, and only its chosen points are
+  // looked up, by rank; one outside it is skipped. Where the thread's last
+  // such search found at most 4 x max_points, point by point as within
+  // does (faster for small neighbourhoods). Returns how many points were
+  // within (before thinning).
+  // `how` forces one way (tests compare them).
+  enum class Thinning { automatic, counted, point_by_point };
+  size_t within_thinned(const Vec3f& q, float max_sq_dist, int max_points, std::vector<std::pair<float, int>>& out,
+                        Thinning how = Thinning::automatic) const;
+  size_t radius_thinned(const Vec3f& q, float r, int max_points, std::vector<int>& out,
+                        Thinning how = Thinning::automatic) const;
   size_t size() const { return points_.size(); }
 
  private:
@@ -42,6 +57,41 @@ class KdTree3 {
     float split = 0;
     int left = -1, right = -1;
   };
+  struct Box {
+    float lo[3], hi[3];  // of a node's points
+  };
+  // A run of the radius search's visiting order: a subtree inside the ball
+  // (first < 0: every point of `node`) or the points of a leaf found within
+  // (tree positions hits[first, first + count)).
+  struct Run {
+    int node, first, count;
+  };
+  template <bool kStrict>
+  void runs_of(int node, const Vec3f& q, float bound, std::vector<Run>& runs,
+               std::vector<int>& hits) const;
+  template <bool kStrict>
+  size_t thinned(const Vec3f& q, float bound, int max_points, std::vector<std::pair<float, int>>& out) const;
+  // keep_evenly's choice of n entries as a stream of ranks: floor(i n / m)
+  // for i < m, stepped without division.
+  struct Ranks {
+    size_t i = 0, m = 0, rank = 0, rem = 0, step = 0, extra = 0;
+    Ranks(size_t n, size_t keep) : m(keep), step(keep ? n / keep : 0), extra(keep ? n % keep : 0) {}
+    bool below(size_t end) const { return i < m && rank < end; }
+    void next() {
+      ++i;
+      rank += step;
+      rem += extra;
+      if (rem >= m) {
+        rem -= m;
+        ++rank;
+      }
+    }
+  };
+  // Appends the subtree's points whose ranks come next (its points take
+  // ranks base.. in visit_radius's order: near child first) as (squared
+  // distance, input index).
+  void pick_ranks(int node, const Vec3f& q, size_t base, Ranks& ranks, std::vector<std::pair<float, int>>& out) const;
+  void emit(const Vec3f& q, int position, std::vector<std::pair<float, int>>& out) const;
   struct Entry {
     Vec3f point;
     int index;  // in the input
@@ -61,6 +111,7 @@ class KdTree3 {
   std::vector<int> order_;     // tree position -> input index
   std::vector<int> position_;  // input index -> tree position
   std::vector<Node> nodes_;
+  std::vector<Box> boxes_;  // per node (apart from nodes_: the nearest search reads nodes_ alone)
 };
 
 // Thins a neighbour list to at most `max_points` entries evenly spaced in

@@ -39,12 +39,14 @@ CloudNeighbours::CloudNeighbours(const std::vector<Vec3f>& points) : tree_(finit
 size_t CloudNeighbours::within(const Vec3f& q, float r2, std::vector<std::pair<float, int>>& out, bool sorted,
                                int max_points) const {
   const bool thin = max_points > 0;
-  tree_.within(q, r2, out, sorted && !thin);
-  const size_t found = out.size();
+  size_t found = 0;
   if (thin) {
-    keep_evenly(out, max_points);
+    found = tree_.within_thinned(q, r2, max_points, out);  // keep_evenly of the tree-order list
     // (squared distance, tree index) pairs order as the kd-tree's sorted keys
     if (sorted) std::sort(out.begin(), out.end());
+  } else {
+    tree_.within(q, r2, out, sorted);
+    found = out.size();
   }
   // tree index -> cloud index keeps the order (finite_points keeps it)
   for (auto& e : out) e.second = cloud_index_[static_cast<size_t>(e.second)];
