@@ -271,7 +271,6 @@ inline void KdTree3::emit(const Vec3f& q, int position, std::vector<std::pair<fl
 constexpr double kBoxMargin = 1e-6, kSmallestBound = 1e-20;
 constexpr int kWholeFrom = 8;
 
-template <bool kStrict>
 void KdTree3::runs_of(int node, const Vec3f& q, float bound, std::vector<Run>& runs, std::vector<int>& hits) const {
   const Node& n = nodes_[static_cast<size_t>(node)];
   if (n.end - n.begin >= kWholeFrom && bound > kSmallestBound) {
@@ -296,7 +295,7 @@ void KdTree3::runs_of(int node, const Vec3f& q, float bound, std::vector<Run>& r
       const int m = std::min(4, n.end - i);
       for (int mask = leaf_distances(q, i, m, bound, d4); mask != 0; mask &= mask - 1) {
         const int k = __builtin_ctz(static_cast<unsigned>(mask));
-        if (!kStrict || d4[k] < bound) hits.push_back(i + k);
+        if (d4[k] < bound) hits.push_back(i + k);  // strictly, as within
       }
     }
     const int count = static_cast<int>(hits.size()) - first;
@@ -306,8 +305,8 @@ void KdTree3::runs_of(int node, const Vec3f& q, float bound, std::vector<Run>& r
   // The order and the pruning of visit_radius.
   const float diff = q[n.dim] - n.split;
   const int near = diff < 0 ? n.left : n.right, far = diff < 0 ? n.right : n.left;
-  runs_of<kStrict>(near, q, bound, runs, hits);
-  if (diff * diff <= bound) runs_of<kStrict>(far, q, bound, runs, hits);
+  runs_of(near, q, bound, runs, hits);
+  if (diff * diff <= bound) runs_of(far, q, bound, runs, hits);
 }
 
 void KdTree3::pick_ranks(int node, const Vec3f& q, size_t base, Ranks& ranks,
@@ -327,7 +326,6 @@ void KdTree3::pick_ranks(int node, const Vec3f& q, size_t base, Ranks& ranks,
   pick_ranks(far, q, base + static_cast<size_t>(nn.end - nn.begin), ranks, out);
 }
 
-template <bool kStrict>
 size_t KdTree3::thinned(const Vec3f& q, float bound, int max_points, std::vector<std::pair<float, int>>& out) const {
   out.clear();
   if (nodes_.empty() || !q.allFinite()) return 0;
@@ -335,7 +333,7 @@ size_t KdTree3::thinned(const Vec3f& q, float bound, int max_points, std::vector
   thread_local std::vector<int> hits;
   runs.clear();
   hits.clear();
-  runs_of<kStrict>(0, q, bound, runs, hits);
+  runs_of(0, q, bound, runs, hits);
   size_t n = 0;
   for (const Run& r : runs) n += static_cast<size_t>(r.count);
   // keep_evenly's choice: entry floor(i n / m) of the n, i < m.
@@ -382,23 +380,7 @@ size_t KdTree3::within_thinned(const Vec3f& q, float max_sq_dist, int max_points
     out.clear();
     return last_found = 0;
   }
-  return last_found = thinned<true>(q, max_sq_dist, max_points, out);
-}
-
-size_t KdTree3::radius_thinned(const Vec3f& q, float r, int max_points, std::vector<int>& out, Thinning how) const {
-  if (point_by_point(how, max_points)) {
-    radius_unsorted(q, r, out);
-    last_found = out.size();
-    keep_evenly(out, max_points);
-    return last_found;
-  }
-  out.clear();
-  if (!(r > 0)) return last_found = 0;
-  thread_local std::vector<std::pair<float, int>> found;
-  last_found = thinned<false>(q, r * r, max_points, found);
-  out.reserve(found.size());
-  for (const auto& f : found) out.push_back(f.second);
-  return last_found;
+  return last_found = thinned(q, max_sq_dist, max_points, out);
 }
 
 }  // namespace pb

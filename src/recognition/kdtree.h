@@ -33,20 +33,17 @@ class KdTree3 {
   void within(const Vec3f& q, float max_sq_dist, std::vector<std::pair<float, int>>& out, bool sorted = true) const;
   // The same set in tree order (no sort: for sums over the neighbourhood).
   void radius_unsorted(const Vec3f& q, float r, std::vector<int>& out) const;
-  // The lists of within(q, max_sq_dist, out, false) and radius_unsorted
-  // thinned by keep_evenly(out, max_points), the same entries in the same
-  // order, found without visiting every point of a large neighbourhood: a
+  // The list of within(q, max_sq_dist, out, false) thinned by
+  // keep_evenly(out, max_points), the same entries in the same order, and
+  // how many points were within (before thinning). Counted: without
+  // visiting every point of a large neighbourhood (FPFH's supports): a
   // subtree whose box lies inside the ball (with a margin that covers the
-  // distances' rounding) is counted whole, and only its chosen points are
-  // looked up, by rank; one outside it is skipped. Where the thread's last
-  // such search found at most 4 x max_points, point by point as within
-  // does (faster for small neighbourhoods). Returns how many points were
-  // within (before thinning).
-  // `how` forces one way (tests compare them).
+  // distances' rounding) is counted whole and only its chosen points are
+  // looked up, by rank; one outside it is skipped. Point by point: within,
+  // then keep_evenly (faster for small neighbourhoods). Automatic: counted
+  // where the thread's last such search found more than 4 x max_points.
   enum class Thinning { automatic, counted, point_by_point };
   size_t within_thinned(const Vec3f& q, float max_sq_dist, int max_points, std::vector<std::pair<float, int>>& out,
-                        Thinning how = Thinning::automatic) const;
-  size_t radius_thinned(const Vec3f& q, float r, int max_points, std::vector<int>& out,
                         Thinning how = Thinning::automatic) const;
   size_t size() const { return points_.size(); }
 
@@ -66,10 +63,8 @@ class KdTree3 {
   struct Run {
     int node, first, count;
   };
-  template <bool kStrict>
   void runs_of(int node, const Vec3f& q, float bound, std::vector<Run>& runs,
                std::vector<int>& hits) const;
-  template <bool kStrict>
   size_t thinned(const Vec3f& q, float bound, int max_points, std::vector<std::pair<float, int>>& out) const;
   // keep_evenly's choice of n entries as a stream of ranks: floor(i n / m)
   // for i < m, stepped without division.
