@@ -513,7 +513,8 @@ DIFFERENCES = [
     "clouds' centroids, where the thesis's section 3.2.4 aligns the clusters' average normals for every global "
     "descriptor; the esfpose ablation runs ESF that way. It draws 20,000 point triples (PCL's value), where the "
     "thesis's section 3.2.3 iterates \"the number of points\" (the triples ablation), and takes its roll from the "
-    "CRH, which needs normals the thesis's ESF does not compute (the esfroll ablation skips it).",
+    "CRH, which needs normals the thesis's ESF does not compute (the esfroll ablation skips it). The esfread "
+    "ablation switches these readings and the nearest one at once.",
     "Synthetic table: the LS5 stands upright in half of the images and lies in another rest pose in the other "
     "half (`target_upright_probability: 0.5`); the thesis's synthetic LS5 is \"slightly tilted\" and \"not "
     "standing upright\". The tilt ablation stands it upright, leaned by up to 20 degrees (`target_tilt_deg`).",
