@@ -148,11 +148,13 @@ TEST(KdTree3, ThinnedSearchesEqualTheFullOnesThinned) {
   for (const auto& pts : clouds) {
     const pb::KdTree3 tree(pts);
     for (int t = 0; t < 60; ++t) {
-      const Vec3f q = t % 3 == 0 ? pts[static_cast<size_t>(rng.uniform_int(0, static_cast<int>(pts.size()) - 1))]
-                                 : Vec3f(static_cast<float>(rng.uniform(-50, 300)), static_cast<float>(rng.uniform(-50, 300)),
+      auto any_point = [&] { return pts[static_cast<size_t>(rng.uniform_int(0, static_cast<int>(pts.size()) - 1))]; };
+      const Vec3f q = t % 3 == 0 ? any_point()
+                                 : Vec3f(static_cast<float>(rng.uniform(-50, 300)),
+                                         static_cast<float>(rng.uniform(-50, 300)),
                                          static_cast<float>(rng.uniform(-50, 800)));
       // A radius exactly at some point's distance (the bound's edge) or random.
-      const float edge = (pts[static_cast<size_t>(rng.uniform_int(0, static_cast<int>(pts.size()) - 1))] - q).squaredNorm();
+      const float edge = (any_point() - q).squaredNorm();
       for (const float r2 : {edge, static_cast<float>(rng.uniform(1, 40000)), 1e9f}) {
         for (const int max_points : {0, 1, 5, 64, 256, 100000}) {
           std::vector<std::pair<float, int>> full, got;

@@ -166,7 +166,8 @@ PointSet random_cloud(pb::Rng& rng, int n, double extent, double centre, double 
   }
   ps.pixel.resize(static_cast<size_t>(n));
   std::iota(ps.pixel.begin(), ps.pixel.end(), 0);
-  for (int i = n - 1; i > 0; --i) std::swap(ps.pixel[static_cast<size_t>(i)], ps.pixel[static_cast<size_t>(rng.uniform_int(0, i))]);
+  for (int i = n - 1; i > 0; --i)
+    std::swap(ps.pixel[static_cast<size_t>(i)], ps.pixel[static_cast<size_t>(rng.uniform_int(0, i))]);
   return ps;
 }
 

@@ -265,9 +265,10 @@ inline void KdTree3::emit(const Vec3f& q, int position, std::vector<std::pair<fl
 // The margin of the box tests: a squared distance as leaf_distances rounds
 // it is within 5 float roundings (relative 3e-7) of the exact one, so a box
 // whose farthest corner is below bound x (1 - 1e-6) holds only points
-// within, and one whose nearest point is beyond bound x (1 + 1e-6) none. Bounds this small are left to the point-by-point search (no
-// subnormal rounding to reason about), and so are subtrees of fewer than
-// kWholeFrom points (their test would cost more than it saves).
+// within, and one whose nearest point is beyond bound x (1 + 1e-6) none.
+// Bounds this small are left to the point-by-point search (no subnormal
+// rounding to reason about), and so are subtrees of fewer than kWholeFrom
+// points.
 constexpr double kBoxMargin = 1e-6, kSmallestBound = 1e-20;
 constexpr int kWholeFrom = 8;
 

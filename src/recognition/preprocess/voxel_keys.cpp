@@ -54,6 +54,19 @@ void keys_scalar(const Vec3f* p, size_t i, size_t n, const AxisGrid& a, uint64_t
 
 #ifdef PB_VOXEL_KEYS_X86
 
+// The twelve floats of four points at b, in three loads, as an x, a y and a
+// z vector (SSE; inlined into the AVX2 kernel as well).
+inline void four_points(const float* b, __m128 c[3]) {
+  // v0 = x0 y0 z0 x1, v1 = y1 z1 x2 y2, v2 = z2 x3 y3 z3.
+  const __m128 v0 = _mm_loadu_ps(b), v1 = _mm_loadu_ps(b + 4), v2 = _mm_loadu_ps(b + 8);
+  const __m128 t0 = _mm_shuffle_ps(v0, v1, _MM_SHUFFLE(1, 0, 3, 2));  // z0 x1 y1 z1
+  const __m128 t1 = _mm_shuffle_ps(v1, v2, _MM_SHUFFLE(2, 1, 3, 2));  // x2 y2 x3 y3
+  const __m128 t2 = _mm_shuffle_ps(v0, t0, _MM_SHUFFLE(0, 2, 0, 1));  // y0 x0 y1 z0
+  c[0] = _mm_shuffle_ps(v0, t1, _MM_SHUFFLE(2, 0, 3, 0));             // x0 x1 x2 x3
+  c[1] = _mm_shuffle_ps(t2, t1, _MM_SHUFFLE(3, 1, 2, 0));             // y0 y1 y2 y3
+  c[2] = _mm_shuffle_ps(t0, v2, _MM_SHUFFLE(3, 0, 3, 0));             // z0 z1 z2 z3
+}
+
 // Four points per step: their twelve floats in three loads, turned into an
 // x, a y and a z vector; per coordinate the same double product (or
 // quotient) as keys_scalar, floor by roundpd, the integer by truncation (the
@@ -72,15 +85,8 @@ __attribute__((target("avx2"))) size_t keys_avx2(const Vec3f* p, size_t n, const
   const __m256i none = _mm256_set1_epi64x(-1);
   size_t i = 0;
   for (; i + 4 <= n; i += 4) {
-    const float* b = f + 3 * i;
-    // v0 = x0 y0 z0 x1, v1 = y1 z1 x2 y2, v2 = z2 x3 y3 z3.
-    const __m128 v0 = _mm_loadu_ps(b), v1 = _mm_loadu_ps(b + 4), v2 = _mm_loadu_ps(b + 8);
-    const __m128 t0 = _mm_shuffle_ps(v0, v1, _MM_SHUFFLE(1, 0, 3, 2));  // z0 x1 y1 z1
-    const __m128 t1 = _mm_shuffle_ps(v1, v2, _MM_SHUFFLE(2, 1, 3, 2));  // x2 y2 x3 y3
-    const __m128 t2 = _mm_shuffle_ps(v0, t0, _MM_SHUFFLE(0, 2, 0, 1));  // y0 x0 y1 z0
-    const __m128 c[3] = {_mm_shuffle_ps(v0, t1, _MM_SHUFFLE(2, 0, 3, 0)),   // x0 x1 x2 x3
-                         _mm_shuffle_ps(t2, t1, _MM_SHUFFLE(3, 1, 2, 0)),   // y0 y1 y2 y3
-                         _mm_shuffle_ps(t0, v2, _MM_SHUFFLE(3, 0, 3, 0))};  // z0 z1 z2 z3
+    __m128 c[3];
+    four_points(f + 3 * i, c);
     __m128 ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
     __m256i key = _mm256_setzero_si256();
     for (int d = 0; d < 3; ++d) {
@@ -96,7 +102,6 @@ __attribute__((target("avx2"))) size_t keys_avx2(const Vec3f* p, size_t n, const
   return i;
 }
 
-
 #endif
 
 }  // namespace
@@ -107,21 +112,15 @@ bool finite_box(const Vec3f* points, size_t n, float lo[3], float hi[3]) {
   size_t i = 0;
 #ifdef PB_VOXEL_KEYS_X86
   if (n >= 4) {
-    // Four points per step, turned into x, y and z vectors as keys_avx2
-    // does; a lane of a non-finite point becomes +inf for the minimum and
+    // Four points per step (four_points); a lane of a non-finite point becomes +inf for the minimum and
     // -inf for the maximum (no NaN reaches min or max).
     const float* f = points->data();
     const __m128 magnitude = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff)), inf = _mm_set1_ps(kInf),
                  ninf = _mm_set1_ps(-kInf);
     __m128 mn[3] = {inf, inf, inf}, mx[3] = {ninf, ninf, ninf};
     for (; i + 4 <= n; i += 4) {
-      const float* b = f + 3 * i;
-      const __m128 v0 = _mm_loadu_ps(b), v1 = _mm_loadu_ps(b + 4), v2 = _mm_loadu_ps(b + 8);
-      const __m128 t0 = _mm_shuffle_ps(v0, v1, _MM_SHUFFLE(1, 0, 3, 2));
-      const __m128 t1 = _mm_shuffle_ps(v1, v2, _MM_SHUFFLE(2, 1, 3, 2));
-      const __m128 t2 = _mm_shuffle_ps(v0, t0, _MM_SHUFFLE(0, 2, 0, 1));
-      const __m128 c[3] = {_mm_shuffle_ps(v0, t1, _MM_SHUFFLE(2, 0, 3, 0)), _mm_shuffle_ps(t2, t1, _MM_SHUFFLE(3, 1, 2, 0)),
-                           _mm_shuffle_ps(t0, v2, _MM_SHUFFLE(3, 0, 3, 0))};
+      __m128 c[3];
+      four_points(f + 3 * i, c);
       __m128 ok = _mm_cmplt_ps(_mm_and_ps(c[0], magnitude), inf);
       ok = _mm_and_ps(ok, _mm_cmplt_ps(_mm_and_ps(c[1], magnitude), inf));
       ok = _mm_and_ps(ok, _mm_cmplt_ps(_mm_and_ps(c[2], magnitude), inf));
