@@ -76,7 +76,6 @@ __attribute__((target("avx2"))) int sums_avx2(const WindowSumRow& a, int u, doub
 
 using Kernel = int (*)(const WindowSumRow&, int, double*, double*);
 
-
 Kernel pick() { return cpu_has_avx2() ? sums_avx2 : sums_sse2; }
 
 #endif

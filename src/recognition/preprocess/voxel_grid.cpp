@@ -156,8 +156,6 @@ inline int bit_width(uint64_t v) {
   return b;
 }
 
-inline bool finite3(const Vec3f& p) { return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z()); }
-
 // Groups the points by cell, with the key order of the cells (PCL's: z, then
 // y, then x for kZYX). When every axis spans fewer than 2^21 cells (always,
 // for images at sensor range and millimetre-scale leaves) the key is one
@@ -201,7 +199,7 @@ Cells group(const std::vector<Vec3f>& pts, const VoxelGridOptions& opt) {
   std::vector<Key> keys;
   Cells c = group_by<Key>(
       n, [&](size_t i) { return Key{cell(pts[i][ax[0]]), cell(pts[i][ax[1]]), cell(pts[i][ax[2]])}; },
-      [&](size_t i) { return !finite3(pts[i]); }, keys);
+      [&](size_t i) { return !pts[i].allFinite(); }, keys);
   std::vector<std::pair<Key, int>> keyed(keys.size());
   for (size_t k = 0; k < keys.size(); ++k) keyed[k] = {keys[k], static_cast<int>(k)};
   std::sort(keyed.begin(), keyed.end());

@@ -39,7 +39,7 @@ template <bool kDivide>
 void keys_scalar(const Vec3f* p, size_t i, size_t n, const AxisGrid& a, uint64_t* keys) {
   for (; i < n; ++i) {
     const Vec3f& q = p[i];
-    if (!(std::isfinite(q.x()) && std::isfinite(q.y()) && std::isfinite(q.z()))) {
+    if (!q.allFinite()) {
       keys[i] = kNoCell;
       continue;
     }
@@ -67,9 +67,8 @@ inline void four_points(const float* b, __m128 c[3]) {
   c[2] = _mm_shuffle_ps(t0, v2, _MM_SHUFFLE(3, 0, 3, 0));             // z0 z1 z2 z3
 }
 
-// Four points per step: their twelve floats in three loads, turned into an
-// x, a y and a z vector; per coordinate the same double product (or
-// quotient) as keys_scalar, floor by roundpd, the integer by truncation (the
+// Four points per step (four_points); per coordinate the same double
+// product (or quotient) as keys_scalar, floor by roundpd, the integer by truncation (the
 // floor is integral and within int32: PackedGrid::int32_cells). Lanes of
 // non-finite points get kNoCell. Returns the first point not done.
 template <bool kDivide>
@@ -143,7 +142,7 @@ bool finite_box(const Vec3f* points, size_t n, float lo[3], float hi[3]) {
 #endif
   for (; i < n; ++i) {
     const Vec3f& p = points[i];
-    if (!(std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z()))) continue;
+    if (!p.allFinite()) continue;
     for (int d = 0; d < 3; ++d) {
       l[d] = std::min(l[d], p[d]);
       h[d] = std::max(h[d], p[d]);
