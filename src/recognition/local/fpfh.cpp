@@ -297,11 +297,18 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
         if (d2 == 0.f) continue;
         const float weight = 1.f / d2;
         const Hist& s = spfhs[static_cast<size_t>(row_of[static_cast<size_t>(q)])];
-        for (int j = 0; j < kFpfhDim; ++j) {
-          const float v = s[j] * weight;
-          sum[j / kBins] += v;
-          h[j] += v;
+        // The products first (vectorized), then each histogram's double sum
+        // in bin order: the same additions as one loop over the 33 bins.
+        std::array<float, kFpfhDim> v;
+        for (int j = 0; j < kFpfhDim; ++j) v[j] = s[j] * weight;
+        for (int j = 0; j < kFpfhDim; ++j) h[j] += v[j];
+        double s0 = sum[0], s1 = sum[1], s2 = sum[2];
+        for (int b = 0; b < kBins; ++b) {
+          s0 += v[b];
+          s1 += v[kBins + b];
+          s2 += v[2 * kBins + b];
         }
+        sum = {s0, s1, s2};
       }
       float* row = out.data() + static_cast<size_t>(i) * kFpfhDim;
       for (int j = 0; j < kFpfhDim; ++j) {

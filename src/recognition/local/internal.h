@@ -124,6 +124,10 @@ class DescriptorIndex {
   // projected bounds, so a row may be missed (approximate search).
   void knn_block(const float* queries, int n, int k, float max_sq_dist,
                  std::vector<std::pair<int, float>>* out, int max_checks = 0) const;
+  // Whether short rows (FPFH's) take their bounds from the AVX2 kernel
+  // (default: where the CPU has AVX2) or from Eigen's product as long rows
+  // do; the answers are the same either way (tests run both).
+  void set_avx2_bounds(bool on);
 
  private:
   void build_projection();

@@ -33,7 +33,11 @@
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
 
+#include "core/cpu.h"
 #include "recognition/local/internal.h"
 
 namespace pb::local {
@@ -60,6 +64,8 @@ struct DescriptorIndex::Impl {
   std::vector<float> basis;    // proj_dim x dim, orthonormal rows (principal axes)
   std::vector<float> proj;     // rows x proj_dim: each row projected on the basis
   std::vector<float> proj_sq;  // squared norm of each projected row
+  std::vector<float> proj_t;   // short rows: proj_dim x rows, the projections axis by axis
+  bool avx2_bounds = false;    // short rows' bounds from bounds_avx2
 };
 
 DescriptorIndex::DescriptorIndex() : impl_(new Impl) {}
@@ -105,7 +111,15 @@ void DescriptorIndex::build_projection() {
   m.proj.assign(Z.data(), Z.data() + Z.size());
   m.proj_sq.resize(m.rows);
   for (size_t r = 0; r < m.rows; ++r) m.proj_sq[r] = Z.row(static_cast<Eigen::Index>(r)).squaredNorm();
+  if (m.proj_dim == kProjDimShort) {
+    m.proj_t.resize(static_cast<size_t>(m.proj_dim) * m.rows);
+    for (size_t r = 0; r < m.rows; ++r)
+      for (int a = 0; a < m.proj_dim; ++a) m.proj_t[static_cast<size_t>(a) * m.rows + r] = Z(static_cast<Eigen::Index>(r), a);
+    m.avx2_bounds = cpu_has_avx2();
+  }
 }
+
+void DescriptorIndex::set_avx2_bounds(bool on) { impl_->avx2_bounds = on && !impl_->proj_t.empty() && cpu_has_avx2(); }
 
 size_t DescriptorIndex::size() const { return impl_->rows; }
 
@@ -189,6 +203,33 @@ inline void offer(std::vector<std::pair<int, float>>& out, size_t kk, int row, f
              e);
 }
 
+#if defined(__x86_64__) || defined(__i386__)
+// The lower bounds |Pq|^2 + |Pd|^2 - 2 Pq.Pd of one query (projection zq,
+// its squared norm zn) to every row, eight rows at a time: zt holds the
+// rows' projections axis by axis (kProjDimShort x rows). Another rounding
+// than Eigen's product, inside the margin knn_block allows for it.
+__attribute__((target("avx2"))) void short_bounds_avx2(const float* zq, float zn, const float* zt, const float* psq,
+                                                       size_t rows, float* lbs) {
+  __m256 q[kProjDimShort];
+  for (int a = 0; a < kProjDimShort; ++a) q[a] = _mm256_set1_ps(-2.f * zq[a]);
+  const __m256 n8 = _mm256_set1_ps(zn);
+  size_t r = 0;
+  for (; r + 8 <= rows; r += 8) {
+    __m256 acc = _mm256_add_ps(n8, _mm256_loadu_ps(psq + r));
+    for (int a = 0; a < kProjDimShort; ++a)
+      acc = _mm256_add_ps(acc, _mm256_mul_ps(q[a], _mm256_loadu_ps(zt + static_cast<size_t>(a) * rows + r)));
+    _mm256_storeu_ps(lbs + r, acc);
+  }
+  for (; r < rows; ++r) {
+    float acc = zn + psq[r];
+    for (int a = 0; a < kProjDimShort; ++a) acc += -2.f * zq[a] * zt[static_cast<size_t>(a) * rows + r];
+    lbs[r] = acc;
+  }
+}
+#else
+void short_bounds_avx2(const float*, float, const float*, const float*, size_t, float*) {}
+#endif
+
 }  // namespace
 
 // The `cap` smallest (v[r], r) pairs (value, then index) among those with
@@ -243,7 +284,14 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
   const Eigen::Map<const RowMat> B(m.basis.data(), m.proj_dim, static_cast<Eigen::Index>(dim));
   const Eigen::Map<const RowMat> Z(m.proj.data(), static_cast<Eigen::Index>(m.rows), m.proj_dim);
   const RowMat Zq = Q * B.transpose();  // n x proj_dim
-  RowMat G = Zq * Z.transpose();  // n x rows projected dot products, then the bounds
+  // n x rows projected dot products, then the bounds in place; or, for short
+  // rows with AVX2, each query's bounds straight from the kernel.
+  RowMat G;
+  std::vector<float> wide;
+  if (m.avx2_bounds)
+    wide.resize(m.rows);
+  else
+    G = Zq * Z.transpose();
   std::vector<std::pair<float, int>> cand;
   std::vector<std::pair<int, float>> best, measured;
   for (int i = 0; i < n; ++i) {
@@ -257,9 +305,15 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
     // First pass: the bounds (in place of the dot products) and the kk
     // smallest of them; their exact distances cap the k-th best (tau0), so
     // only rows with a bound up to tau0 remain candidates.
-    float* lbs = G.row(i).data();
+    float* lbs = nullptr;
     const float* psq = m.proj_sq.data();
-    for (size_t r = 0; r < m.rows; ++r) lbs[r] = zn + psq[r] - 2.f * lbs[r];  // branch-free: vectorized
+    if (m.avx2_bounds) {
+      lbs = wide.data();
+      short_bounds_avx2(Zq.row(i).data(), zn, m.proj_t.data(), psq, m.rows, lbs);
+    } else {
+      lbs = G.row(i).data();
+      for (size_t r = 0; r < m.rows; ++r) lbs[r] = zn + psq[r] - 2.f * lbs[r];  // branch-free: vectorized
+    }
     cand.clear();
     if (kk == 1) {  // the smallest bound, the lowest row among equal ones
       const size_t arg = first_argmin(lbs, m.rows);
