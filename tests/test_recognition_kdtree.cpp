@@ -109,7 +109,8 @@ TEST(KdTree3, WithinIsStrictAndSortedByDistanceThenIndex) {
   for (const auto& e : at_bound) EXPECT_NE(e.second, static_cast<int>(pts.size()) - 1) << "25 is not below 25";
 }
 
-// Long neighbourhoods (thousands of points: the radix-sorted path) come in
+// Long neighbourhoods (thousands of points: the bucket-sorted path, buckets
+// of many equal distances too) come in
 // the same order as short ones: by distance, equal distances by index.
 TEST(KdTree3, LongNeighbourhoodsAreSortedByDistanceThenIndex) {
   std::vector<Vec3f> pts = random_cloud(6000, 21, 50.f);
@@ -124,7 +125,7 @@ TEST(KdTree3, LongNeighbourhoodsAreSortedByDistanceThenIndex) {
         if (d < max2) want.emplace_back(d, static_cast<int>(i));
       }
       std::sort(want.begin(), want.end());
-      ASSERT_GT(want.size(), 512u);  // long enough for the radix sort
+      ASSERT_GT(want.size(), 512u);  // long enough for the bucket sort
       std::vector<std::pair<float, int>> got;
       tree.within(q, max2, got);
       EXPECT_EQ(got, want);

@@ -1,6 +1,7 @@
 #include "recognition/kdtree.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #ifdef __SSE2__
@@ -161,55 +162,60 @@ void KdTree3::radius(const Vec3f& q, float r, std::vector<int>& out) const {
 
 namespace {
 
-// Sorts 64-bit keys ascending: std::sort for short lists, an LSD radix sort
-// (11-bit digits, skipping digits every key shares) for long ones (the
-// neighbourhoods of thousands of points in noisy, dense clouds). The same
-// order either way: the keys are distinct.
+// Sorts 64-bit keys (a squared distance's float bits over a point index)
+// ascending: std::sort for short lists; long ones (the neighbourhoods of
+// thousands of points in noisy, dense clouds) by a bucket sort on the
+// distance, then each bucket on its own. The bucket of distance d is
+// floor(d * scale): non-decreasing in d (a float product with a positive
+// scale and the truncation both are), so the buckets come in key order,
+// and the result is std::sort's (the keys are distinct). Before: an LSD
+// radix sort of 11-bit digits, five passes of two reads and a scattered
+// write over the keys where this makes one of each.
 void sort_keys(std::vector<uint64_t>& keys) {
-  constexpr size_t kRadixFrom = 512;
-  if (keys.size() < kRadixFrom) {
+  constexpr size_t kBucketFrom = 512;
+  constexpr size_t kInsertionUpTo = 16;  // a bucket this short: insertion sort
+  const size_t n = keys.size();
+  const auto dist = [](uint64_t k) {
+    const uint32_t bits = static_cast<uint32_t>(k >> 32);
+    float d;
+    std::memcpy(&d, &bits, sizeof d);
+    return d;
+  };
+  float dmax = 0;
+  if (n >= kBucketFrom)
+    for (uint64_t k : keys) dmax = std::max(dmax, dist(k));
+  if (n < kBucketFrom || !(dmax > 1e-30f) || !std::isfinite(dmax)) {
     std::sort(keys.begin(), keys.end());
     return;
   }
+  const size_t buckets = n / 2;
+  const float scale = static_cast<float>(buckets) / dmax;
+  const auto bucket_of = [&](uint64_t k) {
+    return std::min(buckets - 1, static_cast<size_t>(dist(k) * scale));
+  };
+  thread_local std::vector<uint32_t> first;
   thread_local std::vector<uint64_t> tmp;
-  tmp.resize(keys.size());
-  // Packed: the high words (distances) less their minimum, shifted down onto
-  // the low words' (indices') width; the order is the same (keys order as
-  // (high, low), and low < 2^width). The bits that vary then lie next to one
-  // another, so fewer 11-bit digits need a pass. Unpacked after.
-  uint32_t hi_min = ~uint32_t(0), lo_max = 0;
-  for (uint64_t k : keys) {
-    hi_min = std::min(hi_min, static_cast<uint32_t>(k >> 32));
-    lo_max = std::max(lo_max, static_cast<uint32_t>(k));
-  }
-  int width = 0;
-  while (width < 32 && (lo_max >> width) != 0) ++width;
-  for (uint64_t& k : keys) k = ((k >> 32) - hi_min) << width | (k & 0xffffffffull);
-  uint64_t all_or = 0, all_and = ~uint64_t(0);
-  for (uint64_t k : keys) {
-    all_or |= k;
-    all_and &= k;
-  }
-  const uint64_t varying = all_or ^ all_and;  // bits that differ between keys
-  constexpr int kBits = 11;
-  constexpr size_t kBuckets = size_t(1) << kBits;
-  uint32_t count[kBuckets];
-  for (int shift = 0; shift < 64; shift += kBits) {
-    const uint64_t mask = (kBuckets - 1);
-    if (((varying >> shift) & mask) == 0) continue;  // every key has the same digit here
-    std::fill(count, count + kBuckets, 0u);
-    for (uint64_t k : keys) ++count[(k >> shift) & mask];
-    uint32_t sum = 0;
-    for (size_t b = 0; b < kBuckets; ++b) {
-      const uint32_t c = count[b];
-      count[b] = sum;
-      sum += c;
+  first.assign(buckets + 1, 0u);
+  tmp.resize(n);
+  for (uint64_t k : keys) ++first[bucket_of(k) + 1];
+  for (size_t b = 0; b < buckets; ++b) first[b + 1] += first[b];
+  for (uint64_t k : keys) tmp[first[bucket_of(k)]++] = k;  // first[b] ends as bucket b's end
+  uint64_t* const t = tmp.data();
+  for (size_t b = 0, begin = 0; b < buckets; ++b) {
+    const size_t end = first[b];
+    if (end - begin > kInsertionUpTo) {
+      std::sort(t + begin, t + end);
+    } else {
+      for (size_t i = begin + 1; i < end; ++i) {
+        const uint64_t k = t[i];
+        size_t j = i;
+        for (; j > begin && t[j - 1] > k; --j) t[j] = t[j - 1];
+        t[j] = k;
+      }
     }
-    for (uint64_t k : keys) tmp[count[(k >> shift) & mask]++] = k;
-    keys.swap(tmp);
+    begin = end;
   }
-  const uint64_t low_mask = width == 0 ? 0 : (~uint64_t(0) >> (64 - width));
-  for (uint64_t& k : keys) k = ((k >> width) + hi_min) << 32 | (k & low_mask);
+  keys.swap(tmp);
 }
 
 }  // namespace

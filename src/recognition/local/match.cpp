@@ -291,7 +291,7 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
   if (m.avx2_bounds)
     wide.resize(m.rows);
   else
-    G = Zq * Z.transpose();
+    G.noalias() = Zq * Z.transpose();
   std::vector<std::pair<float, int>> cand;
   std::vector<std::pair<int, float>> best, measured;
   for (int i = 0; i < n; ++i) {
