@@ -4,7 +4,9 @@
 // Every descriptor is also projected on the first principal axes of the
 // indexed rows (an orthonormal basis P, so |P q - P d| <= |q - d| for every
 // pair). The bounds of a block of queries to every row come from one small
-// matrix product (|Pq|^2 + |Pd|^2 - 2 Pq.Pd, Eigen's blocked GEMM); rows are
+// matrix product (|Pq|^2 + |Pd|^2 - 2 Pq.Pd, Eigen's blocked GEMM; for
+// short rows, where the CPU has AVX2, from short_bounds_avx2, query by
+// query over the projections stored axis by axis); rows are
 // then measured exactly in the order of their bounds until the bound exceeds
 // the k-th best exact distance (or the threshold), with a margin for the
 // product's rounding. Every row that can be among the k nearest is measured
@@ -65,7 +67,7 @@ struct DescriptorIndex::Impl {
   std::vector<float> proj;     // rows x proj_dim: each row projected on the basis
   std::vector<float> proj_sq;  // squared norm of each projected row
   std::vector<float> proj_t;   // short rows: proj_dim x rows, the projections axis by axis
-  bool avx2_bounds = false;    // short rows' bounds from bounds_avx2
+  bool avx2_bounds = false;    // short rows: bounds from short_bounds_avx2
 };
 
 DescriptorIndex::DescriptorIndex() : impl_(new Impl) {}
@@ -114,7 +116,8 @@ void DescriptorIndex::build_projection() {
   if (m.proj_dim == kProjDimShort) {
     m.proj_t.resize(static_cast<size_t>(m.proj_dim) * m.rows);
     for (size_t r = 0; r < m.rows; ++r)
-      for (int a = 0; a < m.proj_dim; ++a) m.proj_t[static_cast<size_t>(a) * m.rows + r] = Z(static_cast<Eigen::Index>(r), a);
+      for (int a = 0; a < m.proj_dim; ++a)
+        m.proj_t[static_cast<size_t>(a) * m.rows + r] = Z(static_cast<Eigen::Index>(r), a);
     m.avx2_bounds = cpu_has_avx2();
   }
 }
