@@ -169,8 +169,9 @@ namespace {
 // floor(d * scale): non-decreasing in d (a float product with a positive
 // scale and the truncation both are), so the buckets come in key order,
 // and the result is std::sort's (the keys are distinct). Before: an LSD
-// radix sort of 11-bit digits, five passes of two reads and a scattered
-// write over the keys where this makes one of each.
+// radix sort of 11-bit digits, about five passes of a count and a
+// scattered write each, where this makes one (after a pass for the largest
+// distance) and sorts buckets of about two keys.
 void sort_keys(std::vector<uint64_t>& keys) {
   constexpr size_t kBucketFrom = 512;
   constexpr size_t kInsertionUpTo = 16;  // a bucket this short: insertion sort
