@@ -13,7 +13,13 @@ An ablation names the experiments it copies and what it switches: `scenes`
 scene's generator overrides, JSON merge patch: {warehouse: {wall: true}}),
 `settings` (merged into the experiment's settings), `config` (other
 top-level keys of the experiment replaced, e.g. perturb_deg; not name,
-seed, scenes, settings, report or description). The copy of experiment
+seed, scenes, settings, report or description), and `switches`: a list of
+targeted switches applied after those, each with an optional
+`experiments` (default: all of the ablation's) and `scenes` (default: all
+kept) that it applies to, and any of `generator` (merged into each of
+those scenes), `settings` (merged into each of those scenes' own settings
+when `scenes` is given, else into the experiment's) and `config` (not with
+`scenes`). The copy of experiment
 E is named ablation_NAME_E, keeps E's report reference, and differs from E
 only by the switch. Exit 2 with the file and field on a bad spec."""
 import copy
@@ -82,9 +88,40 @@ def load_spec(path):
                 raise SpecError(path, where + ".config." + key, "cannot be switched (use scenes, generator or settings)")
         if "scenes" in a and not (isinstance(a["scenes"], list) and a["scenes"]):
             raise SpecError(path, where + ".scenes", "must be a non-empty list of scene names")
-        if not any(k in a for k in ("generator", "settings", "config")):
-            raise SpecError(path, where, "switches nothing (give 'generator', 'settings' or 'config')")
+        if "switches" in a:
+            check_switches(path, where + ".switches", a)
+        if not any(k in a for k in ("generator", "settings", "config", "switches")):
+            raise SpecError(path, where, "switches nothing (give 'generator', 'settings', 'config' or 'switches')")
     return spec["ablations"]
+
+
+def check_switches(path, where, ablation):
+    """The targeted switches of one ablation, checked."""
+    if not isinstance(ablation["switches"], list) or not ablation["switches"]:
+        raise SpecError(path, where, "must be a non-empty list")
+    for i, sw in enumerate(ablation["switches"]):
+        at = "%s[%d]" % (where, i)
+        if not isinstance(sw, dict):
+            raise SpecError(path, at, "must be a mapping")
+        for key in sw:
+            if key not in ("experiments", "scenes", "generator", "settings", "config"):
+                raise SpecError(path, at + "." + key, "unknown key (experiments, scenes, generator, settings, config)")
+        for key in ("experiments", "scenes"):
+            if key in sw and not (isinstance(sw[key], list) and sw[key]):
+                raise SpecError(path, at + "." + key, "must be a non-empty list of names")
+        for e in sw.get("experiments", []):
+            if e not in ablation["experiments"]:
+                raise SpecError(path, at + ".experiments", "'%s' is not one of the ablation's experiments" % e)
+        for key in ("generator", "settings", "config"):
+            if key in sw and not isinstance(sw[key], dict):
+                raise SpecError(path, at + "." + key, "must be a mapping")
+        if not any(k in sw for k in ("generator", "settings", "config")):
+            raise SpecError(path, at, "switches nothing (give 'generator', 'settings' or 'config')")
+        if "config" in sw and "scenes" in sw:
+            raise SpecError(path, at + ".config", "applies to the whole experiment: not with 'scenes'")
+        for key in sw.get("config", {}):
+            if key in FIXED_KEYS:
+                raise SpecError(path, at + ".config." + key, "cannot be switched (use scenes, generator or settings)")
 
 
 def derive(ablation, experiment, config, config_path="experiment"):
@@ -108,6 +145,22 @@ def derive(ablation, experiment, config, config_path="experiment"):
         out["settings"] = merge_patch(out.get("settings", {}), ablation["settings"])
     for key, value in ablation.get("config", {}).items():
         out[key] = copy.deepcopy(value)
+    for i, sw in enumerate(ablation.get("switches", [])):
+        if "experiments" in sw and experiment not in sw["experiments"]:
+            continue
+        targets = [s for s in scenes if "scenes" not in sw or s.get("name") in sw["scenes"]]
+        for s in targets:
+            if "generator" in sw:
+                if "generate" not in s:
+                    raise SpecError(config_path, "scenes.%s" % s.get("name"),
+                                    "is not generated: no generator to switch (switches[%d])" % i)
+                s["generator"] = merge_patch(s.get("generator", {}), sw["generator"])
+            if "settings" in sw and "scenes" in sw:
+                s["settings"] = merge_patch(s.get("settings", {}), sw["settings"])
+        if "settings" in sw and "scenes" not in sw:
+            out["settings"] = merge_patch(out.get("settings", {}), sw["settings"])
+        for key, value in sw.get("config", {}).items():
+            out[key] = copy.deepcopy(value)
     return out
 
 

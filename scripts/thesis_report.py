@@ -534,7 +534,13 @@ DIFFERENCES = [
     "signature only (`global.matches_per_signature: 1`). CVFH's and CESF's initial pose aligns the regions' "
     "negated mean normals and takes the CRH about them, where pcl::CRHEstimation (and the thesis's CRH text) "
     "projects the normals about the camera-to-centroid ray; the rayaxis ablation uses that ray "
-    "(`global.view_ray_axis`).",
+    "(`global.view_ray_axis`). CVFH's and CESF's stable regions grow with lengths relative to the object and "
+    "our thresholds, where the thesis changed only its tables' parameters between scenarios and took CVFH from "
+    "PCL; the pclcvfh ablation uses pcl::CVFHEstimation's defaults in every scenario.",
+    "The text ablation switches every reading above that follows the thesis's text or the PCL defaults it used "
+    "(statue, tilt, free, cover, tutorial, pclicp, pclcvfh, rayaxis, literal, triples, esfpose) at once, for "
+    "CVFH, CESF, SHOT and FPFH; the textesf ablation does the same for ESF with esfroll's switch too. A gap that "
+    "no single reading closes can be the sum of several; these two show whether it is.",
     "Times are wall-clock seconds of the online computation of one image (training views excluded: they are "
     "rendered and described once and cached), single-threaded; the load column of the experiments table says "
     "what else ran on the machine.",

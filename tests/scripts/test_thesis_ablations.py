@@ -63,6 +63,28 @@ class Derive(unittest.TestCase):
         self.assertEqual(d["seed"], EXPERIMENT["seed"])
         self.assertNotIn("perturb_deg", EXPERIMENT)
 
+    def test_targeted_switches_reach_only_their_experiments_and_scenes(self):
+        a = spec(name="text", experiments=["table_x", "table_y"], settings={"refine": {"crop": False}}, switches=[
+            {"scenes": ["table_astra"], "settings": {"local": {"descriptor_radius_mm": 20}},
+             "generator": {"noise": {"sigma": 2}}},
+            {"experiments": ["table_y"], "scenes": ["warehouse_synthetic"], "generator": {"occlusion": {"p": 1}}},
+            {"experiments": ["table_y"], "config": {"object": "liberty"}, "settings": {"views": {"views": 3}}},
+        ])
+        x = ta.derive(a, "table_x", EXPERIMENT)
+        self.assertEqual(x["settings"], {"verify": {"score": "inliers"}, "views": {"follow_scene": True},
+                                         "refine": {"crop": False}})
+        self.assertEqual(x["scenes"][0], EXPERIMENT["scenes"][0])  # the warehouse: table_y's switch only
+        self.assertEqual(x["scenes"][1]["settings"], {"local": {"descriptor_radius_mm": 20}})
+        self.assertEqual(x["scenes"][1]["generator"], {"images": 60, "noise": {"sigma": 2}})
+        self.assertEqual(x["object"], "ls5")
+        y = ta.derive(a, "table_y", EXPERIMENT)
+        self.assertEqual(y["scenes"][0]["generator"], {"images": 30, "warehouse": {"wall": False}, "occlusion": {"p": 1}})
+        self.assertEqual(y["scenes"][0]["settings"], {"views": {"views": 12}})  # scene settings untouched
+        self.assertEqual(y["settings"]["views"], {"follow_scene": True, "views": 3})
+        self.assertEqual(y["object"], "liberty")
+        self.assertEqual(EXPERIMENT["scenes"][1], {"name": "table_astra", "generate": "t.yaml",
+                                                   "generator": {"images": 60}})  # input untouched
+
     def test_no_scene_left_is_an_error(self):
         with self.assertRaises(ta.SpecError) as c:
             ta.derive(spec(scenes=["nowhere"], generator={"x": 1}), "table_x", EXPERIMENT, "cfg.yaml")
@@ -115,6 +137,21 @@ class BadSpec(unittest.TestCase):
              "ablations[0].config.seed: cannot be switched"),
             ("ablations:\n  - {name: a, cause: c, switched: s, experiments: [x], config: 3}\n",
              "ablations[0].config: must be a mapping"),
+            ("ablations:\n  - {name: a, cause: c, switched: s, experiments: [x], switches: []}\n",
+             "ablations[0].switches: must be a non-empty list"),
+            ("ablations:\n  - {name: a, cause: c, switched: s, experiments: [x], switches: [{scenes: [t]}]}\n",
+             "ablations[0].switches[0]: switches nothing"),
+            ("ablations:\n  - {name: a, cause: c, switched: s, experiments: [x],"
+             " switches: [{experiments: [y], settings: {}}]}\n",
+             "ablations[0].switches[0].experiments: 'y' is not one of the ablation's experiments"),
+            ("ablations:\n  - {name: a, cause: c, switched: s, experiments: [x],"
+             " switches: [{scenes: [t], config: {object: o}}]}\n",
+             "ablations[0].switches[0].config: applies to the whole experiment"),
+            ("ablations:\n  - {name: a, cause: c, switched: s, experiments: [x], switches: [{setting: {}}]}\n",
+             "ablations[0].switches[0].setting: unknown key"),
+            ("ablations:\n  - {name: a, cause: c, switched: s, experiments: [x],"
+             " switches: [{config: {name: z}}]}\n",
+             "ablations[0].switches[0].config.name: cannot be switched"),
         ]
         for text, want in cases:
             code, err = self.run_spec(text)
