@@ -95,9 +95,13 @@ void clusters_bench(benchmark::State& state, Clusters fn) {
 void BM_EuclideanClusters(benchmark::State& state) { clusters_bench(state, global::euclidean_clusters); }
 void BM_EuclideanClustersPcl(benchmark::State& state) { clusters_bench(state, global::euclidean_clusters_pcl); }
 
-// ESF of one training view: ours (20000 samples, seeded) and PCL's.
+// ESF of one training view: ours (20000 samples, seeded) and PCL's. Ours
+// also on the view's first N points (the argument; 0: all of them), the size
+// of CESF's stable regions, where each point pair's trace is reused.
 void BM_EsfOurs(benchmark::State& state) {
-  const auto& pts = fixture().views.front().cloud.points;
+  const auto& all = fixture().views.front().cloud.points;
+  const size_t n = state.range(0) > 0 ? std::min(all.size(), static_cast<size_t>(state.range(0))) : all.size();
+  const std::vector<Vec3f> pts(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(n));
   for (auto _ : state) {
     Rng rng(1);
     benchmark::DoNotOptimize(compute_esf(pts, rng).data());
@@ -186,7 +190,7 @@ void BM_Online(benchmark::State& state, const std::string& name) {
 BENCHMARK(BM_Preprocess)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_EuclideanClusters)->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_EuclideanClustersPcl)->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_EsfOurs)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_EsfOurs)->Arg(0)->Arg(50)->Arg(150)->Arg(400)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_EsfPcl)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_CvfhView)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_CrhSpectrumAndPeaks)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -120,6 +120,22 @@ TEST(GlobalEsf, HistogramsAreThoseOfTheSteppedLineTracing) {
   EXPECT_EQ(hash_hex(bytes), "ac09ddb762035115");
 }
 
+// The same for small clouds, where each point pair is drawn many times and
+// its line's trace is looked up instead of traced again (CESF's stable
+// regions have tens to hundreds of points): the fingerprint was recorded
+// before the lookup existed, so the lookup changes no bit.
+TEST(GlobalEsf, SmallCloudsHaveTheHistogramsOfTracingEveryLine) {
+  std::string bytes;
+  for (int n : {3, 12, 40, 150, 400, 700}) {
+    for (const auto& [name, f] : shapes()) {
+      Rng rng(13 + static_cast<uint64_t>(n));
+      const std::vector<float> h = compute_esf(sample(f, n, 7), rng);
+      bytes.append(reinterpret_cast<const char*>(h.data()), h.size() * sizeof(float));
+    }
+  }
+  EXPECT_EQ(hash_hex(bytes), "3fe602dc048ae871");
+}
+
 // A3's bin from the table of bin edges equals the formula (acos): every
 // float within 3000 ulps of each rounding edge (|cos| = cos((k + 1/2) / 63 x
 // 90 deg)), two million random ones in [0, 1], and the ends, values above 1,
