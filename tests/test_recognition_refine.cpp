@@ -231,7 +231,8 @@ TEST_F(RefineCases, SameInputsGiveSamePoseBits) {
 // Our ICP and ICP point-to-plane, bit for bit as recorded (session 27), so
 // that a change meant to find the same correspondences faster shows when it
 // does not: the 20 cases under the default settings, without reciprocity,
-// on a random 100 points, and coarse to fine from 200 points.
+// on a random 100 points, and coarse to fine from 200 points (on this
+// toolchain: x86-64 without FMA contraction, as the ESF fingerprints).
 TEST_F(RefineCases, OwnIcpPosesAreTheRecordedBits) {
   RefineSettings one_way, sub, coarse;
   one_way.reciprocal_correspondences = false;

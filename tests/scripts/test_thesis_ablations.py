@@ -78,7 +78,8 @@ class Derive(unittest.TestCase):
         self.assertEqual(x["scenes"][1]["generator"], {"images": 60, "noise": {"sigma": 2}})
         self.assertEqual(x["object"], "ls5")
         y = ta.derive(a, "table_y", EXPERIMENT)
-        self.assertEqual(y["scenes"][0]["generator"], {"images": 30, "warehouse": {"wall": False}, "occlusion": {"p": 1}})
+        self.assertEqual(y["scenes"][0]["generator"],
+                         {"images": 30, "warehouse": {"wall": False}, "occlusion": {"p": 1}})
         self.assertEqual(y["scenes"][0]["settings"], {"views": {"views": 12}})  # scene settings untouched
         self.assertEqual(y["settings"]["views"], {"follow_scene": True, "views": 3})
         self.assertEqual(y["object"], "liberty")
