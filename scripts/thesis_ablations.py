@@ -80,12 +80,7 @@ def load_spec(path):
         seen.add(a["name"])
         if not isinstance(a.get("experiments"), list) or not a["experiments"]:
             raise SpecError(path, where + ".experiments", "must be a non-empty list of experiment names")
-        for key in ("generator", "settings", "config"):
-            if key in a and not isinstance(a[key], dict):
-                raise SpecError(path, where + "." + key, "must be a mapping")
-        for key in a.get("config", {}):
-            if key in FIXED_KEYS:
-                raise SpecError(path, where + ".config." + key, "cannot be switched (use scenes, generator or settings)")
+        check_parts(path, where, a)
         if "scenes" in a and not (isinstance(a["scenes"], list) and a["scenes"]):
             raise SpecError(path, where + ".scenes", "must be a non-empty list of scene names")
         if "switches" in a:
@@ -93,6 +88,17 @@ def load_spec(path):
         if not any(k in a for k in ("generator", "settings", "config", "switches")):
             raise SpecError(path, where, "switches nothing (give 'generator', 'settings', 'config' or 'switches')")
     return spec["ablations"]
+
+
+def check_parts(path, where, d):
+    """What a switch (an ablation's own, or a targeted one) merges in: generator, settings and config mappings,
+    config without the fixed keys."""
+    for key in ("generator", "settings", "config"):
+        if key in d and not isinstance(d[key], dict):
+            raise SpecError(path, where + "." + key, "must be a mapping")
+    for key in d.get("config", {}):
+        if key in FIXED_KEYS:
+            raise SpecError(path, where + ".config." + key, "cannot be switched (use scenes, generator or settings)")
 
 
 def check_switches(path, where, ablation):
@@ -112,16 +118,11 @@ def check_switches(path, where, ablation):
         for e in sw.get("experiments", []):
             if e not in ablation["experiments"]:
                 raise SpecError(path, at + ".experiments", "'%s' is not one of the ablation's experiments" % e)
-        for key in ("generator", "settings", "config"):
-            if key in sw and not isinstance(sw[key], dict):
-                raise SpecError(path, at + "." + key, "must be a mapping")
+        check_parts(path, at, sw)
         if not any(k in sw for k in ("generator", "settings", "config")):
             raise SpecError(path, at, "switches nothing (give 'generator', 'settings' or 'config')")
         if "config" in sw and "scenes" in sw:
             raise SpecError(path, at + ".config", "applies to the whole experiment: not with 'scenes'")
-        for key in sw.get("config", {}):
-            if key in FIXED_KEYS:
-                raise SpecError(path, at + ".config." + key, "cannot be switched (use scenes, generator or settings)")
 
 
 def derive(ablation, experiment, config, config_path="experiment"):
@@ -135,33 +136,32 @@ def derive(ablation, experiment, config, config_path="experiment"):
     scenes = [s for s in out.get("scenes", []) if keep is None or s.get("name") in keep]
     if not scenes:
         raise SpecError(config_path, "scenes", "none of %s in experiment %s" % (keep, experiment))
-    for s in scenes:
-        if "generator" in ablation:
-            if "generate" not in s:
-                raise SpecError(config_path, "scenes.%s" % s.get("name"), "is not generated: no generator to switch")
-            s["generator"] = merge_patch(s.get("generator", {}), ablation["generator"])
     out["scenes"] = scenes
-    if "settings" in ablation:
-        out["settings"] = merge_patch(out.get("settings", {}), ablation["settings"])
-    for key, value in ablation.get("config", {}).items():
-        out[key] = copy.deepcopy(value)
+    # The ablation's own switch: every kept scene, the experiment's settings (its `scenes` only filtered them).
+    apply_switch(out, {k: ablation[k] for k in ("generator", "settings", "config") if k in ablation}, config_path)
     for i, sw in enumerate(ablation.get("switches", [])):
-        if "experiments" in sw and experiment not in sw["experiments"]:
-            continue
-        targets = [s for s in scenes if "scenes" not in sw or s.get("name") in sw["scenes"]]
-        for s in targets:
-            if "generator" in sw:
-                if "generate" not in s:
-                    raise SpecError(config_path, "scenes.%s" % s.get("name"),
-                                    "is not generated: no generator to switch (switches[%d])" % i)
-                s["generator"] = merge_patch(s.get("generator", {}), sw["generator"])
-            if "settings" in sw and "scenes" in sw:
-                s["settings"] = merge_patch(s.get("settings", {}), sw["settings"])
-        if "settings" in sw and "scenes" not in sw:
-            out["settings"] = merge_patch(out.get("settings", {}), sw["settings"])
-        for key, value in sw.get("config", {}).items():
-            out[key] = copy.deepcopy(value)
+        if "experiments" not in sw or experiment in sw["experiments"]:
+            apply_switch(out, sw, config_path, " (switches[%d])" % i)
     return out
+
+
+def apply_switch(out, sw, config_path, note=""):
+    """Merges one switch into the experiment copy `out`: its generator into each of its scenes (sw's `scenes`,
+    default all of out's), its settings into those scenes' own settings when sw names scenes, else into the
+    experiment's, its config into the top-level keys."""
+    targets = [s for s in out["scenes"] if "scenes" not in sw or s.get("name") in sw["scenes"]]
+    for s in targets:
+        if "generator" in sw:
+            if "generate" not in s:
+                raise SpecError(config_path, "scenes.%s" % s.get("name"),
+                                "is not generated: no generator to switch" + note)
+            s["generator"] = merge_patch(s.get("generator", {}), sw["generator"])
+        if "settings" in sw and "scenes" in sw:
+            s["settings"] = merge_patch(s.get("settings", {}), sw["settings"])
+    if "settings" in sw and "scenes" not in sw:
+        out["settings"] = merge_patch(out.get("settings", {}), sw["settings"])
+    for key, value in sw.get("config", {}).items():
+        out[key] = copy.deepcopy(value)
 
 
 def pairs(ablations):

@@ -110,8 +110,8 @@ TEST(KdTree3, WithinIsStrictAndSortedByDistanceThenIndex) {
 }
 
 // Long neighbourhoods (thousands of points: the bucket-sorted path, buckets
-// of many equal distances too) come in
-// the same order as short ones: by distance, equal distances by index.
+// of many equal distances too) come in the same order as short ones: by
+// distance, equal distances by index.
 TEST(KdTree3, LongNeighbourhoodsAreSortedByDistanceThenIndex) {
   std::vector<Vec3f> pts = random_cloud(6000, 21, 50.f);
   for (int i = 0; i < 300; ++i) pts.push_back(pts[static_cast<size_t>(i) * 11]);  // equal distances
