@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 
 #include "core/random.h"
@@ -138,6 +139,55 @@ TEST(DescriptorIndex, CappedChecksAreExactUntilTheCapBindsAndKeepAHighRecall) {
 }
 
 
+
+// The capped search ranks rows by their lower bounds, so every way of
+// computing SHOT-sized bounds must give the same bits: the AVX2 kernel and
+// the plain loop, for row counts that are not a multiple of its eight lanes
+// or of its 256-row tiles and for blocks that are not a multiple of its four
+// queries. Each bound is also a lower bound of the exact squared distance,
+// up to the search's rounding margin.
+TEST(DescriptorIndex, ShotSizedBoundsHaveTheSameBitsOnEveryPath) {
+  pb::Rng rng(23);
+  for (const int rows : {1, 7, 300, 2075}) {
+    const std::vector<float> data = clustered_rows(rows, 20, 0.05, rng);
+    pb::local::DescriptorIndex index;
+    index.build(data, kDim);
+    for (const int n : {1, 3, 4, 37}) {
+      std::vector<float> queries;
+      for (int q = 0; q < n; ++q) {
+        const int src = rng.uniform_int(0, rows - 1);
+        for (int j = 0; j < kDim; ++j)
+          queries.push_back(
+              std::max(0.f, data[static_cast<size_t>(src) * kDim + j] + static_cast<float>(rng.normal(0, 0.03))));
+      }
+      index.set_avx2_bounds(false);
+      const std::vector<float> plain = index.lower_bounds(queries.data(), n);
+      index.set_avx2_bounds(true);
+      const std::vector<float> fast = index.lower_bounds(queries.data(), n);
+      ASSERT_EQ(plain.size(), static_cast<size_t>(rows) * static_cast<size_t>(n));
+      ASSERT_EQ(fast.size(), plain.size());
+      for (size_t e = 0; e < plain.size(); ++e)
+        ASSERT_EQ(std::memcmp(&plain[e], &fast[e], sizeof(float)), 0)
+            << "rows " << rows << " queries " << n << ": query " << e / static_cast<size_t>(rows) << ", row "
+            << e % static_cast<size_t>(rows) << ": " << plain[e] << " vs " << fast[e];
+      for (int i = 0; i < n; ++i)
+        for (int r = 0; r < rows; ++r) {
+          float exact = 0, qn = 0;  // qn: the query's squared norm, in the search's margin (rows: unit norm)
+          for (int j = 0; j < kDim; ++j) {
+            const float x = queries[static_cast<size_t>(i) * kDim + j];
+            qn += x * x;
+          }
+          for (int j = 0; j < kDim; ++j) {
+            const float t = queries[static_cast<size_t>(i) * kDim + j] - data[static_cast<size_t>(r) * kDim + j];
+            exact += t * t;
+          }
+          ASSERT_LE(plain[static_cast<size_t>(i) * static_cast<size_t>(rows) + static_cast<size_t>(r)],
+                    exact + 1e-4f * (qn + 1.f))
+              << "rows " << rows << " query " << i << " row " << r;
+        }
+    }
+  }
+}
 
 // The capped search's candidates: the cap smallest (value, index) pairs
 // under the limit, the same set as listing every pair under it and keeping

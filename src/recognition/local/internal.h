@@ -124,13 +124,18 @@ class DescriptorIndex {
   // projected bounds, so a row may be missed (approximate search).
   void knn_block(const float* queries, int n, int k, float max_sq_dist,
                  std::vector<std::pair<int, float>>* out, int max_checks = 0) const;
-  // Whether short rows (FPFH's) take their bounds from the AVX2 kernel
-  // (default: where the CPU has AVX2) or from Eigen's product as long rows
-  // do; the answers are the same either way (tests run both).
+  // Whether the bounds come from the AVX2 kernels (default: where the CPU
+  // has AVX2) or, for short rows (FPFH's), from Eigen's product and, for
+  // long ones (SHOT's), from a plain loop with the same bits; the answers
+  // are the same either way (tests run both).
   void set_avx2_bounds(bool on);
+  // The lower bounds knn_block ranks the rows by, for `n` queries (n x rows,
+  // row-major): for tests, which check that every path gives the same bits.
+  std::vector<float> lower_bounds(const float* queries, int n) const;
 
  private:
   void build_projection();
+  void bounds(const float* queries, int n, float* lbs) const;  // lower_bounds into lbs
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

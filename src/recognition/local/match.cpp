@@ -3,10 +3,11 @@
 // found by a scan with a lower bound, for FPFH (33) and SHOT (352) alike.
 // Every descriptor is also projected on the first principal axes of the
 // indexed rows (an orthonormal basis P, so |P q - P d| <= |q - d| for every
-// pair). The bounds of a block of queries to every row come from one small
-// matrix product (|Pq|^2 + |Pd|^2 - 2 Pq.Pd, Eigen's blocked GEMM; for
-// short rows, where the CPU has AVX2, from short_bounds_avx2, query by
-// query over the projections stored axis by axis); rows are
+// pair). The bounds |Pq|^2 + |Pd|^2 - 2 Pq.Pd of a block of queries to every
+// row come, for long rows, from long_bounds (AVX2 where the CPU has it, the
+// same bits), for short rows from Eigen's blocked product or, with AVX2, from
+// short_bounds_avx2 query by query, over the projections stored axis by
+// axis; rows are
 // then measured exactly in the order of their bounds until the bound exceeds
 // the k-th best exact distance (or the threshold), with a margin for the
 // product's rounding. Every row that can be among the k nearest is measured
@@ -32,6 +33,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
@@ -66,8 +68,8 @@ struct DescriptorIndex::Impl {
   std::vector<float> basis;    // proj_dim x dim, orthonormal rows (principal axes)
   std::vector<float> proj;     // rows x proj_dim: each row projected on the basis
   std::vector<float> proj_sq;  // squared norm of each projected row
-  std::vector<float> proj_t;   // short rows: proj_dim x rows, the projections axis by axis
-  bool avx2_bounds = false;    // short rows: bounds from short_bounds_avx2
+  std::vector<float> proj_t;   // proj_dim x rows, the projections axis by axis
+  bool avx2_bounds = false;    // bounds from short_bounds_avx2 / long_bounds_avx2
 };
 
 DescriptorIndex::DescriptorIndex() : impl_(new Impl) {}
@@ -113,13 +115,11 @@ void DescriptorIndex::build_projection() {
   m.proj.assign(Z.data(), Z.data() + Z.size());
   m.proj_sq.resize(m.rows);
   for (size_t r = 0; r < m.rows; ++r) m.proj_sq[r] = Z.row(static_cast<Eigen::Index>(r)).squaredNorm();
-  if (m.proj_dim == kProjDimShort) {
-    m.proj_t.resize(static_cast<size_t>(m.proj_dim) * m.rows);
-    for (size_t r = 0; r < m.rows; ++r)
-      for (int a = 0; a < m.proj_dim; ++a)
-        m.proj_t[static_cast<size_t>(a) * m.rows + r] = Z(static_cast<Eigen::Index>(r), a);
-    m.avx2_bounds = cpu_has_avx2();
-  }
+  m.proj_t.resize(static_cast<size_t>(m.proj_dim) * m.rows);
+  for (size_t r = 0; r < m.rows; ++r)
+    for (int a = 0; a < m.proj_dim; ++a)
+      m.proj_t[static_cast<size_t>(a) * m.rows + r] = Z(static_cast<Eigen::Index>(r), a);
+  m.avx2_bounds = cpu_has_avx2();
 }
 
 void DescriptorIndex::set_avx2_bounds(bool on) { impl_->avx2_bounds = on && !impl_->proj_t.empty() && cpu_has_avx2(); }
@@ -144,6 +144,29 @@ inline float sq_dist(const float* a, const float* b, size_t dim) {
   }
   return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
 }
+
+#if defined(__x86_64__) || defined(__i386__)
+// sq_dist with the eight partial sums in one AVX2 register: each lane does
+// the same operations in the same order (no fused multiply-add), so the
+// same bits.
+__attribute__((target("avx2"))) float sq_dist_avx2(const float* a, const float* b, size_t dim) {
+  __m256 acc8 = _mm256_setzero_ps();
+  size_t j = 0;
+  for (; j + 8 <= dim; j += 8) {
+    const __m256 t = _mm256_sub_ps(_mm256_loadu_ps(a + j), _mm256_loadu_ps(b + j));
+    acc8 = _mm256_add_ps(acc8, _mm256_mul_ps(t, t));
+  }
+  float acc[8];
+  _mm256_storeu_ps(acc, acc8);
+  for (; j < dim; ++j) {
+    const float t = a[j] - b[j];
+    acc[0] += t * t;
+  }
+  return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+}
+#else
+float sq_dist_avx2(const float* a, const float* b, size_t dim) { return sq_dist(a, b, dim); }
+#endif
 
 // The first index of the smallest of v[0..n) (n > 0; as the scan `if (v[r] <
 // v[arg]) arg = r`, for finite values). Four lanes of SSE minima find the
@@ -229,9 +252,101 @@ __attribute__((target("avx2"))) void short_bounds_avx2(const float* zq, float zn
     lbs[r] = acc;
   }
 }
+
+// The lower bounds of long rows (SHOT's 32 axes), eight rows at a time: the
+// same values as long_bounds (below), bit for bit (each lane does the same
+// float operations in the same order; no fused multiply-add). Rows in tiles
+// that stay in the L1 cache; four queries share each load of a tile's
+// projections.
+__attribute__((target("avx2"))) void long_bounds_avx2(const float* zq, const float* zn, int nq, int pd,
+                                                      const float* zt, const float* psq, size_t rows, float* lbs) {
+  constexpr size_t kTile = 256;  // rows: 32 axes x 256 rows x 4 bytes = 32 KB
+  const __m256 two = _mm256_set1_ps(2.f);
+  __m256 qb[4 * kProjDim];  // pd <= kProjDim
+  for (size_t t0 = 0; t0 < rows; t0 += kTile) {
+    const size_t t1 = std::min(rows, t0 + kTile);
+    int i = 0;
+    for (; i + 4 <= nq; i += 4) {
+      const float* q = zq + static_cast<size_t>(i) * pd;
+      const size_t P = static_cast<size_t>(pd);
+      // The four queries' coordinates, each broadcast once per tile (axis by
+      // axis, query by query): the products read them from memory.
+      for (size_t a = 0; a < P; ++a)
+        for (size_t j = 0; j < 4; ++j) qb[4 * a + j] = _mm256_set1_ps(q[j * P + a]);
+      size_t r = t0;
+      for (; r + 8 <= t1; r += 8) {
+        __m256 z = _mm256_loadu_ps(zt + r);
+        __m256 d0 = _mm256_mul_ps(qb[0], z), d1 = _mm256_mul_ps(qb[1], z), d2 = _mm256_mul_ps(qb[2], z),
+               d3 = _mm256_mul_ps(qb[3], z);
+        for (size_t a = 1; a < P; ++a) {
+          z = _mm256_loadu_ps(zt + a * rows + r);
+          const __m256* b = qb + 4 * a;
+          d0 = _mm256_add_ps(d0, _mm256_mul_ps(b[0], z));
+          d1 = _mm256_add_ps(d1, _mm256_mul_ps(b[1], z));
+          d2 = _mm256_add_ps(d2, _mm256_mul_ps(b[2], z));
+          d3 = _mm256_add_ps(d3, _mm256_mul_ps(b[3], z));
+        }
+        const __m256 p = _mm256_loadu_ps(psq + r);
+        const __m256 d[4] = {d0, d1, d2, d3};
+        for (int j = 0; j < 4; ++j)
+          _mm256_storeu_ps(lbs + static_cast<size_t>(i + j) * rows + r,
+                           _mm256_sub_ps(_mm256_add_ps(_mm256_set1_ps(zn[i + j]), p), _mm256_mul_ps(two, d[j])));
+      }
+      for (; r < t1; ++r)
+        for (int j = 0; j < 4; ++j) {
+          const float* qj = q + static_cast<size_t>(j) * P;
+          float d = qj[0] * zt[r];
+          for (size_t a = 1; a < P; ++a) d = d + qj[a] * zt[a * rows + r];
+          lbs[static_cast<size_t>(i + j) * rows + r] = (zn[i + j] + psq[r]) - 2.f * d;
+        }
+    }
+    for (; i < nq; ++i) {  // the last queries one at a time
+      const float* q = zq + static_cast<size_t>(i) * pd;
+      size_t r = t0;
+      for (; r + 8 <= t1; r += 8) {
+        __m256 d = _mm256_mul_ps(_mm256_set1_ps(q[0]), _mm256_loadu_ps(zt + r));
+        for (int a = 1; a < pd; ++a) {
+          const __m256 z = _mm256_loadu_ps(zt + static_cast<size_t>(a) * rows + r);
+          d = _mm256_add_ps(d, _mm256_mul_ps(_mm256_set1_ps(q[a]), z));
+        }
+        const __m256 base = _mm256_add_ps(_mm256_set1_ps(zn[i]), _mm256_loadu_ps(psq + r));
+        _mm256_storeu_ps(lbs + static_cast<size_t>(i) * rows + r, _mm256_sub_ps(base, _mm256_mul_ps(two, d)));
+      }
+      for (; r < t1; ++r) {
+        float d = q[0] * zt[r];
+        for (int a = 1; a < pd; ++a) d = d + q[a] * zt[static_cast<size_t>(a) * rows + r];
+        lbs[static_cast<size_t>(i) * rows + r] = (zn[i] + psq[r]) - 2.f * d;
+      }
+    }
+  }
+}
 #else
 void short_bounds_avx2(const float*, float, const float*, const float*, size_t, float*) {}
+void long_bounds_avx2(const float*, const float*, int, int, const float*, const float*, size_t, float*) {}
 #endif
+
+// The lower bounds of long rows, for the `nq` queries of a block (projections
+// zq, nq x pd; squared norms zn) to every row, written to lbs (nq x rows): zt
+// holds the rows' projections axis by axis (pd x rows). Each dot product is
+// summed over the axes in ascending order, a product then an add, and the
+// bound is (zn + psq) - 2 dot. One order for every path, because the capped
+// search (max_checks) ranks rows by these values: the AVX2 kernel and this
+// loop give the same matches. (Eigen's product, used before, sums the rows
+// left over from its 12-row panels in another order.)
+void long_bounds(const float* zq, const float* zn, int nq, int pd, const float* zt, const float* psq, size_t rows,
+                 float* lbs) {
+  for (int i = 0; i < nq; ++i) {
+    const float* q = zq + static_cast<size_t>(i) * pd;
+    float* out = lbs + static_cast<size_t>(i) * rows;
+    for (size_t r = 0; r < rows; ++r) out[r] = q[0] * zt[r];
+    for (int a = 1; a < pd; ++a) {
+      const float qa = q[a];
+      const float* z = zt + static_cast<size_t>(a) * rows;
+      for (size_t r = 0; r < rows; ++r) out[r] = out[r] + qa * z[r];
+    }
+    for (size_t r = 0; r < rows; ++r) out[r] = (zn[i] + psq[r]) - 2.f * out[r];
+  }
+}
 
 }  // namespace
 
@@ -274,6 +389,43 @@ void smallest_at_most(const float* v, size_t n, float limit, size_t cap,
   for (; r < n; ++r) offer_row(r);
 }
 
+void DescriptorIndex::bounds(const float* queries, int n, float* lbs) const {
+  const Impl& m = *impl_;
+  const Eigen::Index dim = m.dim;
+  const Eigen::Map<const RowMat> Q(queries, n, dim);
+  const Eigen::Map<const RowMat> B(m.basis.data(), m.proj_dim, dim);
+  const RowMat Zq = Q * B.transpose();  // n x proj_dim
+  std::vector<float> zn(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) zn[static_cast<size_t>(i)] = Zq.row(i).squaredNorm();
+  // Long rows: long_bounds, or its AVX2 kernel (the same bits). Short rows:
+  // the AVX2 kernel query by query, or Eigen's n x rows product of the
+  // projections, then the bounds in place (short rows are searched exactly:
+  // their rounding does not matter).
+  if (m.dim > kShortRows) {
+    (m.avx2_bounds ? long_bounds_avx2 : long_bounds)(Zq.data(), zn.data(), n, m.proj_dim, m.proj_t.data(),
+                                                     m.proj_sq.data(), m.rows, lbs);
+  } else if (m.avx2_bounds && m.proj_dim == kProjDimShort) {
+    for (int i = 0; i < n; ++i)
+      short_bounds_avx2(Zq.row(i).data(), zn[static_cast<size_t>(i)], m.proj_t.data(), m.proj_sq.data(), m.rows,
+                        lbs + static_cast<size_t>(i) * m.rows);
+  } else {
+    Eigen::Map<RowMat> G(lbs, n, static_cast<Eigen::Index>(m.rows));
+    const Eigen::Map<const RowMat> Z(m.proj.data(), static_cast<Eigen::Index>(m.rows), m.proj_dim);
+    G.noalias() = Zq * Z.transpose();
+    for (int i = 0; i < n; ++i) {
+      float* g = lbs + static_cast<size_t>(i) * m.rows;
+      const float zni = zn[static_cast<size_t>(i)];
+      for (size_t r = 0; r < m.rows; ++r) g[r] = zni + m.proj_sq[r] - 2.f * g[r];  // branch-free: vectorized
+    }
+  }
+}
+
+std::vector<float> DescriptorIndex::lower_bounds(const float* queries, int n) const {
+  std::vector<float> lbs(static_cast<size_t>(n) * impl_->rows);
+  if (!lbs.empty()) bounds(queries, n, lbs.data());
+  return lbs;
+}
+
 void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq_dist,
                                 std::vector<std::pair<int, float>>* out, int max_checks) const {
   const size_t dim = static_cast<size_t>(impl_->dim);
@@ -283,18 +435,9 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
   }
   const Impl& m = *impl_;
   const size_t kk = std::min<size_t>(static_cast<size_t>(k), m.rows);
-  const Eigen::Map<const RowMat> Q(queries, n, static_cast<Eigen::Index>(dim));
-  const Eigen::Map<const RowMat> B(m.basis.data(), m.proj_dim, static_cast<Eigen::Index>(dim));
-  const Eigen::Map<const RowMat> Z(m.proj.data(), static_cast<Eigen::Index>(m.rows), m.proj_dim);
-  const RowMat Zq = Q * B.transpose();  // n x proj_dim
-  // n x rows projected dot products, then the bounds in place; or, for short
-  // rows with AVX2, each query's bounds straight from the kernel.
-  RowMat G;
-  std::vector<float> wide;
-  if (m.avx2_bounds)
-    wide.resize(m.rows);
-  else
-    G.noalias() = Zq * Z.transpose();
+  const std::unique_ptr<float[]> all(new float[static_cast<size_t>(n) * m.rows]);  // every one written
+  bounds(queries, n, all.get());
+  const auto dist = m.avx2_bounds ? sq_dist_avx2 : sq_dist;  // the same bits
   std::vector<std::pair<float, int>> cand;
   std::vector<std::pair<int, float>> best, measured;
   for (int i = 0; i < n; ++i) {
@@ -302,21 +445,11 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
     const float* q = queries + static_cast<size_t>(i) * dim;
     float qn = 0;
     for (size_t j = 0; j < dim; ++j) qn += q[j] * q[j];
-    const float zn = Zq.row(i).squaredNorm();
     // Rounding margin of the product form and of the float basis: generous.
     const float margin = 1e-4f * (qn + m.max_sq_norm) + 1e-30f;
-    // First pass: the bounds (in place of the dot products) and the kk
-    // smallest of them; their exact distances cap the k-th best (tau0), so
-    // only rows with a bound up to tau0 remain candidates.
-    float* lbs = nullptr;
-    const float* psq = m.proj_sq.data();
-    if (m.avx2_bounds) {
-      lbs = wide.data();
-      short_bounds_avx2(Zq.row(i).data(), zn, m.proj_t.data(), psq, m.rows, lbs);
-    } else {
-      lbs = G.row(i).data();
-      for (size_t r = 0; r < m.rows; ++r) lbs[r] = zn + psq[r] - 2.f * lbs[r];  // branch-free: vectorized
-    }
+    // First pass: the kk smallest bounds; their exact distances cap the k-th
+    // best (tau0), so only rows with a bound up to tau0 remain candidates.
+    const float* lbs = all.get() + static_cast<size_t>(i) * m.rows;
     cand.clear();
     if (kk == 1) {  // the smallest bound, the lowest row among equal ones
       const size_t arg = first_argmin(lbs, m.rows);
@@ -332,7 +465,7 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
     }
     float tau0 = 0;
     for (const auto& c : cand)
-      tau0 = std::max(tau0, sq_dist(q, m.data.data() + static_cast<size_t>(c.second) * dim, dim));
+      tau0 = std::max(tau0, dist(q, m.data.data() + static_cast<size_t>(c.second) * dim, dim));
     const float limit = std::min(tau0, max_sq_dist) + margin;
     // Second pass: the candidates, measured in the order of their bounds.
     cand.clear();
@@ -346,7 +479,7 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
     for (const auto& [lb, r] : cand) {
       const float tau = best.size() == kk ? best.back().second : max_sq_dist;
       if (lb > tau + margin) break;  // no later row can enter the k nearest
-      const float s = sq_dist(q, m.data.data() + static_cast<size_t>(r) * dim, dim);
+      const float s = dist(q, m.data.data() + static_cast<size_t>(r) * dim, dim);
       if (!(s < max_sq_dist)) continue;
       offer(best, kk, r, s);
       measured.emplace_back(r, s);
