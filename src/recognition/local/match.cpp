@@ -37,23 +37,15 @@
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
-#if defined(__x86_64__) || defined(__i386__)
-#include <immintrin.h>
-#endif
 
 #include "core/cpu.h"
 #include "recognition/local/internal.h"
+#include "recognition/local/match_kernels.h"
 
 namespace pb::local {
 
 namespace {
-// Principal axes of the lower bound: 32 for long rows (SHOT: match_max_checks'
-// measured recall is that of these bounds), 12 for short ones (FPFH). Fewer
-// axes make the product cheaper and the bound looser; FPFH's match stage on
-// bench_local's table image took 2.8 / 1.9 / 1.8 / 2.1 / 2.5 ms with 32 / 16 /
-// 12 / 8 / 6 axes (results/bench/README.md, twelfth round).
-constexpr int kProjDim = 32;
-constexpr int kProjDimShort = 12;
+// The axes of the bound: kProjDim, kProjDimShort (match_kernels.h).
 constexpr int kShortRows = 64;  // rows of at most this many values are short
 constexpr size_t kPcaRows = 1000;  // at most this many (evenly spaced) rows estimate the axes
 using RowMat = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
@@ -128,46 +120,6 @@ size_t DescriptorIndex::size() const { return impl_->rows; }
 
 namespace {
 
-// Squared L2 distance with eight fixed partial sums (vectorizable; the same
-// summation order every run, whatever the blocking).
-inline float sq_dist(const float* a, const float* b, size_t dim) {
-  float acc[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-  size_t j = 0;
-  for (; j + 8 <= dim; j += 8)
-    for (int l = 0; l < 8; ++l) {
-      const float t = a[j + l] - b[j + l];
-      acc[l] += t * t;
-    }
-  for (; j < dim; ++j) {
-    const float t = a[j] - b[j];
-    acc[0] += t * t;
-  }
-  return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
-}
-
-#if defined(__x86_64__) || defined(__i386__)
-// sq_dist with the eight partial sums in one AVX2 register: each lane does
-// the same operations in the same order (no fused multiply-add), so the
-// same bits.
-__attribute__((target("avx2"))) float sq_dist_avx2(const float* a, const float* b, size_t dim) {
-  __m256 acc8 = _mm256_setzero_ps();
-  size_t j = 0;
-  for (; j + 8 <= dim; j += 8) {
-    const __m256 t = _mm256_sub_ps(_mm256_loadu_ps(a + j), _mm256_loadu_ps(b + j));
-    acc8 = _mm256_add_ps(acc8, _mm256_mul_ps(t, t));
-  }
-  float acc[8];
-  _mm256_storeu_ps(acc, acc8);
-  for (; j < dim; ++j) {
-    const float t = a[j] - b[j];
-    acc[0] += t * t;
-  }
-  return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
-}
-#else
-float sq_dist_avx2(const float* a, const float* b, size_t dim) { return sq_dist(a, b, dim); }
-#endif
-
 // The first index of the smallest of v[0..n) (n > 0; as the scan `if (v[r] <
 // v[arg]) arg = r`, for finite values). Four lanes of SSE minima find the
 // value (a minimum is exact in any order), a scan its first index.
@@ -227,125 +179,6 @@ inline void offer(std::vector<std::pair<int, float>>& out, size_t kk, int row, f
   out.insert(std::upper_bound(out.begin(), out.end(), e,
                               [](const auto& a, const auto& b) { return a.second < b.second; }),
              e);
-}
-
-#if defined(__x86_64__) || defined(__i386__)
-// The lower bounds |Pq|^2 + |Pd|^2 - 2 Pq.Pd of one query (projection zq,
-// its squared norm zn) to every row, eight rows at a time: zt holds the
-// rows' projections axis by axis (kProjDimShort x rows). Another rounding
-// than Eigen's product, inside the margin knn_block allows for it.
-__attribute__((target("avx2"))) void short_bounds_avx2(const float* zq, float zn, const float* zt, const float* psq,
-                                                       size_t rows, float* lbs) {
-  __m256 q[kProjDimShort];
-  for (int a = 0; a < kProjDimShort; ++a) q[a] = _mm256_set1_ps(-2.f * zq[a]);
-  const __m256 n8 = _mm256_set1_ps(zn);
-  size_t r = 0;
-  for (; r + 8 <= rows; r += 8) {
-    __m256 acc = _mm256_add_ps(n8, _mm256_loadu_ps(psq + r));
-    for (int a = 0; a < kProjDimShort; ++a)
-      acc = _mm256_add_ps(acc, _mm256_mul_ps(q[a], _mm256_loadu_ps(zt + static_cast<size_t>(a) * rows + r)));
-    _mm256_storeu_ps(lbs + r, acc);
-  }
-  for (; r < rows; ++r) {
-    float acc = zn + psq[r];
-    for (int a = 0; a < kProjDimShort; ++a) acc += -2.f * zq[a] * zt[static_cast<size_t>(a) * rows + r];
-    lbs[r] = acc;
-  }
-}
-
-// The lower bounds of long rows (SHOT's 32 axes), eight rows at a time: the
-// same values as long_bounds (below), bit for bit (each lane does the same
-// float operations in the same order; no fused multiply-add). Rows in tiles
-// that stay in the L1 cache; four queries share each load of a tile's
-// projections.
-__attribute__((target("avx2"))) void long_bounds_avx2(const float* zq, const float* zn, int nq, int pd,
-                                                      const float* zt, const float* psq, size_t rows, float* lbs) {
-  constexpr size_t kTile = 256;  // rows: 32 axes x 256 rows x 4 bytes = 32 KB
-  const __m256 two = _mm256_set1_ps(2.f);
-  __m256 qb[4 * kProjDim];  // pd <= kProjDim
-  for (size_t t0 = 0; t0 < rows; t0 += kTile) {
-    const size_t t1 = std::min(rows, t0 + kTile);
-    int i = 0;
-    for (; i + 4 <= nq; i += 4) {
-      const float* q = zq + static_cast<size_t>(i) * pd;
-      const size_t P = static_cast<size_t>(pd);
-      // The four queries' coordinates, each broadcast once per tile (axis by
-      // axis, query by query): the products read them from memory.
-      for (size_t a = 0; a < P; ++a)
-        for (size_t j = 0; j < 4; ++j) qb[4 * a + j] = _mm256_set1_ps(q[j * P + a]);
-      size_t r = t0;
-      for (; r + 8 <= t1; r += 8) {
-        __m256 z = _mm256_loadu_ps(zt + r);
-        __m256 d0 = _mm256_mul_ps(qb[0], z), d1 = _mm256_mul_ps(qb[1], z), d2 = _mm256_mul_ps(qb[2], z),
-               d3 = _mm256_mul_ps(qb[3], z);
-        for (size_t a = 1; a < P; ++a) {
-          z = _mm256_loadu_ps(zt + a * rows + r);
-          const __m256* b = qb + 4 * a;
-          d0 = _mm256_add_ps(d0, _mm256_mul_ps(b[0], z));
-          d1 = _mm256_add_ps(d1, _mm256_mul_ps(b[1], z));
-          d2 = _mm256_add_ps(d2, _mm256_mul_ps(b[2], z));
-          d3 = _mm256_add_ps(d3, _mm256_mul_ps(b[3], z));
-        }
-        const __m256 p = _mm256_loadu_ps(psq + r);
-        const __m256 d[4] = {d0, d1, d2, d3};
-        for (int j = 0; j < 4; ++j)
-          _mm256_storeu_ps(lbs + static_cast<size_t>(i + j) * rows + r,
-                           _mm256_sub_ps(_mm256_add_ps(_mm256_set1_ps(zn[i + j]), p), _mm256_mul_ps(two, d[j])));
-      }
-      for (; r < t1; ++r)
-        for (int j = 0; j < 4; ++j) {
-          const float* qj = q + static_cast<size_t>(j) * P;
-          float d = qj[0] * zt[r];
-          for (size_t a = 1; a < P; ++a) d = d + qj[a] * zt[a * rows + r];
-          lbs[static_cast<size_t>(i + j) * rows + r] = (zn[i + j] + psq[r]) - 2.f * d;
-        }
-    }
-    for (; i < nq; ++i) {  // the last queries one at a time
-      const float* q = zq + static_cast<size_t>(i) * pd;
-      size_t r = t0;
-      for (; r + 8 <= t1; r += 8) {
-        __m256 d = _mm256_mul_ps(_mm256_set1_ps(q[0]), _mm256_loadu_ps(zt + r));
-        for (int a = 1; a < pd; ++a) {
-          const __m256 z = _mm256_loadu_ps(zt + static_cast<size_t>(a) * rows + r);
-          d = _mm256_add_ps(d, _mm256_mul_ps(_mm256_set1_ps(q[a]), z));
-        }
-        const __m256 base = _mm256_add_ps(_mm256_set1_ps(zn[i]), _mm256_loadu_ps(psq + r));
-        _mm256_storeu_ps(lbs + static_cast<size_t>(i) * rows + r, _mm256_sub_ps(base, _mm256_mul_ps(two, d)));
-      }
-      for (; r < t1; ++r) {
-        float d = q[0] * zt[r];
-        for (int a = 1; a < pd; ++a) d = d + q[a] * zt[static_cast<size_t>(a) * rows + r];
-        lbs[static_cast<size_t>(i) * rows + r] = (zn[i] + psq[r]) - 2.f * d;
-      }
-    }
-  }
-}
-#else
-void short_bounds_avx2(const float*, float, const float*, const float*, size_t, float*) {}
-void long_bounds_avx2(const float*, const float*, int, int, const float*, const float*, size_t, float*) {}
-#endif
-
-// The lower bounds of long rows, for the `nq` queries of a block (projections
-// zq, nq x pd; squared norms zn) to every row, written to lbs (nq x rows): zt
-// holds the rows' projections axis by axis (pd x rows). Each dot product is
-// summed over the axes in ascending order, a product then an add, and the
-// bound is (zn + psq) - 2 dot. One order for every path, because the capped
-// search (max_checks) ranks rows by these values: the AVX2 kernel and this
-// loop give the same matches. (Eigen's product, used before, sums the rows
-// left over from its 12-row panels in another order.)
-void long_bounds(const float* zq, const float* zn, int nq, int pd, const float* zt, const float* psq, size_t rows,
-                 float* lbs) {
-  for (int i = 0; i < nq; ++i) {
-    const float* q = zq + static_cast<size_t>(i) * pd;
-    float* out = lbs + static_cast<size_t>(i) * rows;
-    for (size_t r = 0; r < rows; ++r) out[r] = q[0] * zt[r];
-    for (int a = 1; a < pd; ++a) {
-      const float qa = q[a];
-      const float* z = zt + static_cast<size_t>(a) * rows;
-      for (size_t r = 0; r < rows; ++r) out[r] = out[r] + qa * z[r];
-    }
-    for (size_t r = 0; r < rows; ++r) out[r] = (zn[i] + psq[r]) - 2.f * out[r];
-  }
 }
 
 }  // namespace

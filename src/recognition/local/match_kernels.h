@@ -1,0 +1,62 @@
+// The arithmetic kernels of the descriptor index (match.cpp): squared
+// distances and the projected lower bounds, each in a plain version and, on
+// x86, an AVX2 one chosen at run time (core/cpu.h). Where a result feeds a
+// choice that rounding could change (SHOT's capped search ranks rows by their
+// bounds), the AVX2 version does the same float operations in the same order
+// per lane, with no fused multiply-add: the same bits.
+#pragma once
+
+#include <cstddef>
+
+namespace pb::local {
+
+// Principal axes of the lower bound: 32 for long rows (SHOT: match_max_checks'
+// measured recall is that of these bounds), 12 for short ones (FPFH). Fewer
+// axes make the product cheaper and the bound looser; FPFH's match stage on
+// bench_local's table image took 2.8 / 1.9 / 1.8 / 2.1 / 2.5 ms with 32 / 16 /
+// 12 / 8 / 6 axes (results/bench/README.md, twelfth round).
+constexpr int kProjDim = 32;
+constexpr int kProjDimShort = 12;
+
+// Squared L2 distance with eight fixed partial sums (vectorizable; the same
+// summation order every run, whatever the blocking).
+inline float sq_dist(const float* a, const float* b, size_t dim) {
+  float acc[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  size_t j = 0;
+  for (; j + 8 <= dim; j += 8)
+    for (int l = 0; l < 8; ++l) {
+      const float t = a[j + l] - b[j + l];
+      acc[l] += t * t;
+    }
+  for (; j < dim; ++j) {
+    const float t = a[j] - b[j];
+    acc[0] += t * t;
+  }
+  return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+}
+
+// sq_dist's value from the eight partial sums in one AVX2 register (plain
+// sq_dist where the build is not for x86): the same bits.
+float sq_dist_avx2(const float* a, const float* b, size_t dim);
+
+// The lower bounds |Pq|^2 + |Pd|^2 - 2 Pq.Pd of one query (projection zq, its
+// squared norm zn) to every row into lbs, from the rows' projections stored
+// axis by axis (zt, kProjDimShort x rows) and their squared norms (psq). Only
+// where the CPU has AVX2. Its rounding differs from Eigen's product; FPFH's
+// exact search allows for it.
+void short_bounds_avx2(const float* zq, float zn, const float* zt, const float* psq, size_t rows, float* lbs);
+
+// The lower bounds of long rows, for the `nq` queries of a block (projections
+// zq, nq x pd, pd <= kProjDim; squared norms zn) to every row, written to lbs
+// (nq x rows): zt holds the rows' projections axis by axis (pd x rows). Each
+// dot product is summed over the axes in ascending order, a product then an
+// add, and the bound is (zn + psq) - 2 dot. One order for every path, because
+// the capped search (max_checks) ranks rows by these values: long_bounds_avx2
+// (where the CPU has AVX2) gives the same bits. (Eigen's product, used before,
+// sums the rows left over from its 12-row panels in another order.)
+void long_bounds(const float* zq, const float* zn, int nq, int pd, const float* zt, const float* psq, size_t rows,
+                 float* lbs);
+void long_bounds_avx2(const float* zq, const float* zn, int nq, int pd, const float* zt, const float* psq,
+                      size_t rows, float* lbs);
+
+}  // namespace pb::local
