@@ -6,11 +6,10 @@
 // pair). The bounds |Pq|^2 + |Pd|^2 - 2 Pq.Pd of a block of queries to every
 // row come, for long rows, from long_bounds (AVX2 where the CPU has it, the
 // same bits), for short rows from Eigen's blocked product or, with AVX2, from
-// short_bounds_avx2 query by query, over the projections stored axis by
-// axis; rows are
-// then measured exactly in the order of their bounds until the bound exceeds
-// the k-th best exact distance (or the threshold), with a margin for the
-// product's rounding. Every row that can be among the k nearest is measured
+// short_bounds_avx2 query by query, over the projections stored axis by axis
+// (match_kernels.h). Rows are then measured exactly in the order of their
+// bounds until the bound exceeds the k-th best exact distance (or the
+// threshold), with a margin for the bounds' rounding. Every row that can be among the k nearest is measured
 // exactly and offered in ascending row order, so the result is the exact
 // scan's, bit for bit. Approximate on request (max_checks > 0): at most that
 // many rows, those of the lowest bounds, are measured exactly per query; the
