@@ -67,8 +67,7 @@ __attribute__((target("avx2"))) void long_bounds_avx2(const float* zq, const flo
   __m256 qb[4 * kProjDim];  // pd <= kProjDim
   for (size_t t0 = 0; t0 < rows; t0 += kTile) {
     const size_t t1 = std::min(rows, t0 + kTile);
-    int i = 0;
-    for (; i + 4 <= nq; i += 4) {
+    for (int i = 0; i + 4 <= nq; i += 4) {
       const float* q = zq + static_cast<size_t>(i) * pd;
       const size_t P = static_cast<size_t>(pd);
       // The four queries' coordinates, each broadcast once per tile (axis by
@@ -102,25 +101,13 @@ __attribute__((target("avx2"))) void long_bounds_avx2(const float* zq, const flo
           lbs[static_cast<size_t>(i + j) * rows + r] = (zn[i + j] + psq[r]) - 2.f * d;
         }
     }
-    for (; i < nq; ++i) {  // the last queries one at a time
-      const float* q = zq + static_cast<size_t>(i) * pd;
-      size_t r = t0;
-      for (; r + 8 <= t1; r += 8) {
-        __m256 d = _mm256_mul_ps(_mm256_set1_ps(q[0]), _mm256_loadu_ps(zt + r));
-        for (int a = 1; a < pd; ++a) {
-          const __m256 z = _mm256_loadu_ps(zt + static_cast<size_t>(a) * rows + r);
-          d = _mm256_add_ps(d, _mm256_mul_ps(_mm256_set1_ps(q[a]), z));
-        }
-        const __m256 base = _mm256_add_ps(_mm256_set1_ps(zn[i]), _mm256_loadu_ps(psq + r));
-        _mm256_storeu_ps(lbs + static_cast<size_t>(i) * rows + r, _mm256_sub_ps(base, _mm256_mul_ps(two, d)));
-      }
-      for (; r < t1; ++r) {
-        float d = q[0] * zt[r];
-        for (int a = 1; a < pd; ++a) d = d + q[a] * zt[static_cast<size_t>(a) * rows + r];
-        lbs[static_cast<size_t>(i) * rows + r] = (zn[i] + psq[r]) - 2.f * d;
-      }
-    }
   }
+  // The last queries of a block that are not a group of four (at most three
+  // per frame): the plain loop, whose bits these are.
+  const int grouped = nq / 4 * 4;
+  if (grouped < nq)
+    long_bounds(zq + static_cast<size_t>(grouped) * pd, zn + grouped, nq - grouped, pd, zt, psq, rows,
+                lbs + static_cast<size_t>(grouped) * rows);
 }
 #else
 void short_bounds_avx2(const float*, float, const float*, const float*, size_t, float*) {}
