@@ -6,9 +6,9 @@
 //   correspondences  every source point's nearest target point within
 //                    max_correspondence_mm; reciprocal (optional): the target
 //                    point's nearest source point must be that point. The
-//                    target grid (grid_nearest.h) is built once; the reciprocal search maps
+//                    target tree is built once; the reciprocal search maps
 //                    the target point back by the inverse of the current
-//                    transform into a source grid built once (distances are
+//                    transform into a source tree built once (distances are
 //                    invariant under the rigid transform), where PCL rebuilds
 //                    a tree over the moved source on every iteration.
 //   step             point-to-point: the least-squares rotation and
@@ -38,7 +38,7 @@
 #include <numeric>
 
 #include "core/random.h"
-#include "recognition/grid_nearest.h"
+#include "recognition/kdtree.h"
 #include "recognition/refine/internal.h"
 
 namespace pb::refine_detail {
@@ -60,12 +60,10 @@ std::vector<size_t> sample_indices(size_t n, int k, uint64_t seed) {
 
 namespace {
 
-// ICP's nearest-neighbour searches run on grids (grid_nearest.h: the same
-// answers as the kd-tree it replaced, KdTree3) of cells the size of the
-// correspondence bound, in metres as the problem's points.
-GridNearest search_grid(const std::vector<Vec3f>& pts, const RefineSettings& s) {
-  return GridNearest(pts, s.max_correspondence_mm * 1e-3);
-}
+// Leaf size of ICP's kd-trees: nearest-neighbour queries only, whose answer
+// does not depend on it (ties go to the lower index); on the warehouse, 24
+// points per leaf made refinement about 8% faster than the default 8.
+constexpr int kIcpLeafSize = 24;
 
 struct Pair {
   int src, tgt;
@@ -77,8 +75,8 @@ using Mat4 = Eigen::Matrix4d;
 // Correspondences of the source points moved by T (see the file comment).
 // `last[i]`: source point i's match of the previous iteration (or -1), the
 // target search's starting bound (the same answer, found sooner).
-void correspond(const std::vector<Vec3f>& src, const GridNearest& src_grid, const std::vector<Vec3f>& tgt,
-                const GridNearest& tgt_grid, const Mat4& T, const RefineSettings& s, std::vector<int>& last,
+void correspond(const std::vector<Vec3f>& src, const KdTree3& src_tree, const std::vector<Vec3f>& tgt,
+                const KdTree3& tgt_tree, const Mat4& T, const RefineSettings& s, std::vector<int>& last,
                 std::vector<Pair>& out) {
   out.clear();
   const double max_m = s.max_correspondence_mm * 1e-3;
@@ -89,12 +87,12 @@ void correspond(const std::vector<Vec3f>& src, const GridNearest& src_grid, cons
   for (size_t i = 0; i < src.size(); ++i) {
     const Vec3f q = R * src[i] + t;
     float d2 = 0;
-    const int j = tgt_grid.nearest(q, &d2, max2, last[i]);
+    const int j = tgt_tree.nearest(q, &d2, max2, last[i]);
     last[i] = j;
     if (j < 0) continue;
     if (s.reciprocal_correspondences) {
       const Vec3f back = Ri * (tgt[static_cast<size_t>(j)] - t);
-      if (src_grid.nearest(back, nullptr, max2, static_cast<int>(i)) != static_cast<int>(i)) continue;
+      if (src_tree.nearest(back, nullptr, max2, static_cast<int>(i)) != static_cast<int>(i)) continue;
     }
     out.push_back({static_cast<int>(i), j, d2});
   }
@@ -158,17 +156,17 @@ enum class Metric { kPoint, kPlane };
 // Iterates from T until a stopping rule fires or `cap` iterations have run
 // (o.iterations counts every stage's iterations; o.converged is the last
 // stage's).
-void iterate(const std::vector<Vec3f>& src, const Problem& p, const GridNearest& tgt_grid, const RefineSettings& s,
+void iterate(const std::vector<Vec3f>& src, const Problem& p, const KdTree3& tgt_tree, const RefineSettings& s,
              Metric metric, int cap, Mat4& T, Outcome& o) {
   o.converged = false;
   if (cap <= 0 || src.size() < 3) return;
-  const GridNearest src_grid = s.reciprocal_correspondences ? search_grid(src, s) : GridNearest();
+  const KdTree3 src_tree = s.reciprocal_correspondences ? KdTree3(src, kIcpLeafSize) : KdTree3();
   const double rot_cos = std::cos(s.rotation_epsilon_deg * M_PI / 180.0);
   double prev_mse = std::numeric_limits<double>::max();
   std::vector<Pair> c;
   std::vector<int> last(src.size(), -1);
   for (int it = 0; it < cap;) {
-    correspond(src, src_grid, p.tgt, tgt_grid, T, s, last, c);
+    correspond(src, src_tree, p.tgt, tgt_tree, T, s, last, c);
     if (c.size() < 3) break;  // unconverged, the transform so far stands
     const Mat4 D = metric == Metric::kPoint ? step_point(src, p.tgt, T, c) : step_plane(src, p.tgt, p.tgt_normals, T, c);
     if (!D.allFinite()) break;
@@ -202,7 +200,7 @@ Outcome icp(const Problem& p, const RefineSettings& s, uint64_t seed, Metric met
   Outcome o;
   const std::vector<Vec3f> src = sampled(p.src, s.icp_sample_points, seed);
   if (src.size() < 3 || p.tgt.size() < 3) return o;
-  const GridNearest tgt_grid = search_grid(p.tgt, s);
+  const KdTree3 tgt_tree(p.tgt, kIcpLeafSize);
   Mat4 T = Mat4::Identity();
   int cap = s.max_iterations;
   // Coarse stage: a seeded random subset of the source points, leaving the
@@ -210,10 +208,10 @@ Outcome icp(const Problem& p, const RefineSettings& s, uint64_t seed, Metric met
   const size_t coarse = static_cast<size_t>(std::max(0, s.icp_coarse_points));
   if (coarse >= 3 && src.size() > coarse && cap > s.icp_fine_iterations) {
     const std::vector<Vec3f> sub = sampled(src, static_cast<int>(coarse), derive_seed(seed, {1}));
-    iterate(sub, p, tgt_grid, s, metric, cap - s.icp_fine_iterations, T, o);
+    iterate(sub, p, tgt_tree, s, metric, cap - s.icp_fine_iterations, T, o);
     cap -= o.iterations;
   }
-  iterate(src, p, tgt_grid, s, metric, cap, T, o);
+  iterate(src, p, tgt_tree, s, metric, cap, T, o);
   o.delta = T.cast<float>();
   return o;
 }

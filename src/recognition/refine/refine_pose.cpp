@@ -11,7 +11,7 @@
 #include <limits>
 
 #include "core/error.h"
-#include "recognition/grid_nearest.h"
+#include "recognition/kdtree.h"
 #include "recognition/pcl_adapter.h"
 #include "recognition/refine/internal.h"
 #include "recognition/refine/refine.h"
@@ -129,18 +129,14 @@ RefineResult refine_pose(const std::string& method, const PointSet& model, const
   // Fitness: mean squared distance (mm^2) of the model points to their
   // nearest cropped scene point, over pairs within max_correspondence_mm.
   {
-    // The search is bounded a little beyond the limit (1e-4, relative): a
-    // nearest point beyond the bound is beyond the limit too, so the same
-    // pairs count as with an unbounded search.
-    const double lim = max_corr * max_corr;
-    const GridNearest grid(p.tgt, max_corr * 1e-3);
-    const float bound = static_cast<float>(lim * 1e-6 * (1 + 1e-4));
+    const KdTree3 tree(p.tgt);
     double sum = 0;
     size_t n = 0;
+    const double lim = max_corr * max_corr;
     for (const auto& x : model.points) {
       const Vec3f q = ((res.T_cam_model * x.cast<double>() - c) * 1e-3).cast<float>();
       float d2 = 0;
-      if (grid.nearest(q, &d2, bound) < 0) continue;
+      if (tree.nearest(q, &d2) < 0) continue;
       const double dmm2 = static_cast<double>(d2) * 1e6;
       if (dmm2 <= lim) {
         sum += dmm2;
