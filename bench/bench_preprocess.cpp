@@ -76,11 +76,16 @@ void BM_VoxelGrid(benchmark::State& st) {
   st.counters["out"] = static_cast<double>(n);
 }
 
+// The RANSAC plane as preprocess_scene runs it (candidates scored on a
+// random subset of plane_sample_points, then the winner's inliers among all
+// points and the refit).
 void BM_Plane(benchmark::State& st) {
   const Frame& f = frame(static_cast<int>(st.range(0)));
   const PointSet ps = voxel_downsample(cut(f), {f.s.voxel_mm});
   for (auto _ : st)
-    benchmark::DoNotOptimize(detail::ransac_plane(ps.points, f.s.plane_threshold_mm, f.s.plane_iterations, 1).data());
+    benchmark::DoNotOptimize(detail::ransac_plane(ps.points, f.s.plane_threshold_mm, f.s.plane_iterations, 1, nullptr,
+                                                  f.s.plane_sample_points, f.s.plane_probability)
+                                 .data());
   st.counters["points"] = static_cast<double>(ps.size());
 }
 
