@@ -22,8 +22,11 @@ import re
 import sys
 
 CONTROL = re.compile(r"\b(if|for|while|switch|catch|do|else)\s*(\(.*\))?\s*$", re.S)
+# Each qualifier with its own trailing spaces (no two ways to match a run of
+# spaces: an alternation of qualifiers and single spaces under a star took
+# exponential time on a long blanked comment after a parenthesis).
 SIGNATURE = re.compile(
-    r"\)\s*(const)?\s*(override|final|noexcept|mutable|\s)*\s*(->\s*[\w:<>,\s&*]+)?\s*$", re.S)
+    r"\)\s*(?:(?:const|override|final|noexcept|mutable)\b\s*)*(?:->\s*[\w:<>,&*][\w:<>,\s&*]*)?$", re.S)
 INIT_LIST = re.compile(r"\)\s*:\s*[\w:]+\s*[({].*[)}]\s*$", re.S)
 
 

@@ -39,6 +39,20 @@ class Functions(unittest.TestCase):
         text = 'void h() {\n  const char* s = "{{";  // }\n  /* { */\n}\n'
         self.assertEqual(structure_check.functions(text), [("h", 1, 4)])
 
+    def test_qualifiers_and_long_blank_runs_after_a_parenthesis(self):
+        # Qualifiers and a trailing return type still make a signature; a
+        # parenthesis followed by a long run of spaces (a blanked comment)
+        # and then something else is no signature, and is decided at once
+        # (the earlier pattern backtracked over every split of the run:
+        # minutes on src/recognition/local/match_kernels.cpp).
+        text = ("auto f(int x) const noexcept -> int {\n"
+                "  return x;\n"
+                "}\n"
+                "#if defined(A)" + " " * 3000 + "/* a long comment */ " + "x" + " " * 3000 + "\n"
+                "struct S {\n"
+                "};\n")
+        self.assertEqual(structure_check.functions(text), [("f", 1, 3)])
+
     def test_control_statements_and_initializers_are_not_functions(self):
         text = "int v[] = {1, 2};\nvoid k() {\n  for (int i = 0; i < 2; ++i) {\n  }\n}\n"
         self.assertEqual(structure_check.functions(text), [("k", 2, 5)])
