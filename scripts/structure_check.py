@@ -23,8 +23,9 @@ import sys
 
 CONTROL = re.compile(r"\b(if|for|while|switch|catch|do|else)\s*(\(.*\))?\s*$", re.S)
 # Each qualifier with its own trailing spaces (no two ways to match a run of
-# spaces: an alternation of qualifiers and single spaces under a star took
-# exponential time on a long blanked comment after a parenthesis).
+# spaces: an alternation of qualifiers and single spaces under a star,
+# between two runs of spaces, backtracked for minutes over a long blanked
+# comment after a parenthesis).
 SIGNATURE = re.compile(
     r"\)\s*(?:(?:const|override|final|noexcept|mutable)\b\s*)*(?:->\s*[\w:<>,&*][\w:<>,\s&*]*)?$", re.S)
 INIT_LIST = re.compile(r"\)\s*:\s*[\w:]+\s*[({].*[)}]\s*$", re.S)
