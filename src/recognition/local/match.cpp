@@ -9,9 +9,9 @@
 // short_bounds_avx2 query by query, over the projections stored axis by axis
 // (match_kernels.h). Rows are then measured exactly in the order of their
 // bounds until the bound exceeds the k-th best exact distance (or the
-// threshold), with a margin for the bounds' rounding. Every row that can be among the k nearest is measured
-// exactly and offered in ascending row order, so the result is the exact
-// scan's, bit for bit. Approximate on request (max_checks > 0): at most that
+// threshold), with a margin for the bounds' rounding. Every row that can be
+// among the k nearest is measured exactly and offered in ascending row order,
+// so the result is the exact scan's, bit for bit. Approximate on request (max_checks > 0): at most that
 // many rows, those of the lowest bounds, are measured exactly per query; the
 // answer is still exact whenever the early exit comes first (measured
 // recall: LocalSettings' match_max_checks). Searches are const and
