@@ -40,6 +40,14 @@ class Pipeline : public ::testing::Test {
     delete scene_;
     delete mesh_;
   }
+  // The model trained for `s`, and in *all the result of refining every
+  // hypothesis ("ok" expected): the max_hypotheses tests' reference.
+  static auto trained_and_all_refined(const pb::RecognitionSettings& s, pb::RecognitionResult* all) {
+    auto model = pb::test::train(*mesh_, s);
+    *all = pb::recognize(scene_->depth, scene_->K, *model, s);
+    EXPECT_EQ(all->status, "ok") << all->message;
+    return model;
+  }
   static pb::Mesh* mesh_;
   static pbtest::TableScene* scene_;
 };
@@ -118,10 +126,9 @@ TEST_F(Pipeline, FindsTheLBlockWithFpfhAndIcp) {
 TEST_F(Pipeline, MaxHypothesesRefinesTheMostPromisingExactlyAsBefore) {
   pb::RecognitionSettings s = small_settings("fpfh");
   s.refine.icp_sample_points = 150;
-  const auto model = pb::test::train(*mesh_, s);
-  const pb::RecognitionResult all = pb::recognize(scene_->depth, scene_->K, *model, s);
-  ASSERT_EQ(all.status, "ok") << all.message;
-  ASSERT_GT(all.hypotheses.size(), 3u);
+  pb::RecognitionResult all;
+  const auto model = trained_and_all_refined(s, &all);
+  ASSERT_GT(all.hypotheses.size(), 3u) << all.message;
   s.refine.max_hypotheses = 3;
   const pb::RecognitionResult few = pb::recognize(scene_->depth, scene_->K, *model, s);
   ASSERT_EQ(few.status, "ok") << few.message;
@@ -134,6 +141,30 @@ TEST_F(Pipeline, MaxHypothesesRefinesTheMostPromisingExactlyAsBefore) {
   EXPECT_TRUE(same_bits(few.T_cam_model, all.T_cam_model));
   EXPECT_EQ(few.inliers, all.inliers);
   EXPECT_LT((few.T_cam_model.t - scene_->T_cam_model.t).norm(), 10.0);
+}
+
+// refine.screen_points: every hypothesis is registered on a random 60 of its
+// model points, the 3 verification ranks first are refined on all of them
+// from there. The object is found, the same pose bit for bit with 1 and 2
+// threads, and the screening counts: without it (ranked at the initial pose)
+// the kept hypotheses are others or refined from elsewhere.
+TEST_F(Pipeline, ScreeningOnASubsetKeepsTheBestAndIsDeterministic) {
+  pb::RecognitionSettings s = small_settings("fpfh");
+  pb::RecognitionResult all;
+  const auto model = trained_and_all_refined(s, &all);
+  ASSERT_GT(all.hypotheses.size(), 3u) << all.message;
+  s.refine.max_hypotheses = 3;
+  const pb::RecognitionResult unscreened = pb::recognize(scene_->depth, scene_->K, *model, s);
+  s.refine.screen_points = 60;
+  const pb::RecognitionResult a = run_with_threads(1, *scene_, *model, s);
+  ASSERT_EQ(a.status, "ok") << a.message;
+  ASSERT_EQ(a.hypotheses.size(), 3u);
+  EXPECT_LT((a.T_cam_model.t - scene_->T_cam_model.t).norm(), 10.0);
+  EXPECT_LT(pbtest::angle_deg(a.T_cam_model.R, scene_->T_cam_model.R), 5.0);
+  expect_same_result(a, run_with_threads(2, *scene_, *model, s), "screened: 1 vs 2 threads");
+  bool differs = false;
+  for (size_t i = 0; i < 3; ++i) differs = differs || !same_bits(a.hypotheses[i].T_cam_model, unscreened.hypotheses[i].T_cam_model);
+  EXPECT_TRUE(differs) << "screening changed nothing";
 }
 
 // Registration alone (Table 4.9): from a slightly perturbed ground truth the

@@ -1,6 +1,8 @@
 #include "core/random.h"
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 
 namespace pb {
 
@@ -61,6 +63,21 @@ double Rng::normal(double mean, double sigma) {
   spare_ = r * std::sin(2.0 * M_PI * u2);
   has_spare_ = true;
   return mean + sigma * r * std::cos(2.0 * M_PI * u2);
+}
+
+std::vector<size_t> sample_indices(size_t n, int k, uint64_t seed) {
+  std::vector<size_t> idx(n);
+  std::iota(idx.begin(), idx.end(), size_t(0));
+  if (k <= 0 || static_cast<size_t>(k) >= n) return idx;
+  Rng rng(seed);
+  const size_t kk = static_cast<size_t>(k);
+  for (size_t i = 0; i < kk; ++i) {
+    const size_t j = i + static_cast<size_t>(rng.uniform_int(0, static_cast<int>(n - i - 1)));
+    std::swap(idx[i], idx[j]);
+  }
+  idx.resize(kk);
+  std::sort(idx.begin(), idx.end());
+  return idx;
 }
 
 }  // namespace pb

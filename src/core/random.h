@@ -6,8 +6,10 @@
 // libraries.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <initializer_list>
+#include <vector>
 
 namespace pb {
 
@@ -34,5 +36,10 @@ class Rng {
   bool has_spare_ = false;
   double spare_ = 0.0;
 };
+
+// The first k of a seeded Fisher-Yates shuffle of 0..n-1, in index order (all
+// of them when k is 0 or not below n): a random subset of points (ICP's
+// source points, the pipeline's screening subset).
+std::vector<std::size_t> sample_indices(std::size_t n, int k, uint64_t seed);
 
 }  // namespace pb

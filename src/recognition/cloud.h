@@ -24,6 +24,10 @@ struct PointSet {
   bool has_normals() const { return normals.size() == points.size() && !points.empty(); }
 };
 
+// The points `indices` name, in that order, with every per-point field the
+// cloud has (normals, curvature, pixel).
+PointSet subset(const PointSet& cloud, const std::vector<int>& indices);
+
 // A pose hypothesis for the object in the scene.
 struct Hypothesis {
   Pose T_cam_model;      // model -> scene camera

@@ -22,7 +22,7 @@ namespace {
 constexpr size_t kMinScenePoints = 3;
 
 // Random streams of one call (derive_seed ids).
-enum Stream : uint64_t { kStreamScene = 11, kStreamMethod = 12, kStreamRefine = 13 };
+enum Stream : uint64_t { kStreamScene = 11, kStreamMethod = 12, kStreamRefine = 13, kStreamScreen = 14 };
 
 bool finite_pose(const Pose& p) { return p.R.allFinite() && p.t.allFinite(); }
 
@@ -58,8 +58,10 @@ PointSet prepare_scene(const DepthImage& depth, const Intrinsics& K, const Recog
 // depend on the thread count. stream[i]: hypothesis i's position in the
 // method's list (its random stream, the same whether or not others were
 // dropped before refinement).
+// sources: hypothesis i's model points, when given (screening's subsets);
+// else its view's model cloud.
 void refine_all(std::vector<Hypothesis>& hyps, const std::vector<uint64_t>& stream, const TrainedModel& model,
-                const PointSet& scene, const RecognitionSettings& s) {
+                const PointSet& scene, const RecognitionSettings& s, const std::vector<PointSet>* sources = nullptr) {
   for (const auto& h : hyps) model.model_cloud(h.view);  // throws for a view index out of range
   const long nh = static_cast<long>(hyps.size());
   std::vector<std::exception_ptr> errors(hyps.size());
@@ -67,7 +69,8 @@ void refine_all(std::vector<Hypothesis>& hyps, const std::vector<uint64_t>& stre
   for (long i = 0; i < nh; ++i) {
     try {
       Hypothesis& h = hyps[static_cast<size_t>(i)];
-      const RefineResult r = refine_pose(s.refinement, model.model_cloud(h.view), scene, h.T_cam_model, s.refine,
+      const PointSet& source = sources ? (*sources)[static_cast<size_t>(i)] : model.model_cloud(h.view);
+      const RefineResult r = refine_pose(s.refinement, source, scene, h.T_cam_model, s.refine,
                                          derive_seed(s.seed, {kStreamRefine, stream[static_cast<size_t>(i)]}));
       if (finite_pose(r.T_cam_model)) {
         h.T_cam_model = r.T_cam_model;
@@ -97,41 +100,13 @@ void count_all(std::vector<Hypothesis>& hyps, const TrainedModel& model, const P
   }
 }
 
-// RefineSettings::max_hypotheses: keeps the hypotheses with the most inliers
-// within max_correspondence_mm at their initial pose (ties: score, then the
-// method's order), in the method's order. Returns the kept hypotheses'
-// positions in the method's list.
-std::vector<uint64_t> keep_most_promising(std::vector<Hypothesis>& hyps, const TrainedModel& model,
-                                          const PointIndex& index, const RecognitionSettings& s) {
-  const size_t keep = static_cast<size_t>(s.refine.max_hypotheses);
-  std::vector<uint64_t> kept_at(hyps.size());
-  for (size_t i = 0; i < kept_at.size(); ++i) kept_at[i] = i;
-  if (keep == 0 || hyps.size() <= keep) return kept_at;
-  count_all(hyps, model, index, s.verify, s.refine.max_correspondence_mm);
-  std::vector<size_t> order(hyps.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    if (hyps[a].inliers != hyps[b].inliers) return hyps[a].inliers > hyps[b].inliers;
-    return score_of(hyps[a]) > score_of(hyps[b]);
-  });
-  order.resize(keep);
-  std::sort(order.begin(), order.end());
-  std::vector<Hypothesis> kept;
-  kept_at.clear();
-  for (size_t i : order) {
-    kept.push_back(hyps[i]);
-    kept_at.push_back(i);
-  }
-  hyps = std::move(kept);
-  return kept_at;
-}
-
-// Counts inliers and ranks by verify.score (inliers, or the depth evidence
-// of visibility) first; ties by inliers, score, then view index, then the
-// method's order.
-std::vector<Hypothesis> verify_and_rank(std::vector<Hypothesis> hyps, const TrainedModel& model,
-                                        const PointIndex& index, const VerifySettings& v, const DepthImage& depth,
-                                        const Intrinsics& K) {
+// Counts every hypothesis's inliers and verification (verify.score: inliers,
+// or the depth evidence of visibility); returns the order verification ranks
+// them in: verification first; ties by inliers, score, then view index, then
+// the method's order.
+std::vector<size_t> verification_order(std::vector<Hypothesis>& hyps, const TrainedModel& model,
+                                       const PointIndex& index, const VerifySettings& v, const DepthImage& depth,
+                                       const Intrinsics& K) {
   count_all(hyps, model, index, v, v.inlier_threshold_mm);
   const bool visibility = v.score == "visibility";
   for (Hypothesis& h : hyps)
@@ -149,9 +124,53 @@ std::vector<Hypothesis> verify_and_rank(std::vector<Hypothesis> hyps, const Trai
     if (x.view != y.view) return x.view < y.view;
     return a < b;
   });
+  return order;
+}
+
+std::vector<Hypothesis> verify_and_rank(std::vector<Hypothesis> hyps, const TrainedModel& model,
+                                        const PointIndex& index, const VerifySettings& v, const DepthImage& depth,
+                                        const Intrinsics& K) {
   std::vector<Hypothesis> ranked;
-  for (size_t i : order) ranked.push_back(hyps[i]);
+  for (size_t i : verification_order(hyps, model, index, v, depth, K)) ranked.push_back(hyps[i]);
   return ranked;
+}
+
+// RefineSettings::max_hypotheses: keeps the hypotheses verification ranks
+// first (verification_order), in the method's order: at their initial pose,
+// or, with refine.screen_points, after a registration of a seeded random
+// subset of that many of their model points (the kept ones are then refined
+// on all their points from the screened pose). Returns the kept hypotheses'
+// positions in the method's list.
+std::vector<uint64_t> keep_most_promising(std::vector<Hypothesis>& hyps, const TrainedModel& model,
+                                          const PointSet& scene, const PointIndex& index, const DepthImage& depth,
+                                          const Intrinsics& K, const RecognitionSettings& s) {
+  const size_t keep = static_cast<size_t>(s.refine.max_hypotheses);
+  std::vector<uint64_t> kept_at(hyps.size());
+  for (size_t i = 0; i < kept_at.size(); ++i) kept_at[i] = i;
+  if (keep == 0 || hyps.size() <= keep) return kept_at;
+  if (s.refine.screen_points > 0) {
+    std::vector<PointSet> sources;
+    for (size_t i = 0; i < hyps.size(); ++i) {
+      const PointSet& cloud = model.model_cloud(hyps[i].view);
+      std::vector<int> pick;
+      for (size_t k : sample_indices(cloud.size(), s.refine.screen_points,
+                                     derive_seed(s.seed, {kStreamScreen, static_cast<uint64_t>(i)})))
+        pick.push_back(static_cast<int>(k));
+      sources.push_back(subset(cloud, pick));
+    }
+    refine_all(hyps, kept_at, model, scene, s, &sources);
+  }
+  std::vector<size_t> order = verification_order(hyps, model, index, s.verify, depth, K);
+  order.resize(keep);
+  std::sort(order.begin(), order.end());
+  std::vector<Hypothesis> kept;
+  kept_at.clear();
+  for (size_t i : order) {
+    kept.push_back(hyps[i]);
+    kept_at.push_back(i);
+  }
+  hyps = std::move(kept);
+  return kept_at;
 }
 
 // The acceptance rule (VerifySettings): a hypothesis needs an inlier and at
@@ -223,7 +242,7 @@ void refine_verify_accept(std::vector<Hypothesis> hyps, const TrainedModel& mode
   const PointIndex index(scene.points);
   res.times.verify = timer.seconds();
   timer.reset();
-  const std::vector<uint64_t> stream = keep_most_promising(hyps, model, index, s);
+  const std::vector<uint64_t> stream = keep_most_promising(hyps, model, scene, index, depth, K, s);
   refine_all(hyps, stream, model, scene, s);
   res.times.refine = timer.seconds();
   timer.reset();

@@ -45,8 +45,6 @@ std::vector<std::vector<int>> euclidean_clusters(const std::vector<Vec3f>& point
 // euclidean_clusters (tests and benchmarks only).
 std::vector<std::vector<int>> euclidean_clusters_pcl(const std::vector<Vec3f>& points, double tolerance_mm,
                                                      int min_points, int max_points);
-// The points (and normals, curvature, pixels) at `indices`.
-PointSet subset(const PointSet& cloud, const std::vector<int>& indices);
 
 // A stable region: CVFH's smooth region growing after removing high-
 // curvature points (pcl::CVFHEstimation's algorithm and parameters): points

@@ -253,7 +253,7 @@ class GlobalMethod : public Method {
     std::vector<PointSet> cluster_clouds;
     std::vector<Signature> scene_sigs;
     for (size_t c = 0; c < clusters.size(); ++c) {
-      cluster_clouds.push_back(global::subset(scene, clusters[c]));
+      cluster_clouds.push_back(subset(scene, clusters[c]));
       auto sigs = describe(kind_, cluster_clouds.back(), g, derive_seed(seed, {kSceneStream, c}));
       for (auto& sig : sigs) {
         sig.source = static_cast<int>(c);

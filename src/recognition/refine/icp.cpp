@@ -43,21 +43,6 @@
 
 namespace pb::refine_detail {
 
-std::vector<size_t> sample_indices(size_t n, int k, uint64_t seed) {
-  std::vector<size_t> idx(n);
-  std::iota(idx.begin(), idx.end(), size_t(0));
-  if (k <= 0 || static_cast<size_t>(k) >= n) return idx;
-  Rng rng(seed);
-  const size_t kk = static_cast<size_t>(k);
-  for (size_t i = 0; i < kk; ++i) {
-    const size_t j = i + static_cast<size_t>(rng.uniform_int(0, static_cast<int>(n - i - 1)));
-    std::swap(idx[i], idx[j]);
-  }
-  idx.resize(kk);
-  std::sort(idx.begin(), idx.end());
-  return idx;
-}
-
 namespace {
 
 // Leaf size of ICP's kd-trees: nearest-neighbour queries only, whose answer

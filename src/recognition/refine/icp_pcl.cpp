@@ -8,6 +8,7 @@
 // internal.h.
 #include <pcl/registration/icp.h>
 
+#include "core/random.h"
 #include "recognition/pcl_adapter.h"
 #include "recognition/refine/pcl_registration.h"
 

@@ -46,10 +46,6 @@ Outcome run_icp_lm(const Problem& p, const RefineSettings& s, uint64_t seed);
 Outcome run_gicp(const Problem& p, const RefineSettings& s, uint64_t seed);
 Outcome run_ndt(const Problem& p, const RefineSettings& s, uint64_t seed);
 
-// The first k of a seeded Fisher-Yates shuffle of 0..n-1, in index order (all
-// of them when k is 0 or not below n): ICP's random subset of source points.
-std::vector<size_t> sample_indices(size_t n, int k, uint64_t seed);
-
 // Unit normals by PCA over the k nearest neighbours (sign arbitrary: the
 // point-to-plane and plane-to-plane metrics do not depend on it).
 std::vector<Vec3f> estimate_normals(const std::vector<Vec3f>& pts, int k);

@@ -55,11 +55,15 @@ struct RefineSettings {
                                            // max_correspondence_mm, which is relative by default; a
                                            // fraction "0.05d" is allowed)
   int normal_neighbours = 10;              // k for PCA normals when a cloud has none (icp_plane, gicp)
-  int max_hypotheses = 0;                  // refine only this many hypotheses: those with the most
-                                           // model points within max_correspondence_mm of a scene
-                                           // point at their initial pose (ties: the method's score,
-                                           // then its order); the others are dropped before
-                                           // refinement. 0 = refine every hypothesis (thesis)
+  int max_hypotheses = 0;                  // refine only this many hypotheses: those verification
+                                           // would rank first (verify.score, ties as there) at their
+                                           // initial pose, or after screening (screen_points); the
+                                           // others are dropped. 0 = refine every hypothesis (thesis)
+  int screen_points = 0;                   // with max_hypotheses: every hypothesis is first
+                                           // registered (this method, max_iterations) on a seeded
+                                           // random subset of this many of its model points and
+                                           // ranked at that pose; the kept ones are refined on all
+                                           // points from there. 0 = rank at the initial pose
 
   template <class S, class F>
   static void fields(S& s, F& f) {
@@ -82,6 +86,7 @@ struct RefineSettings {
     f("crop_margin_mm", s.crop_margin_mm, fields::length({}));  // a length ("0.05d"); < 0: the sentinel
     f("normal_neighbours", s.normal_neighbours, fields::at_least(3));
     f("max_hypotheses", s.max_hypotheses, fields::at_least(0));
+    f("screen_points", s.screen_points, fields::at_least(0));
   }
   void validate(const YamlNode& node) const {
     if (ndt_outlier_ratio >= 1) node["ndt_outlier_ratio"].fail("must be below 1");
