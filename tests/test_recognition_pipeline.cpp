@@ -155,6 +155,7 @@ TEST_F(Pipeline, ScreeningOnASubsetKeepsTheBestAndIsDeterministic) {
   ASSERT_GT(all.hypotheses.size(), 3u) << all.message;
   s.refine.max_hypotheses = 3;
   const pb::RecognitionResult unscreened = pb::recognize(scene_->depth, scene_->K, *model, s);
+  ASSERT_EQ(unscreened.hypotheses.size(), 3u);
   s.refine.screen_points = 60;
   const pb::RecognitionResult a = run_with_threads(1, *scene_, *model, s);
   ASSERT_EQ(a.status, "ok") << a.message;
@@ -163,7 +164,8 @@ TEST_F(Pipeline, ScreeningOnASubsetKeepsTheBestAndIsDeterministic) {
   EXPECT_LT(pbtest::angle_deg(a.T_cam_model.R, scene_->T_cam_model.R), 5.0);
   expect_same_result(a, run_with_threads(2, *scene_, *model, s), "screened: 1 vs 2 threads");
   bool differs = false;
-  for (size_t i = 0; i < 3; ++i) differs = differs || !same_bits(a.hypotheses[i].T_cam_model, unscreened.hypotheses[i].T_cam_model);
+  for (size_t i = 0; i < 3; ++i)
+    differs = differs || !same_bits(a.hypotheses[i].T_cam_model, unscreened.hypotheses[i].T_cam_model);
   EXPECT_TRUE(differs) << "screening changed nothing";
 }
 
