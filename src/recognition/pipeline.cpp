@@ -152,11 +152,9 @@ std::vector<uint64_t> keep_most_promising(std::vector<Hypothesis>& hyps, const T
     std::vector<PointSet> sources;
     for (size_t i = 0; i < hyps.size(); ++i) {
       const PointSet& cloud = model.model_cloud(hyps[i].view);
-      std::vector<int> pick;
-      for (size_t k : sample_indices(cloud.size(), s.refine.screen_points,
-                                     derive_seed(s.seed, {kStreamScreen, static_cast<uint64_t>(i)})))
-        pick.push_back(static_cast<int>(k));
-      sources.push_back(subset(cloud, pick));
+      const std::vector<size_t> pick = sample_indices(cloud.size(), s.refine.screen_points,
+                                                      derive_seed(s.seed, {kStreamScreen, static_cast<uint64_t>(i)}));
+      sources.push_back(subset(cloud, std::vector<int>(pick.begin(), pick.end())));
     }
     refine_all(hyps, kept_at, model, scene, s, &sources);
   }

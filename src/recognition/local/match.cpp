@@ -11,11 +11,12 @@
 // bounds until the bound exceeds the k-th best exact distance (or the
 // threshold), with a margin for the bounds' rounding. Every row that can be
 // among the k nearest is measured exactly and offered in ascending row order,
-// so the result is the exact scan's, bit for bit. Approximate on request (max_checks > 0): at most that
-// many rows, those of the lowest bounds, are measured exactly per query; the
-// answer is still exact whenever the early exit comes first (measured
-// recall: LocalSettings' match_max_checks). Searches are const and
-// thread-safe, and deterministic (no randomized trees).
+// so the result is the exact scan's, bit for bit. Approximate on request
+// (max_checks > 0): at most that many rows, those of the lowest bounds, are
+// measured exactly per query; the answer is still exact whenever the early
+// exit comes first (measured recall: LocalSettings' match_max_checks).
+// Searches are const and thread-safe, and deterministic (no randomized
+// trees).
 //
 // Why no kd-tree: for SHOT one visits nearly every leaf (measured: no faster
 // than a linear scan). FPFH used FLANN's single kd-tree (the index
