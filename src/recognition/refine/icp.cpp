@@ -35,7 +35,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
 
 #include "core/random.h"
 #include "recognition/kdtree.h"
