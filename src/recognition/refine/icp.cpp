@@ -44,10 +44,11 @@ namespace pb::refine_detail {
 
 namespace {
 
-// Leaf size of ICP's kd-trees: nearest-neighbour queries only, whose answer
-// does not depend on it (ties go to the lower index); on the warehouse, 24
-// points per leaf made refinement about 8% faster than the default 8.
-constexpr int kIcpLeafSize = 24;
+// Leaf size of ICP's kd-trees (the target's: kTargetLeafSize, internal.h):
+// nearest-neighbour queries only, whose answer does not depend on it (ties
+// go to the lower index); on the warehouse, 24 points per leaf made
+// refinement about 8% faster than the default 8.
+constexpr int kIcpLeafSize = kTargetLeafSize;
 
 struct Pair {
   int src, tgt;
@@ -184,7 +185,8 @@ Outcome icp(const Problem& p, const RefineSettings& s, uint64_t seed, Metric met
   Outcome o;
   const std::vector<Vec3f> src = sampled(p.src, s.icp_sample_points, seed);
   if (src.size() < 3 || p.tgt.size() < 3) return o;
-  const KdTree3 tgt_tree(p.tgt, kIcpLeafSize);
+  const KdTree3 own = p.tgt_tree ? KdTree3() : KdTree3(p.tgt, kIcpLeafSize);
+  const KdTree3& tgt_tree = p.tgt_tree ? *p.tgt_tree : own;
   Mat4 T = Mat4::Identity();
   int cap = s.max_iterations;
   // Coarse stage: a seeded random subset of the source points, leaving the

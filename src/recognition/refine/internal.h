@@ -20,7 +20,14 @@
 #include "recognition/refine/refine.h"
 
 namespace pb {
+
+class KdTree3;
+
 namespace refine_detail {
+
+// The leaf size of the crop's kd-tree (the own ICP's nearest-neighbour
+// searches and the fitness).
+constexpr int kTargetLeafSize = 24;
 
 struct Problem {
   std::vector<Vec3f> src;          // model points, local frame (m), after the initial pose
@@ -28,6 +35,8 @@ struct Problem {
   std::vector<Vec3f> tgt;          // cropped scene points, local frame (m)
   std::vector<Vec3f> tgt_normals;  // unit; filled when the method needs normals
   double model_diameter_m = 0;     // extent of the model cloud: its bounding box diagonal in the model frame
+  const KdTree3* tgt_tree = nullptr;  // over tgt (leaf kTargetLeafSize), built once by refine_pose for
+                                      // the method and the fitness; null: a method builds its own
 };
 
 struct Outcome {

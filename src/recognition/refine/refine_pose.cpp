@@ -89,6 +89,10 @@ RefineResult refine_pose(const std::string& method, const PointSet& model, const
   p.tgt.reserve(crop.size());
   for (size_t i : crop) p.tgt.push_back(((scene.points[i].cast<double>() - c) * 1e-3).cast<float>());
 
+  // One tree over the crop, for the method's nearest neighbours and the
+  // fitness below (a nearest neighbour does not depend on the leaf size).
+  const KdTree3 tgt_tree(p.tgt, refine_detail::kTargetLeafSize);
+  p.tgt_tree = &tgt_tree;
   if (entry.run) {
     if (entry.needs_normals(s)) {
       if (model.has_normals()) {
@@ -129,7 +133,7 @@ RefineResult refine_pose(const std::string& method, const PointSet& model, const
   // Fitness: mean squared distance (mm^2) of the model points to their
   // nearest cropped scene point, over pairs within max_correspondence_mm.
   {
-    const KdTree3 tree(p.tgt);
+    const KdTree3& tree = tgt_tree;
     double sum = 0;
     size_t n = 0;
     const double lim = max_corr * max_corr;
