@@ -13,6 +13,7 @@
 #include "recognition/kdtree.h"
 #include "recognition/local/internal.h"
 #include "recognition/preprocess/internal.h"
+#include "recognition/preprocess/preprocess.h"
 #include "test_recognition_local_util.h"
 
 namespace pb {
@@ -129,6 +130,70 @@ TEST(ThinningNormals, ACappedNeighbourhoodGivesNearlyTheSameNormal) {
   PointSet same = plane;
   detail::estimate_normals(same, 22.0, 100000);
   EXPECT_EQ(same.normals, full.normals);
+}
+
+// The coarse support (preprocess.normal_coarse_support): on a noisy sphere
+// seen from the origin, where the true normal is known, normals from the
+// centroids of a coarse grid are as close to it as those from the thinned
+// points; a small isolated cluster, too sparse for the coarse grid, still
+// gets its normals (from its own points).
+double angle_deg(const Vec3f& a, const Vec3f& b) {
+  return std::acos(std::clamp(static_cast<double>(a.normalized().dot(b.normalized())), -1.0, 1.0)) * 180 / M_PI;
+}
+
+TEST(ThinningNormals, ACoarseSupportIsAsCloseToTheTrueNormal) {
+  const Vec3f centre(0, 0, 3000);
+  const double R = 800;
+  PointSet sphere;
+  Rng rng(11);
+  for (int i = -45; i <= 45; ++i)  // the near cap, about 20 mm apart, 2 mm of noise along the radius
+    for (int j = -45; j <= 45; ++j) {
+      const Vec3f d = Vec3f(0.025f * i, 0.025f * j, -1.f).normalized();
+      sphere.points.push_back(centre + d * static_cast<float>(R + rng.normal(0, 2)));
+    }
+  PointSet cluster = sphere;  // and 10 points of a 30 mm patch 1 m in front of it
+  for (int k = 0; k < 10; ++k)
+    cluster.points.emplace_back(static_cast<float>(rng.uniform(-15, 15)), static_cast<float>(rng.uniform(-15, 15)),
+                                2000.f);
+  PointSet thin = cluster, coarse = cluster;
+  detail::estimate_normals(thin, 180.0, 64);
+  detail::estimate_normals(coarse, 180.0, 64, 40.0);
+  ASSERT_EQ(thin.size(), cluster.size());
+  ASSERT_EQ(coarse.size(), cluster.size()) << "every point keeps a normal, the isolated patch's included";
+  std::vector<double> e_thin, e_coarse;
+  for (size_t i = 0; i < sphere.size(); ++i) {
+    const int gi = static_cast<int>(i) / 91 - 45, gj = static_cast<int>(i) % 91 - 45;
+    if (std::abs(gi) > 30 || std::abs(gj) > 30) continue;  // balls cut by the cap's border tilt either normal
+    const Vec3f truth = sphere.points[i] - centre;  // outward: toward the viewer at the origin
+    e_thin.push_back(angle_deg(thin.normals[i], truth));
+    e_coarse.push_back(angle_deg(coarse.normals[i], truth));
+  }
+  auto pct = [](std::vector<double> v, double q) {
+    std::sort(v.begin(), v.end());
+    return v[static_cast<size_t>(q * static_cast<double>(v.size() - 1))];
+  };
+  // The 180 mm ball on an 800 mm sphere tilts a PCA normal only slightly
+  // (the cap is symmetric about the point); either support is within
+  // a degree of the truth for nearly every point.
+  EXPECT_LT(pct(e_thin, 0.95), 1.0);
+  EXPECT_LT(pct(e_coarse, 0.95), 1.0);
+  EXPECT_LT(pct(e_coarse, 0.5), 1.5 * pct(e_thin, 0.5) + 0.1);
+  for (size_t i = sphere.size(); i < cluster.size(); ++i)
+    EXPECT_LT(angle_deg(coarse.normals[i], Vec3f(0, 0, -1)), 1.0) << "the isolated patch faces the camera";
+}
+
+TEST(ThinningNormals, TheCoarseSupportServesOnlyWhereABallHoldsManyVoxels) {
+  PreprocessSettings table;  // defaults: 10 mm voxels, 20 mm normals
+  EXPECT_EQ(table.normal_support_leaf_mm(), 0.0);
+  PreprocessSettings warehouse;  // as the LS5's warehouse runs resolve it
+  warehouse.voxel_mm = 20;
+  warehouse.normal_radius_mm = 181.6;
+  EXPECT_NEAR(warehouse.normal_support_leaf_mm(), 181.6 * std::sqrt(M_PI / 64), 1e-9);
+  warehouse.normal_coarse_support = false;
+  EXPECT_EQ(warehouse.normal_support_leaf_mm(), 0.0);
+  warehouse.normal_coarse_support = true;
+  warehouse.normal_max_points = 0;  // no cap: every point, as PCL
+  EXPECT_EQ(warehouse.normal_support_leaf_mm(), 0.0);
 }
 
 }  // namespace

@@ -66,7 +66,12 @@ double depth_noise_sigma(const OrganizedCloud& cloud, int row_step = 4);
 // normal cannot be estimated (fewer than 3 neighbours) are dropped, with
 // their pixel. max_points > 0: a neighbourhood of more points is thinned
 // evenly in tree order to that many (keep_evenly, kdtree.h).
-void estimate_normals(PointSet& cloud, double radius_mm, int max_points = 0);
+// support_leaf_mm > 0: a point's neighbours are instead the centroids of the
+// cloud voxelized at that leaf (a coarse support, built once) within
+// `radius_mm`, thinned the same way; a point with fewer than
+// max_points / 4 of them (a sparse region, where the fine neighbourhood
+// would hardly need thinning) takes the fine neighbourhood as above.
+void estimate_normals(PointSet& cloud, double radius_mm, int max_points = 0, double support_leaf_mm = 0);
 
 // Mixed ("flying", "veil") pixels of an organized cloud: flags a valid pixel
 // when the 3D step to one of its valid 8-neighbours lies within `angle_deg`

@@ -7,10 +7,12 @@
 // (stable for clouds far from the origin). Each point is independent, so
 // OpenMP threads do not change the result.
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 
 #include "recognition/kdtree.h"
 #include "recognition/preprocess/internal.h"
+#include "recognition/preprocess/voxel_grid.h"
 #include "recognition/scatter.h"
 
 namespace pb::detail {
@@ -50,30 +52,71 @@ bool pca_normal(const std::vector<Vec3f>& pts, const std::vector<int>& nb, Vec3f
 
 }  // namespace
 
-void estimate_normals(PointSet& ps, double radius_mm, int max_points) {
+void estimate_normals(PointSet& ps, double radius_mm, int max_points, double support_leaf_mm) {
   ps.normals.clear();
   ps.curvature.clear();
   if (ps.points.empty()) return;
-  const KdTree3 tree(ps.points);
   const long n = static_cast<long>(ps.points.size());
-  std::vector<char> keep(ps.points.size(), 0);
+  const float r = static_cast<float>(radius_mm);
+  std::vector<char> keep(ps.points.size(), 0), fine(ps.points.size(), 1);
   ps.normals.assign(ps.points.size(), Vec3f::Zero());
   ps.curvature.assign(ps.points.size(), 0.f);
+  // One point's normal from the neighbours `nb` (indices into `pts`).
+  auto set_normal = [&](size_t k, const std::vector<Vec3f>& pts, const std::vector<int>& nb) {
+    Vec3f nrm;
+    float curv = 0;
+    if (!pca_normal(pts, nb, nrm, curv)) return false;
+    if (nrm.dot(-ps.points[k]) < 0) nrm = -nrm;  // toward the viewpoint (origin)
+    ps.normals[k] = nrm;
+    ps.curvature[k] = curv;
+    keep[k] = 1;
+    return true;
+  };
+  if (support_leaf_mm > 0) {  // first from the coarse support: the cloud's centroids at support_leaf_mm
+    PointSet bare;
+    bare.points = ps.points;
+    const PointSet support = voxel_downsample(bare, {support_leaf_mm});
+    const KdTree3 coarse(support.points);
+    const size_t min_coarse = static_cast<size_t>(std::max(3, max_points / 4));
 #pragma omp parallel
-  {
-    std::vector<int> nb;
+    {
+      std::vector<int> nb;
 #pragma omp for schedule(static)
-    for (long i = 0; i < n; ++i) {
-      const size_t k = static_cast<size_t>(i);
-      tree.radius_unsorted(ps.points[k], static_cast<float>(radius_mm), nb);
+      for (long i = 0; i < n; ++i) {
+        const size_t k = static_cast<size_t>(i);
+        coarse.radius_unsorted(ps.points[k], r, nb);
+        if (nb.size() < min_coarse) continue;  // sparse here: the fine neighbourhood below
+        keep_evenly(nb, max_points);
+        fine[k] = !set_normal(k, support.points, nb);
+      }
+    }
+  }
+  const size_t n_fine = static_cast<size_t>(std::count(fine.begin(), fine.end(), 1));
+  if (n_fine > 0 && n_fine <= 64 && support_leaf_mm > 0) {
+    // A few sparse points: their neighbours by a scan (cheaper than a tree).
+    const float r2 = r * r;
+    std::vector<int> nb;
+    for (size_t k = 0; k < ps.points.size(); ++k) {
+      if (!fine[k]) continue;
+      nb.clear();
+      for (size_t j = 0; j < ps.points.size(); ++j)
+        if ((ps.points[j] - ps.points[k]).squaredNorm() <= r2) nb.push_back(static_cast<int>(j));
       keep_evenly(nb, max_points);
-      Vec3f nrm;
-      float curv = 0;
-      if (!pca_normal(ps.points, nb, nrm, curv)) continue;
-      if (nrm.dot(-ps.points[k]) < 0) nrm = -nrm;  // toward the viewpoint (origin)
-      ps.normals[k] = nrm;
-      ps.curvature[k] = curv;
-      keep[k] = 1;
+      set_normal(k, ps.points, nb);
+    }
+  } else if (n_fine > 0) {
+    const KdTree3 tree(ps.points);
+#pragma omp parallel
+    {
+      std::vector<int> nb;
+#pragma omp for schedule(static)
+      for (long i = 0; i < n; ++i) {
+        const size_t k = static_cast<size_t>(i);
+        if (!fine[k]) continue;
+        tree.radius_unsorted(ps.points[k], r, nb);
+        keep_evenly(nb, max_points);
+        set_normal(k, ps.points, nb);
+      }
     }
   }
   size_t kept = 0;

@@ -34,6 +34,13 @@ void PreprocessSettings::validate(const YamlNode& node) const {
     node["max_range_mm"].fail("must be greater than min_range_mm (" + std::to_string(min_range_mm) + ")");
 }
 
+double PreprocessSettings::normal_support_leaf_mm() const {
+  if (!normal_coarse_support || normal_max_points <= 0 || !(voxel_mm > 0)) return 0;
+  // About normal_max_points cells of this leaf cover the ball's flat disc.
+  const double leaf = normal_radius_mm * std::sqrt(M_PI / normal_max_points);
+  return leaf >= 1.5 * voxel_mm ? leaf : 0;
+}
+
 namespace detail {
 
 PointSet select(const PointSet& in, const std::vector<char>& keep) {
@@ -317,7 +324,7 @@ PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings&
       ps = detail::select(ps, keep);
     }
   }
-  detail::estimate_normals(ps, s.normal_radius_mm, s.normal_max_points);
+  detail::estimate_normals(ps, s.normal_radius_mm, s.normal_max_points, s.normal_support_leaf_mm());
   return ps;
 }
 
@@ -326,7 +333,7 @@ PointSet preprocess_view(const OrganizedCloud& cloud, const PreprocessSettings& 
   // settings chose: no range cut, no plane.
   PointSet ps = range_cut(cloud, 0.0, std::numeric_limits<double>::infinity());
   ps = voxel_downsample(ps, {s.voxel_mm});
-  detail::estimate_normals(ps, s.normal_radius_mm, s.normal_max_points);
+  detail::estimate_normals(ps, s.normal_radius_mm, s.normal_max_points, s.normal_support_leaf_mm());
   return ps;
 }
 

@@ -44,6 +44,15 @@ struct PreprocessSettings {
   int normal_max_points = 64;       // a normal's neighbourhood of more points than this is thinned
                                     // evenly (in kd-tree order: spatially stratified) to this many
                                     // before the PCA (0 = every point, as pcl::NormalEstimation)
+  bool normal_coarse_support = true;  // a normal's neighbours are the centroids of the cloud voxelized
+                                    // at leaf normal_radius_mm x sqrt(pi / normal_max_points) (as
+                                    // many cells cover the ball's flat disc), instead of the cloud's
+                                    // points thinned, wherever that leaf is at least 1.5 x voxel_mm
+                                    // (the warehouse's 0.1 d = 182 mm at 20 mm voxels: a 40 mm leaf;
+                                    // not the table's 20 mm at 10 mm voxels); a point with fewer
+                                    // than normal_max_points / 4 centroids in its ball takes its own
+                                    // neighbours. false = always the cloud's points (the releases
+                                    // before). Measured: results/bench/README.md, twenty-third round
 
   template <class S, class F>
   static void fields(S& s, F& f) {
@@ -61,8 +70,12 @@ struct PreprocessSettings {
     f("plane_sample_points", s.plane_sample_points, fields::at_least(0));
     f("normal_radius_mm", s.normal_radius_mm, fields::length(fields::positive()));
     f("normal_max_points", s.normal_max_points, fields::at_least(0));
+    f("normal_coarse_support", s.normal_coarse_support);
   }
   void validate(const YamlNode& node) const;  // max_range_mm > min_range_mm
+  // The leaf of the normals' coarse support (normal_coarse_support), or 0
+  // where the cloud's own points serve.
+  double normal_support_leaf_mm() const;
 };
 
 // Scene preprocessing. Every random choice (RANSAC) draws from `seed`.
