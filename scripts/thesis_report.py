@@ -483,7 +483,9 @@ DIFFERENCES = [
     "\"fairly high amount of occlusion\" without numbers, and the cover ablation runs the warehouse rows with the "
     "occluded half 20-60% visible.",
     "Lengths the thesis does not give follow the default profile, relative to the object's diameter (issue 9; "
-    "`settings_resolved` in every record has them in mm): normal radius 0.1 d, RANSAC plane threshold 0.05 d, "
+    "`settings_resolved` in every record has them in mm): normal radius 0.1 d (in the warehouse, where that ball "
+    "spans many 20 mm voxels, its PCA runs on the cloud's centroids at 40 mm: `preprocess.normal_coarse_support`, "
+    "`results/bench/README.md`, twenty-third round), RANSAC plane threshold 0.05 d, "
     "FPFH/SHOT radius 0.3 d, LRF radius 0.2 d, cluster distance 0.1 d, CVFH region distance 0.075 d and normal "
     "radius 0.1 d, ICP correspondence distance 0.1 d, inlier threshold 0.05 d but at most 2 voxels "
     "(`verify.inlier_threshold_max_voxels`: 40 mm in the warehouse, where 0.05 d is 90 mm, 4.5 voxels, and let the "
