@@ -355,6 +355,7 @@ void inject_fault(const std::string& key) {
 }  // namespace
 
 int worker_main() {
+  keep_freed_memory();
   std::string line;
   if (!std::getline(std::cin, line)) return 0;
   const TrialContext ctx = context_from_json(nlohmann::json::parse(line));
