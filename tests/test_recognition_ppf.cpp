@@ -15,6 +15,7 @@
 #include <random>
 #include <sstream>
 
+#include "core/cpu.h"
 #include "core/error.h"
 #include "core/rotation.h"
 #include "core/yaml.h"
@@ -259,6 +260,60 @@ TEST(PpfAlphaBins, EqualTheFormula) {
     for (int i = 0; i < 1000000; ++i) check(any(rng));
     for (float a : {-0.f, 0.f, -3.2f, 3.2f, static_cast<float>(M_PI), -static_cast<float>(M_PI)}) check(a);
     EXPECT_EQ(wrong, 0u) << deg << " deg, of " << checked;
+  }
+}
+
+// Voting's cells eight at a time (AVX2, the bin from its formula in double)
+// equal the one-at-a-time path (AlphaBins): around every bin edge and the
+// wrap at +-pi, with alpha_s at random, and at random, for the default 12
+// degrees and two steps that do not divide 360; lengths that are not a
+// multiple of eight take the one-at-a-time tail.
+TEST(PpfVoteCells, EightAtATimeEqualOneAtATime) {
+  if (!pb::cpu_has_avx2()) GTEST_SKIP() << "this CPU has no AVX2: voting takes the one-at-a-time path only";
+  std::mt19937 rng(12);
+  const float pi = static_cast<float>(M_PI);
+  std::uniform_real_distribution<float> any(-pi, pi);
+  for (const double deg : {12.0, 7.0, 25.3}) {
+    const float step = static_cast<float>(deg * M_PI / 180.0);
+    const int n_alpha = std::max(1, static_cast<int>(std::floor(2 * M_PI / step)));
+    const ppf::VoteCells cells(step, n_alpha);
+    std::vector<float> alpha_m;
+    std::vector<uint32_t> ref;
+    size_t wrong = 0, checked = 0;
+    auto check = [&](float alpha_s) {
+      ref.resize(alpha_m.size());
+      for (size_t k = 0; k < ref.size(); ++k) ref[k] = static_cast<uint32_t>(rng() % 1000);
+      std::vector<uint32_t> got(alpha_m.size()), want(alpha_m.size());
+      cells(ref.data(), alpha_m.data(), alpha_m.size(), alpha_s, got.data());
+      cells.plain(ref.data(), alpha_m.data(), alpha_m.size(), alpha_s, want.data());
+      for (size_t k = 0; k < got.size(); ++k, ++checked)
+        if (got[k] != want[k] && ++wrong <= 3)
+          ADD_FAILURE() << deg << " deg, alpha_m " << alpha_m[k] << ", alpha_s " << alpha_s;
+      alpha_m.clear();
+    };
+    for (int t = 0; t < 40; ++t) {
+      const float alpha_s = t == 0 ? pi : t == 1 ? -pi : any(rng);
+      // alpha_m near alpha_s + each bin edge, the edges one turn away, and +-pi.
+      for (int k = -n_alpha - 1; k <= 2 * n_alpha + 1; ++k) {
+        const double edge = k * static_cast<double>(step) - M_PI;
+        for (const double target : {alpha_s + edge, alpha_s + edge - 2 * M_PI, static_cast<double>(pi),
+                                    -static_cast<double>(pi), alpha_s + M_PI, alpha_s - M_PI}) {
+          if (target < -pi || target > pi) continue;
+          float a = static_cast<float>(target);
+          for (int u = 0; u < 20; ++u) a = std::nextafter(a, -4.f);
+          for (int u = 0; u < 43; ++u, a = std::nextafter(a, 4.f))
+            if (a >= -pi && a <= pi) alpha_m.push_back(a);
+        }
+      }
+      check(alpha_s);
+    }
+    for (int t = 0; t < 1000; ++t) {
+      alpha_m.resize(1000 + t % 8);
+      for (float& a : alpha_m) a = any(rng);
+      check(any(rng));
+    }
+    EXPECT_EQ(wrong, 0u) << deg << " deg, of " << checked;
+    EXPECT_GT(checked, 1000000u);
   }
 }
 

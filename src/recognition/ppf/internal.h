@@ -28,12 +28,6 @@ struct PairEntry {
   }
 };
 
-// What voting reads of a table entry, in the table's order (8 bytes where
-// PairEntry has 24: the ranges a scene pair looks up stay in cache).
-struct VoteEntry {
-  uint32_t ref;   // model reference point
-  float alpha_m;  // its pair's alpha_m
-};
 
 // The table's key index: for each distinct key its range [begin, end) of
 // the sorted table, in an open-addressing hash (one probe sequence per
@@ -123,7 +117,12 @@ struct Model {
   std::vector<Vec3f> points, normals;
   std::vector<PairFeature> features;
   std::vector<PairEntry> table;  // empty: nothing to match
-  std::vector<VoteEntry> votes;   // table[e]'s ref and alpha_m, for every e
+  // What voting reads of table[e], in the table's order and in two arrays
+  // (8 bytes an entry where PairEntry has 24, so the ranges a scene pair
+  // looks up stay in cache; eight of each load at once): its reference
+  // point and its alpha_m.
+  std::vector<uint32_t> vote_ref;
+  std::vector<float> vote_alpha;
   KeyIndex index;                 // over table
   float angle_step = 0, distance_step = 0, diameter = 0;
 };
@@ -188,6 +187,36 @@ class AlphaBins {
   int n_;
   std::vector<float> first_;  // first_[k]: the smallest float of bin k; first_[0] -inf, first_[n] +inf
   float scale_ = 0;
+};
+
+// alpha = alpha_m - alpha_s brought into [-pi, pi] (PCL's wrap: one turn
+// added below -pi, else one taken above pi).
+inline float wrapped_alpha(float alpha_m, float alpha_s) {
+  float alpha = alpha_m - alpha_s;
+  if (alpha < -M_PI) alpha += static_cast<float>(2 * M_PI);
+  else if (alpha > M_PI) alpha -= static_cast<float>(2 * M_PI);
+  return alpha;
+}
+
+// The accumulator cells of one scene pair's votes without neighbouring
+// bins: for each of the n model pairs, cells[k] = ref[k] * n_alpha +
+// bins(wrapped_alpha(alpha_m[k], alpha_s)). The same bits on every CPU:
+// eight pairs at a time where it has AVX2 (the bin from its formula,
+// AlphaBins::exact, in double as PCL's; the last block masked), else one at
+// a time with AlphaBins.
+class VoteCells {
+ public:
+  VoteCells(float angle_step, int n_alpha);
+  void operator()(const uint32_t* ref, const float* alpha_m, size_t n, float alpha_s, uint32_t* cells) const;
+  // The one-at-a-time path alone (tests: the reference of the AVX2 one).
+  void plain(const uint32_t* ref, const float* alpha_m, size_t n, float alpha_s, uint32_t* cells) const;
+  int n_alpha() const { return n_alpha_; }
+
+ private:
+  float step_;
+  int n_alpha_;
+  AlphaBins bins_;
+  bool avx2_;
 };
 
 // How a scene pair votes (PpfSettings::neighbour_margin, vote_once).

@@ -216,7 +216,8 @@ class PpfMethod : public Method {
   // key (then by pair, so equal keys come in a fixed order).
   void build_search() {
     m_.table.clear();
-    m_.votes.clear();
+    m_.vote_ref.clear();
+    m_.vote_alpha.clear();
     const size_t n = m_.points.size();
     if (n < 3 || m_.features.size() != n * n) return;
     m_.table.reserve(m_.features.size());
@@ -230,8 +231,12 @@ class PpfMethod : public Method {
                             static_cast<uint32_t>(i), static_cast<uint32_t>(j), f.alpha_m});
       }
     std::sort(m_.table.begin(), m_.table.end());
-    m_.votes.resize(m_.table.size());
-    for (size_t e = 0; e < m_.table.size(); ++e) m_.votes[e] = {m_.table[e].ref, m_.table[e].alpha_m};
+    m_.vote_ref.resize(m_.table.size());
+    m_.vote_alpha.resize(m_.table.size());
+    for (size_t e = 0; e < m_.table.size(); ++e) {
+      m_.vote_ref[e] = m_.table[e].ref;
+      m_.vote_alpha[e] = m_.table[e].alpha_m;
+    }
     m_.index.build(m_.table);
   }
 

@@ -213,41 +213,31 @@ namespace {
 // reference starts from zero without clearing, and a vote needs no branch.
 // The best cell is kept as votes arrive: the most votes, the lowest cell
 // among equals (the first maximum in cell order, as a scan of the
-// accumulator finds it, since counts only grow).
+// accumulator finds it, since counts only grow), as one maximum of
+// (count, ~cell) packed in 64 bits.
 class Accumulator {
  public:
   explicit Accumulator(size_t cells) : cells_(cells, 0) {}
   void next_reference() {
     ++gen_;
+    stamp_ = static_cast<uint64_t>(gen_) << 32;
     best_ = 0;
-    best_cell_ = 0;
   }
   void add(uint32_t cell) {
     const uint64_t v = cells_[cell];
-    const uint64_t stamp = static_cast<uint64_t>(gen_) << 32;
-    const uint64_t nv = (v >> 32) == gen_ ? v + 1 : stamp + 1;
+    const uint64_t nv = (v >> 32) == gen_ ? v + 1 : stamp_ + 1;
     cells_[cell] = nv;
-    const uint32_t c = static_cast<uint32_t>(nv);
-    const bool better = c > best_ || (c == best_ && cell < best_cell_);
-    best_ = better ? c : best_;
-    best_cell_ = better ? cell : best_cell_;
+    best_ = std::max(best_, (nv << 32) | static_cast<uint32_t>(~cell));
   }
-  uint32_t best() const { return best_; }  // 0: no vote since next_reference()
-  uint32_t best_cell() const { return best_cell_; }
+  uint32_t best() const { return static_cast<uint32_t>(best_ >> 32); }  // 0: no vote since next_reference()
+  uint32_t best_cell() const { return ~static_cast<uint32_t>(best_); }
 
  private:
   std::vector<uint64_t> cells_;
   uint32_t gen_ = 0;
-  uint32_t best_ = 0, best_cell_ = 0;
+  uint64_t stamp_ = 0;
+  uint64_t best_ = 0;  // (count << 32) | ~cell of the best cell
 };
-
-// alpha = alpha_m - alpha_s brought into [-pi, pi] (PCL's wrap).
-inline float wrapped_alpha(float alpha_m, float alpha_s) {
-  float alpha = alpha_m - alpha_s;
-  if (alpha < -M_PI) alpha += static_cast<float>(2 * M_PI);
-  else if (alpha > M_PI) alpha -= static_cast<float>(2 * M_PI);
-  return alpha;
-}
 
 // The votes of one scene pair's model pairs [begin, end) with neighbouring
 // alpha bins (margin > 0): PCL's bin value, its fraction decides the
@@ -255,13 +245,12 @@ inline float wrapped_alpha(float alpha_m, float alpha_s) {
 void vote_with_margin(const Model& m, uint32_t begin, uint32_t end, float alpha_s, int n_alpha, float margin,
                       Accumulator& acc) {
   for (uint32_t e = begin; e < end; ++e) {
-    const VoteEntry& it = m.votes[e];
-    const float alpha = wrapped_alpha(it.alpha_m, alpha_s);
+    const float alpha = wrapped_alpha(m.vote_alpha[e], alpha_s);
     if (!std::isfinite(alpha)) continue;
     const float b = alpha_bin_value(alpha, m.angle_step);
     const float floored = std::floor(b);
     const int bin = std::max(0, std::min(n_alpha - 1, static_cast<int>(floored)));
-    const uint32_t cell = it.ref * static_cast<uint32_t>(n_alpha);
+    const uint32_t cell = m.vote_ref[e] * static_cast<uint32_t>(n_alpha);
     acc.add(cell + static_cast<uint32_t>(bin));
     const float frac = b - floored;  // the neighbouring alpha bin (alpha wraps around)
     if (frac < margin) acc.add(cell + static_cast<uint32_t>((bin + n_alpha - 1) % n_alpha));
@@ -306,8 +295,10 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
   const KdTree3 tree(scene.points);
   const size_t n_model = m.points.size();
   const int n_alpha = std::max(1, static_cast<int>(std::floor(2 * M_PI / m.angle_step)));
-  const AlphaBins bins(m.angle_step, n_alpha);
+  const VoteCells vote_cells(m.angle_step, n_alpha);
   Accumulator acc(n_model * static_cast<size_t>(n_alpha));
+  constexpr uint32_t kChunk = 256;  // cells computed at a time
+  uint32_t cells[kChunk];
   std::vector<PoseVote> poses;
   std::vector<int> nn;
   VoteFlags flags;
@@ -337,12 +328,20 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
         keys[0] = pack_key(atan2_bin(y0, x0, step[0]), feature_bin(f[1], step[1]), feature_bin(f[2], step[2]),
                            feature_bin(f[3], step[3]));
       }
-      const float alpha_s = pcl_alpha(T_sg, scene.points[static_cast<size_t>(i)]);
-      if (!std::isfinite(alpha_s)) continue;
-      const int alpha_s_bin = static_cast<int>(std::floor((alpha_s + M_PI) / m.angle_step));
+      // alpha_s once a key is in the table (a pair whose keys all miss
+      // casts no vote, whatever its alpha_s).
+      float alpha_s = 0;
+      int alpha_s_bin = 0;
+      bool have_alpha_s = false;
       for (int k = 0; k < n_keys; ++k) {
         const auto [begin, end] = m.index.find(keys[k]);
         if (begin == end) continue;
+        if (!have_alpha_s) {
+          alpha_s = pcl_alpha(T_sg, scene.points[static_cast<size_t>(i)]);
+          if (!std::isfinite(alpha_s)) break;
+          alpha_s_bin = static_cast<int>(std::floor((alpha_s + M_PI) / m.angle_step));
+          have_alpha_s = true;
+        }
         if (opt.vote_once && !flags.first(keys[k], alpha_s_bin)) continue;
         if (opt.margin > 0) {
           vote_with_margin(m, begin, end, alpha_s, n_alpha, opt.margin, acc);
@@ -350,10 +349,10 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
         }
         // alpha_m and alpha_s are finite (the table holds finite ones), so
         // alpha is.
-        for (uint32_t e = begin; e < end; ++e) {
-          const VoteEntry& it = m.votes[e];
-          acc.add(it.ref * static_cast<uint32_t>(n_alpha) +
-                  static_cast<uint32_t>(bins(wrapped_alpha(it.alpha_m, alpha_s))));
+        for (uint32_t e = begin; e < end; e += kChunk) {
+          const uint32_t n = std::min(kChunk, end - e);
+          vote_cells(m.vote_ref.data() + e, m.vote_alpha.data() + e, n, alpha_s, cells);
+          for (uint32_t k = 0; k < n; ++k) acc.add(cells[k]);
         }
       }
     }
