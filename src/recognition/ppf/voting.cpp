@@ -303,7 +303,19 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
   std::vector<int> nn;
   VoteFlags flags;
   const float step[4] = {m.angle_step, m.angle_step, m.angle_step, m.distance_step};
-  uint64_t keys[16];
+  // One reference's pairs in three passes, so that the table's memory is
+  // asked for ahead of its use (on a real frame the key index and the
+  // table's ranges are beyond the caches): the keys of every pair, their
+  // ranges in the index (its slots prefetched kSlotsAhead keys ahead), then
+  // the votes (each range's first entries prefetched kRangesAhead keys
+  // ahead). Pairs and keys keep their order, so the votes and the flags are
+  // those of one pass.
+  constexpr size_t kSlotsAhead = 16, kRangesAhead = 8;
+  std::vector<int> pair_point;                    // the pair's second point
+  std::vector<uint32_t> pair_keys_end;            // its keys end here in keys
+  std::vector<uint64_t> keys;
+  std::vector<std::pair<uint32_t, uint32_t>> ranges;  // keys[q]'s range in the table
+  uint64_t pair_keys[16];
   for (int r : refs) {
     const Vec3f sr = scene.points[r], nr = scene.normals[r];
     if (!sr.allFinite() || !nr.allFinite()) continue;
@@ -311,6 +323,9 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
     tree.radius_unsorted(sr, m.diameter, nn);  // votes add up: the neighbour order does not matter
     acc.next_reference();
     flags.next_reference();
+    pair_point.clear();
+    pair_keys_end.clear();
+    keys.clear();
     for (int i : nn) {
       if (i == r) continue;
       float f[4], y0, x0;
@@ -323,26 +338,46 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
       int n_keys = 1;
       if (opt.margin > 0) {  // the bins' fractions count: the angle itself
         f[0] = std::atan2(y0, x0);
-        n_keys = neighbour_keys(f, step, opt.margin, keys);
+        n_keys = neighbour_keys(f, step, opt.margin, pair_keys);
       } else {  // its bin alone (neighbour_keys with no margin)
-        keys[0] = pack_key(atan2_bin(y0, x0, step[0]), feature_bin(f[1], step[1]), feature_bin(f[2], step[2]),
-                           feature_bin(f[3], step[3]));
+        pair_keys[0] = pack_key(atan2_bin(y0, x0, step[0]), feature_bin(f[1], step[1]), feature_bin(f[2], step[2]),
+                                feature_bin(f[3], step[3]));
       }
+      pair_point.push_back(i);
+      keys.insert(keys.end(), pair_keys, pair_keys + n_keys);
+      pair_keys_end.push_back(static_cast<uint32_t>(keys.size()));
+    }
+    ranges.resize(keys.size());
+    for (size_t q = 0; q < keys.size(); ++q) {
+      if (q + kSlotsAhead < keys.size()) m.index.prefetch(keys[q + kSlotsAhead]);
+      ranges[q] = m.index.find(keys[q]);
+    }
+    size_t q = 0;
+    for (size_t p = 0; p < pair_point.size(); ++p) {
+      const size_t i = static_cast<size_t>(pair_point[p]);
       // alpha_s once a key is in the table (a pair whose keys all miss
       // casts no vote, whatever its alpha_s).
       float alpha_s = 0;
       int alpha_s_bin = 0;
       bool have_alpha_s = false;
-      for (int k = 0; k < n_keys; ++k) {
-        const auto [begin, end] = m.index.find(keys[k]);
+      for (; q < pair_keys_end[p]; ++q) {
+        if (q + kRangesAhead < ranges.size()) {
+          const uint32_t ahead = ranges[q + kRangesAhead].first;
+          __builtin_prefetch(m.vote_ref.data() + ahead);
+          __builtin_prefetch(m.vote_alpha.data() + ahead);
+        }
+        const auto [begin, end] = ranges[q];
         if (begin == end) continue;
         if (!have_alpha_s) {
-          alpha_s = pcl_alpha(T_sg, scene.points[static_cast<size_t>(i)]);
-          if (!std::isfinite(alpha_s)) break;
+          alpha_s = pcl_alpha(T_sg, scene.points[i]);
+          if (!std::isfinite(alpha_s)) {
+            q = pair_keys_end[p];
+            break;
+          }
           alpha_s_bin = static_cast<int>(std::floor((alpha_s + M_PI) / m.angle_step));
           have_alpha_s = true;
         }
-        if (opt.vote_once && !flags.first(keys[k], alpha_s_bin)) continue;
+        if (opt.vote_once && !flags.first(keys[q], alpha_s_bin)) continue;
         if (opt.margin > 0) {
           vote_with_margin(m, begin, end, alpha_s, n_alpha, opt.margin, acc);
           continue;
@@ -352,7 +387,7 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
         for (uint32_t e = begin; e < end; e += kChunk) {
           const uint32_t n = std::min(kChunk, end - e);
           vote_cells(m.vote_ref.data() + e, m.vote_alpha.data() + e, n, alpha_s, cells);
-          for (uint32_t k = 0; k < n; ++k) acc.add(cells[k]);
+          for (uint32_t c = 0; c < n; ++c) acc.add(cells[c]);
         }
       }
     }
