@@ -138,8 +138,8 @@ TEST(GlobalEsf, SmallCloudsHaveTheHistogramsOfTracingEveryLine) {
 
 // A3's bin from the table of bin edges equals the formula (acos): every
 // float within 3000 ulps of each rounding edge (|cos| = cos((k + 1/2) / 63 x
-// 90 deg)), two million random ones in [0, 1], and the ends, values above 1,
-// infinity and NaN.
+// 90 deg)) and of each 1/1024th of [0, 1] (the lookup's cells), two million
+// random ones in [0, 1], and the ends, values above 1, infinity and NaN.
 TEST(GlobalEsf, AngleBinTableEqualsTheFormula) {
   size_t wrong = 0, checked = 0;
   auto check = [&](float c) {
@@ -151,6 +151,11 @@ TEST(GlobalEsf, AngleBinTableEqualsTheFormula) {
     float c = static_cast<float>(std::cos((k + 0.5) / (kEsfBinsPerHistogram - 1) * M_PI / 2));
     for (int u = 0; u < 3000; ++u) c = std::nextafter(c, -1.f);
     for (int u = 0; u < 6000; ++u, c = std::nextafter(c, 2.f)) check(c);
+  }
+  for (int j = 0; j <= 1024; ++j) {  // around the lookup's cell boundaries j / 1024
+    float c = static_cast<float>(j) / 1024;
+    for (int u = 0; u < 50; ++u) c = std::nextafter(c, -1.f);
+    for (int u = 0; u < 100; ++u, c = std::nextafter(c, 2.f)) check(c);
   }
   Rng rng(5);
   for (int i = 0; i < 2000000; ++i) check(static_cast<float>(rng.uniform()));

@@ -182,6 +182,10 @@ class PairTraces {
 // exactly when it lies below edge k: six comparisons instead of acos.
 // Checked once over every float from 0 to 1 (session 24, results/bench/
 // README.md): the table and the formula agree on all 1,065,353,217.
+// A |cos| in [0, 1] starts from the lowest bin of its 1/1024th of [0, 1]
+// (the bin of that interval's largest float) and steps up while it lies
+// below the next edge: the same bin as the bisection, in one or two steps
+// but near 1, where the bins crowd.
 class AngleBins {
  public:
   AngleBins() {
@@ -205,8 +209,19 @@ class AngleBins {
       }
       edge_[k] = from_bits(hi);
     }
+    for (int j = 0; j <= kCells; ++j)  // the largest float of cell j: below (j + 1) / kCells, or 1
+      start_[static_cast<size_t>(j)] = static_cast<uint8_t>(
+          bisected(j == kCells ? 1.f : std::nextafter(static_cast<float>(j + 1) / kCells, 0.f)));
   }
   int operator()(float abs_cos) const {
+    if (!(abs_cos >= 0.f && abs_cos <= 1.f)) return bisected(abs_cos);
+    // abs_cos * kCells is exact (a power of two), so its floor is the cell.
+    int b = start_[static_cast<size_t>(abs_cos * static_cast<float>(kCells))];
+    while (abs_cos < edge_[static_cast<size_t>(b) + 1]) ++b;
+    return b;
+  }
+  // The bin by bisection over the edges (NaN: the formula's).
+  int bisected(float abs_cos) const {
     if (std::isnan(abs_cos)) return esf_angle_bin_formula(abs_cos);
     int lo = 0, hi = kB;  // abs_cos < edge_[lo], not < edge_[hi]
     while (hi - lo > 1) {
@@ -217,7 +232,9 @@ class AngleBins {
   }
 
  private:
+  static constexpr int kCells = 1024;
   std::array<float, kB + 1> edge_{};
+  std::array<uint8_t, kCells + 1> start_{};  // the lowest bin of each cell
 };
 
 }  // namespace
