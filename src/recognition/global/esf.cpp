@@ -237,15 +237,18 @@ class AngleBins {
   std::array<uint8_t, kCells + 1> start_{};  // the lowest bin of each cell
 };
 
-}  // namespace
-
-int esf_unit_bin(double v) {
+// esf_unit_bin, inline for compute_esf's histogram loops.
+inline int unit_bin(double v) {
   const double x = v * (kB - 1);
   // std::lround without its call (core/round.h); NaN and values far outside
   // [0, 1] take the call.
   const long r = std::abs(x) < 1e9 ? static_cast<long>(round_half_away(x)) : std::lround(x);
   return std::clamp(static_cast<int>(r), 0, kB - 1);
 }
+
+}  // namespace
+
+int esf_unit_bin(double v) { return unit_bin(v); }
 
 int esf_angle_bin_formula(float abs_cos) {
   const double c = std::clamp(static_cast<double>(abs_cos), 0.0, 1.0);
@@ -298,8 +301,11 @@ std::vector<float> compute_esf(const std::vector<Vec3f>& points_in, Rng& rng, in
   d2_cls.reserve(3 * static_cast<size_t>(samples));
   d3.reserve(samples);
   d3_cls.reserve(samples);
-  std::array<std::array<double, kB>, 3> a3{};
-  std::array<double, kB> ratio{};
+  // Counts in integers, turned into PCL's double sums at the end: A3 adds
+  // line lengths / 32 (sums of multiples of 1/32, exact in double, so equal
+  // to the integer sum / 32), the others add 1.
+  std::array<std::array<int64_t, kB>, 3> a3_len{};
+  std::array<int64_t, kB> ratio_n{};
 
   const long long max_draws = 50LL * samples;
   PairTraces traced(grid, vox, 3LL * samples);
@@ -330,7 +336,7 @@ std::vector<float> compute_esf(const std::vector<Vec3f>& points_in, Rng& rng, in
     d2.push_back(cc);
     d2_cls.push_back(static_cast<uint8_t>(l23.cls));
     for (const Line* l : {&l12, &l13, &l23})
-      if (l->cls == kMixed) ratio[esf_unit_bin(l->ratio)] += 1;
+      if (l->cls == kMixed) ++ratio_n[static_cast<size_t>(unit_bin(l->ratio))];
 
     const int occ = l12.occupied + l13.occupied + l23.occupied;
     const int cnt = l12.count + l13.count + l23.count;
@@ -342,18 +348,27 @@ std::vector<float> compute_esf(const std::vector<Vec3f>& points_in, Rng& rng, in
     d3.push_back(std::sqrt(std::sqrt(area2)));
     d3_cls.push_back(static_cast<uint8_t>(tri));
     // Each angle weighted by the length (in voxels) of the opposite line.
-    a3[tri][th1] += l23.count / 32.0;
-    a3[tri][th2] += l13.count / 32.0;
-    a3[tri][th3] += l12.count / 32.0;
+    a3_len[tri][static_cast<size_t>(th1)] += l23.count;
+    a3_len[tri][static_cast<size_t>(th2)] += l13.count;
+    a3_len[tri][static_cast<size_t>(th3)] += l12.count;
     ++valid;
   }
   if (valid == 0) return out;
 
   const float max_d2 = *std::max_element(d2.begin(), d2.end());
   const float max_d3 = *std::max_element(d3.begin(), d3.end());
-  std::array<std::array<double, kB>, 3> h2{}, h3{};
-  for (size_t i = 0; i < d2.size(); ++i) h2[d2_cls[i]][esf_unit_bin(d2[i] / max_d2)] += 1;
-  for (size_t i = 0; i < d3.size(); ++i) h3[d3_cls[i]][esf_unit_bin(d3[i] / max_d3)] += 1;
+  std::array<std::array<int64_t, kB>, 3> h2_n{}, h3_n{};
+  for (size_t i = 0; i < d2.size(); ++i) ++h2_n[d2_cls[i]][static_cast<size_t>(unit_bin(d2[i] / max_d2))];
+  for (size_t i = 0; i < d3.size(); ++i) ++h3_n[d3_cls[i]][static_cast<size_t>(unit_bin(d3[i] / max_d3))];
+  std::array<std::array<double, kB>, 3> a3{}, h2{}, h3{};
+  std::array<double, kB> ratio{};
+  for (size_t t = 0; t < 3; ++t)
+    for (size_t j = 0; j < kB; ++j) {
+      a3[t][j] = static_cast<double>(a3_len[t][j]) / 32.0;
+      h2[t][j] = static_cast<double>(h2_n[t][j]);
+      h3[t][j] = static_cast<double>(h3_n[t][j]);
+    }
+  for (size_t j = 0; j < kB; ++j) ratio[j] = static_cast<double>(ratio_n[j]);
 
   // Concatenation and weights as PCL: A3 on/off/mixed, D3 on/off/mixed, D2
   // on/off/mixed, D2 ratio.
