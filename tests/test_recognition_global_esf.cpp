@@ -9,9 +9,11 @@
 #include <limits>
 #include <thread>
 
+#include "core/cpu.h"
 #include "core/hash.h"
 #include "core/random.h"
 #include "recognition/global/esf.h"
+#include "recognition/global/esf_lines.h"
 #include "recognition/global/internal.h"
 
 namespace pb {
@@ -134,6 +136,41 @@ TEST(GlobalEsf, SmallCloudsHaveTheHistogramsOfTracingEveryLine) {
     }
   }
   EXPECT_EQ(hash_hex(bytes), "3fe602dc048ae871");
+}
+
+// A batch of lines traced eight at a time (AVX2) counts the voxels of each
+// as tracing it alone: random grids of every density, lines between random
+// voxels (one voxel long up to corner to corner, 63 steps), in batches of
+// every size mod 8.
+TEST(GlobalEsf, LinesEightAtATimeCountAsOneAtATime) {
+  if (!pb::cpu_has_avx2()) GTEST_SKIP() << "this CPU has no AVX2: lines are traced one at a time only";
+  using esf_detail::OccupancyGrid;
+  Rng rng(17);
+  size_t wrong = 0, checked = 0;
+  for (int g = 0; g < 40; ++g) {
+    OccupancyGrid grid;
+    const int marks = rng.uniform_int(0, 3000);
+    for (int k = 0; k < marks; ++k)
+      grid.mark({rng.uniform_int(0, 63), rng.uniform_int(0, 63), rng.uniform_int(0, 63)});
+    const size_t n = static_cast<size_t>(rng.uniform_int(1, 800));
+    std::vector<Eigen::Vector3i> from(n), to(n);
+    for (size_t k = 0; k < n; ++k) {
+      from[k] = {rng.uniform_int(0, 63), rng.uniform_int(0, 63), rng.uniform_int(0, 63)};
+      const int kind = rng.uniform_int(0, 9);
+      to[k] = kind == 0 ? from[k]  // one voxel
+              : kind == 1 ? Eigen::Vector3i(63 - from[k].x(), 63 - from[k].y(), 63 - from[k].z())
+                          : Eigen::Vector3i(rng.uniform_int(0, 63), rng.uniform_int(0, 63), rng.uniform_int(0, 63));
+    }
+    std::vector<esf_detail::Line> fast(n), plain(n);
+    esf_detail::trace_lines(grid, from.data(), to.data(), n, fast.data());
+    esf_detail::trace_lines(grid, from.data(), to.data(), n, plain.data(), true);
+    for (size_t k = 0; k < n; ++k, ++checked)
+      if ((fast[k].count != plain[k].count || fast[k].occupied != plain[k].occupied || fast[k].cls != plain[k].cls) &&
+          ++wrong <= 3)
+        ADD_FAILURE() << "grid " << g << ", line " << k << ": " << fast[k].occupied << "/" << fast[k].count << " vs "
+                      << plain[k].occupied << "/" << plain[k].count;
+  }
+  EXPECT_EQ(wrong, 0u) << "of " << checked;
 }
 
 // A3's bin from the table of bin edges equals the formula (acos): every

@@ -10,138 +10,22 @@
 #include <limits>
 
 #include "core/round.h"
+#include "recognition/global/esf_lines.h"
 
 namespace pb {
 namespace {
 
-constexpr int kG = kEsfGridSize;
-constexpr int kHalf = kG / 2;
+using esf_detail::classified;
+using esf_detail::Cls;
+using esf_detail::kG;
+using esf_detail::kHalf;
+using esf_detail::kMixed;
+using esf_detail::kOff;
+using esf_detail::kOn;
+using esf_detail::Line;
+using esf_detail::OccupancyGrid;
+using esf_detail::trace;
 constexpr int kB = kEsfBinsPerHistogram;
-
-enum Cls { kOn = 0, kOff = 1, kMixed = 2 };
-
-class OccupancyGrid {
- public:
-  OccupancyGrid() : bits_((static_cast<size_t>(kG) * kG * kG + 63) / 64, 0) {}
-  static int cell(float c) { return std::clamp(static_cast<int>(std::floor(c)) + kHalf, 0, kG - 1); }
-  static Eigen::Vector3i cell(const Vec3f& p) { return {cell(p.x()), cell(p.y()), cell(p.z())}; }
-  // Marks the voxel of p and its 26 neighbours.
-  void mark(const Eigen::Vector3i& v) {
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          const int x = v.x() + dx, y = v.y() + dy, z = v.z() + dz;
-          if (x < 0 || y < 0 || z < 0 || x >= kG || y >= kG || z >= kG) continue;
-          const size_t i = index(x, y, z);
-          bits_[i >> 6] |= uint64_t(1) << (i & 63);
-        }
-  }
-  int occupied(int i) const { return static_cast<int>((bits_[static_cast<size_t>(i) >> 6] >> (i & 63)) & 1); }
-  static int index(int x, int y, int z) { return (x * kG + y) * kG + z; }
-  static int stride(int axis) { return axis == 0 ? kG * kG : (axis == 1 ? kG : 1); }
-
- private:
-  std::vector<uint64_t> bits_;  // one bit per voxel: the whole grid stays in the L1 cache
-};
-
-struct Line {
-  int count = 0;     // voxels visited
-  int occupied = 0;  // of which occupied
-  Cls cls = kOff;
-  float ratio = 0;   // occupied / count (used for MIXED)
-};
-
-// One minor coordinate of the traced line: a + (d i / n rounded to nearest,
-// halves up) for i = 0, 1, ..., that is a + floor((2 d i + n) / (2 n)),
-// exact in integers for negative d too, kept as a remainder 0 <= rem < 2n.
-// |2 d| <= 2 n, so one step moves the coordinate by at most one voxel (by
-// `stride` in the grid index; branch-free, masks from the sign bit). It
-// defines the lines; the tracing reads its moves from MoveTable.
-struct Stepper {
-  int rem, step, den, stride;
-  Stepper(int d, int n, int stride_) : rem(n), step(2 * d), den(2 * n), stride(stride_) {}  // i = 0: n / 2n = 0 rem n
-  int next() {  // the index change of this step
-    rem += step;
-    const int under = rem >> 31;               // -1 when rem < 0
-    const int over = (den - 1 - rem) >> 31;    // -1 when rem >= den
-    rem += (under & den) - (over & den);
-    return (over & stride) - (under & stride);
-  }
-};
-
-// The minor axis moves of a line of n steps whose minor coordinate changes
-// by d in all: bit i set when step i moves it (by the sign of d), as the
-// Stepper takes them. One table for every |d| <= n < kG, built once from
-// the Stepper itself, so a line read from it is the Stepper's line. Per
-// step, a shift and a multiply instead of the Stepper's remainder update
-// (bench_global BM_EsfOurs in alternating runs: results/bench/README.md,
-// eleventh round), the same histograms bit for bit (test
-// GlobalEsf.HistogramsAreThoseOfTheSteppedLineTracing).
-class MoveTable {
- public:
-  MoveTable() {
-    for (int n = 1; n < kG; ++n)
-      for (int d = -n; d <= n; ++d) {
-        Stepper s(d, n, 1);
-        uint64_t m = 0;
-        for (int i = 0; i < n; ++i)
-          if (s.next() != 0) m |= uint64_t(1) << i;
-        moves_[static_cast<size_t>(n) * (2 * kG + 1) + static_cast<size_t>(d + kG)] = m;
-      }
-  }
-  uint64_t operator()(int d, int n) const {
-    return moves_[static_cast<size_t>(n) * (2 * kG + 1) + static_cast<size_t>(d + kG)];
-  }
-
- private:
-  std::vector<uint64_t> moves_ = std::vector<uint64_t>(static_cast<size_t>(kG) * (2 * kG + 1), 0);
-};
-
-const MoveTable& move_table() {
-  static const MoveTable t;
-  return t;
-}
-
-// A line's class from its counts (ON: all but at most one voxel occupied,
-// OFF: at most 7, else MIXED with its occupied fraction).
-Line classified(int count, int occupied) {
-  Line L;
-  L.count = count;
-  L.occupied = occupied;
-  if (occupied >= count - 1) {
-    L.cls = kOn;
-  } else if (occupied <= 7) {
-    L.cls = kOff;
-  } else {
-    L.cls = kMixed;
-    L.ratio = static_cast<float>(occupied) / static_cast<float>(count);
-  }
-  return L;
-}
-
-// Traces the line from voxel a toward voxel b: max(|d|) voxels (at least
-// one), a included, b excluded, the minor axes rounded to nearest. The major
-// axis moves one voxel per step; the two others as their move masks say.
-Line trace(const OccupancyGrid& g, const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
-  const Eigen::Vector3i d = b - a;
-  const Eigen::Vector3i ad = d.cwiseAbs();
-  const int n = std::max({ad.x(), ad.y(), ad.z()});
-  int idx = OccupancyGrid::index(a.x(), a.y(), a.z());
-  if (n == 0) return classified(1, g.occupied(idx) ? 1 : 0);
-  const int major = ad.x() == n ? 0 : (ad.y() == n ? 1 : 2);
-  const int m1 = major == 0 ? 1 : 0, m2 = major == 2 ? 1 : 2;
-  const int major_step = (d[major] > 0 ? 1 : -1) * OccupancyGrid::stride(major);
-  const MoveTable& t = move_table();
-  const uint64_t moves1 = t(d[m1], n), moves2 = t(d[m2], n);
-  const int step1 = (d[m1] > 0 ? 1 : -1) * OccupancyGrid::stride(m1);
-  const int step2 = (d[m2] > 0 ? 1 : -1) * OccupancyGrid::stride(m2);
-  int occupied = 0;
-  for (int i = 0; i < n; ++i) {
-    occupied += g.occupied(idx);
-    idx += major_step + static_cast<int>((moves1 >> i) & 1) * step1 + static_cast<int>((moves2 >> i) & 1) * step2;
-  }
-  return classified(n, occupied);
-}
 
 // The traces of ordered point pairs (i, j), from point i's voxel toward
 // point j's. A trace depends on the two voxels alone, and `samples` triples
@@ -159,17 +43,19 @@ class PairTraces {
     static_assert(kG <= 256, "a count and an occupied count fit a byte each");
     if (static_cast<long long>(n_) * static_cast<long long>(n_ - 1) <= traces) memo_.assign(n_ * n_, 0);
   }
+  bool memoized() const { return !memo_.empty(); }
   Line operator()(int i, int j) {
-    if (memo_.empty()) return trace(g_, vox_[static_cast<size_t>(i)], vox_[static_cast<size_t>(j)]);
+    if (memo_.empty()) return trace(g_, t_, vox_[static_cast<size_t>(i)], vox_[static_cast<size_t>(j)]);
     uint16_t& m = memo_[static_cast<size_t>(i) * n_ + static_cast<size_t>(j)];
     if (m != 0) return classified(m >> 8, m & 0xff);
-    const Line L = trace(g_, vox_[static_cast<size_t>(i)], vox_[static_cast<size_t>(j)]);
+    const Line L = trace(g_, t_, vox_[static_cast<size_t>(i)], vox_[static_cast<size_t>(j)]);
     m = static_cast<uint16_t>(L.count << 8 | L.occupied);
     return L;
   }
 
  private:
   const OccupancyGrid& g_;
+  const esf_detail::MoveTable& t_ = esf_detail::move_table();
   const std::vector<Eigen::Vector3i>& vox_;
   size_t n_;
   std::vector<uint16_t> memo_;
@@ -264,6 +150,61 @@ const AngleBins& angle_bins() {
 
 int esf_angle_bin(float abs_cos) { return angle_bins()(abs_cos); }
 
+namespace {
+
+// A valid triple: its points, their distances |p1p2|, |p1p3|, |p2p3|, the
+// squared area, the angle bins at p1, p2, p3.
+struct Triple {
+  int i[3];
+  float d[3];
+  float area2;
+  int th[3];
+};
+
+// What the valid triples add up to: per triple three D2 values with their
+// classes, one D3 value with its class; A3 and the D2 ratio are binned
+// directly. Counts in integers, turned into PCL's double sums at the end:
+// A3 adds line lengths / 32 (sums of multiples of 1/32, exact in double, so
+// equal to the integer sum / 32), the others add 1.
+struct Samples {
+  explicit Samples(int samples) {
+    d2.reserve(3 * static_cast<size_t>(samples));
+    d2_cls.reserve(3 * static_cast<size_t>(samples));
+    d3.reserve(static_cast<size_t>(samples));
+    d3_cls.reserve(static_cast<size_t>(samples));
+  }
+  // The triple with its lines 1->2, 1->3, 2->3.
+  void add(const Triple& t, const Line& l12, const Line& l13, const Line& l23) {
+    d2.push_back(t.d[0]);
+    d2_cls.push_back(static_cast<uint8_t>(l12.cls));
+    d2.push_back(t.d[1]);
+    d2_cls.push_back(static_cast<uint8_t>(l13.cls));
+    d2.push_back(t.d[2]);
+    d2_cls.push_back(static_cast<uint8_t>(l23.cls));
+    for (const Line* l : {&l12, &l13, &l23})
+      if (l->cls == kMixed) ++ratio_n[static_cast<size_t>(unit_bin(l->ratio))];
+    const int occ = l12.occupied + l13.occupied + l23.occupied;
+    const int cnt = l12.count + l13.count + l23.count;
+    Cls tri = kMixed;
+    if (occ <= 21)
+      tri = kOff;
+    else if (cnt - occ < 4)
+      tri = kOn;
+    d3.push_back(std::sqrt(std::sqrt(t.area2)));
+    d3_cls.push_back(static_cast<uint8_t>(tri));
+    // Each angle weighted by the length (in voxels) of the opposite line.
+    a3_len[tri][static_cast<size_t>(t.th[0])] += l23.count;
+    a3_len[tri][static_cast<size_t>(t.th[1])] += l13.count;
+    a3_len[tri][static_cast<size_t>(t.th[2])] += l12.count;
+  }
+  std::vector<float> d2, d3;
+  std::vector<uint8_t> d2_cls, d3_cls;
+  std::array<std::array<int64_t, kB>, 3> a3_len{};
+  std::array<int64_t, kB> ratio_n{};
+};
+
+}  // namespace
+
 std::vector<float> compute_esf(const std::vector<Vec3f>& points_in, Rng& rng, int samples) {
   std::vector<float> out(kEsfBins, 0.f);
   const AngleBins& angle_bin = angle_bins();
@@ -291,69 +232,75 @@ std::vector<float> compute_esf(const std::vector<Vec3f>& points_in, Rng& rng, in
     grid.mark(vox[i]);
   }
 
-  // Per valid triple: three D2 values with their classes, one D3 value with
-  // its class; A3 and the D2 ratio are binned directly.
-  std::vector<float> d2;
-  std::vector<uint8_t> d2_cls;
-  std::vector<float> d3;
-  std::vector<uint8_t> d3_cls;
-  d2.reserve(3 * static_cast<size_t>(samples));
-  d2_cls.reserve(3 * static_cast<size_t>(samples));
-  d3.reserve(samples);
-  d3_cls.reserve(samples);
-  // Counts in integers, turned into PCL's double sums at the end: A3 adds
-  // line lengths / 32 (sums of multiples of 1/32, exact in double, so equal
-  // to the integer sum / 32), the others add 1.
-  std::array<std::array<int64_t, kB>, 3> a3_len{};
-  std::array<int64_t, kB> ratio_n{};
-
+  Samples acc(samples);
   const long long max_draws = 50LL * samples;
   PairTraces traced(grid, vox, 3LL * samples);
-  int valid = 0;
-  for (long long draw = 0; valid < samples && draw < max_draws; ++draw) {
-    const int i1 = rng.uniform_int(0, n - 1);
-    const int i2 = rng.uniform_int(0, n - 1);
-    const int i3 = rng.uniform_int(0, n - 1);
-    if (i1 == i2 || i1 == i3 || i2 == i3) continue;
-    const Vec3f v21 = q[i2] - q[i1], v31 = q[i3] - q[i1], v23 = q[i2] - q[i3];
+  // The next draw: false when it is no valid triple (a repeated point, or
+  // no area).
+  const auto draw_triple = [&](Triple& t) {
+    t.i[0] = rng.uniform_int(0, n - 1);
+    t.i[1] = rng.uniform_int(0, n - 1);
+    t.i[2] = rng.uniform_int(0, n - 1);
+    if (t.i[0] == t.i[1] || t.i[0] == t.i[2] || t.i[1] == t.i[2]) return false;
+    const Vec3f p1 = q[t.i[0]], p2 = q[t.i[1]], p3 = q[t.i[2]];
+    const Vec3f v21 = p2 - p1, v31 = p3 - p1, v23 = p2 - p3;
     const float a = v21.norm(), b = v31.norm(), cc = v23.norm();
     const float s = 0.5f * (a + b + cc);
-    const float area2 = s * (s - a) * (s - b) * (s - cc);  // Heron: squared area
-    if (!(area2 > 0.001f)) continue;
-
-    // Angles at p1 (between 1->2 and 1->3), at p3 and at p2.
-    const int th1 = angle_bin(std::abs(v21.dot(v31)) / (a * b));
-    const int th3 = angle_bin(std::abs(v23.dot(v31)) / (cc * b));
-    const int th2 = angle_bin(std::abs(v23.dot(v21)) / (cc * a));
-
-    const Line l12 = traced(i1, i2);
-    const Line l13 = traced(i1, i3);
-    const Line l23 = traced(i2, i3);
-    d2.push_back(a);
-    d2_cls.push_back(static_cast<uint8_t>(l12.cls));
-    d2.push_back(b);
-    d2_cls.push_back(static_cast<uint8_t>(l13.cls));
-    d2.push_back(cc);
-    d2_cls.push_back(static_cast<uint8_t>(l23.cls));
-    for (const Line* l : {&l12, &l13, &l23})
-      if (l->cls == kMixed) ++ratio_n[static_cast<size_t>(unit_bin(l->ratio))];
-
-    const int occ = l12.occupied + l13.occupied + l23.occupied;
-    const int cnt = l12.count + l13.count + l23.count;
-    Cls tri = kMixed;
-    if (occ <= 21)
-      tri = kOff;
-    else if (cnt - occ < 4)
-      tri = kOn;
-    d3.push_back(std::sqrt(std::sqrt(area2)));
-    d3_cls.push_back(static_cast<uint8_t>(tri));
-    // Each angle weighted by the length (in voxels) of the opposite line.
-    a3_len[tri][static_cast<size_t>(th1)] += l23.count;
-    a3_len[tri][static_cast<size_t>(th2)] += l13.count;
-    a3_len[tri][static_cast<size_t>(th3)] += l12.count;
-    ++valid;
+    t.area2 = s * (s - a) * (s - b) * (s - cc);  // Heron: squared area
+    if (!(t.area2 > 0.001f)) return false;
+    t.d[0] = a;
+    t.d[1] = b;
+    t.d[2] = cc;
+    // Angles at p1 (between 1->2 and 1->3), at p2 and at p3.
+    t.th[0] = angle_bin(std::abs(v21.dot(v31)) / (a * b));
+    t.th[1] = angle_bin(std::abs(v23.dot(v21)) / (cc * a));
+    t.th[2] = angle_bin(std::abs(v23.dot(v31)) / (cc * b));
+    return true;
+  };
+  int valid = 0;
+  long long draw = 0;
+  if (traced.memoized()) {  // small clouds: each triple's lines looked up (or traced once) as it comes
+    for (; valid < samples && draw < max_draws; ++draw) {
+      Triple t;
+      if (!draw_triple(t)) continue;
+      acc.add(t, traced(t.i[0], t.i[1]), traced(t.i[0], t.i[2]), traced(t.i[1], t.i[2]));
+      ++valid;
+    }
+  }
+  // Otherwise valid triples in batches whose lines are traced together (the
+  // draws and their order are those of one triple at a time: a batch holds
+  // at most the triples still wanted, so no draw is made that the
+  // triple-by-triple loop would not make).
+  constexpr int kBatch = 256;
+  std::vector<Triple> batch;
+  std::vector<Eigen::Vector3i> from, to;
+  std::vector<Line> lines;
+  while (valid < samples && draw < max_draws) {
+    batch.clear();
+    const int want = std::min(kBatch, samples - valid);
+    for (Triple t; static_cast<int>(batch.size()) < want && draw < max_draws; ++draw)
+      if (draw_triple(t)) batch.push_back(t);
+    // Each triple's lines 1->2, 1->3, 2->3.
+    from.resize(3 * batch.size());
+    to.resize(3 * batch.size());
+    lines.resize(3 * batch.size());
+    for (size_t k = 0; k < batch.size(); ++k) {
+      const int* i = batch[k].i;
+      from[3 * k] = vox[static_cast<size_t>(i[0])], to[3 * k] = vox[static_cast<size_t>(i[1])];
+      from[3 * k + 1] = vox[static_cast<size_t>(i[0])], to[3 * k + 1] = vox[static_cast<size_t>(i[2])];
+      from[3 * k + 2] = vox[static_cast<size_t>(i[1])], to[3 * k + 2] = vox[static_cast<size_t>(i[2])];
+    }
+    esf_detail::trace_lines(grid, from.data(), to.data(), lines.size(), lines.data());
+    for (size_t k = 0; k < batch.size(); ++k) acc.add(batch[k], lines[3 * k], lines[3 * k + 1], lines[3 * k + 2]);
+    valid += static_cast<int>(batch.size());
   }
   if (valid == 0) return out;
+  const auto& d2 = acc.d2;
+  const auto& d3 = acc.d3;
+  const auto& d2_cls = acc.d2_cls;
+  const auto& d3_cls = acc.d3_cls;
+  const auto& a3_len = acc.a3_len;
+  const auto& ratio_n = acc.ratio_n;
 
   const float max_d2 = *std::max_element(d2.begin(), d2.end());
   const float max_d3 = *std::max_element(d3.begin(), d3.end());
