@@ -197,6 +197,41 @@ struct Samples {
     a3_len[tri][static_cast<size_t>(t.th[1])] += l13.count;
     a3_len[tri][static_cast<size_t>(t.th[2])] += l12.count;
   }
+  // PCL's histogram of the triples so far (at least one) into out (640
+  // values), normalized to sum 1 (left as is when the sum is not positive).
+  void histogram(std::vector<float>& out) const {
+    const float max_d2 = *std::max_element(d2.begin(), d2.end());
+    const float max_d3 = *std::max_element(d3.begin(), d3.end());
+    std::array<std::array<int64_t, kB>, 3> h2_n{}, h3_n{};
+    for (size_t i = 0; i < d2.size(); ++i) ++h2_n[d2_cls[i]][static_cast<size_t>(unit_bin(d2[i] / max_d2))];
+    for (size_t i = 0; i < d3.size(); ++i) ++h3_n[d3_cls[i]][static_cast<size_t>(unit_bin(d3[i] / max_d3))];
+    std::array<std::array<double, kB>, 3> a3{}, h2{}, h3{};
+    std::array<double, kB> ratio{};
+    for (size_t t = 0; t < 3; ++t)
+      for (size_t j = 0; j < kB; ++j) {
+        a3[t][j] = static_cast<double>(a3_len[t][j]) / 32.0;
+        h2[t][j] = static_cast<double>(h2_n[t][j]);
+        h3[t][j] = static_cast<double>(h3_n[t][j]);
+      }
+    for (size_t j = 0; j < kB; ++j) ratio[j] = static_cast<double>(ratio_n[j]);
+
+    // Concatenation and weights as PCL: A3 on/off/mixed, D3 on/off/mixed, D2
+    // on/off/mixed, D2 ratio.
+    const std::array<const std::array<double, kB>*, 10> parts = {&a3[kOn], &a3[kOff], &a3[kMixed], &h3[kOn],
+                                                                 &h3[kOff], &h3[kMixed], &h2[kOn], &h2[kOff],
+                                                                 &h2[kMixed], &ratio};
+    const std::array<double, 10> weights = {0.5, 0.5, 0.5, 0.5, 0.5, 1.0, 0.5, 2.0, 2.0, 1.0};
+    std::array<double, kEsfBins> h{};
+    double sum = 0;
+    for (int k = 0; k < 10; ++k)
+      for (int j = 0; j < kB; ++j) {
+        h[k * kB + j] = (*parts[k])[j] * weights[k];
+        sum += h[k * kB + j];
+      }
+    if (!(sum > 0)) return;
+    for (int i = 0; i < kEsfBins; ++i) out[static_cast<size_t>(i)] = static_cast<float>(h[static_cast<size_t>(i)] / sum);
+  }
+
   std::vector<float> d2, d3;
   std::vector<uint8_t> d2_cls, d3_cls;
   std::array<std::array<int64_t, kB>, 3> a3_len{};
@@ -294,44 +329,7 @@ std::vector<float> compute_esf(const std::vector<Vec3f>& points_in, Rng& rng, in
     for (size_t k = 0; k < batch.size(); ++k) acc.add(batch[k], lines[3 * k], lines[3 * k + 1], lines[3 * k + 2]);
     valid += static_cast<int>(batch.size());
   }
-  if (valid == 0) return out;
-  const auto& d2 = acc.d2;
-  const auto& d3 = acc.d3;
-  const auto& d2_cls = acc.d2_cls;
-  const auto& d3_cls = acc.d3_cls;
-  const auto& a3_len = acc.a3_len;
-  const auto& ratio_n = acc.ratio_n;
-
-  const float max_d2 = *std::max_element(d2.begin(), d2.end());
-  const float max_d3 = *std::max_element(d3.begin(), d3.end());
-  std::array<std::array<int64_t, kB>, 3> h2_n{}, h3_n{};
-  for (size_t i = 0; i < d2.size(); ++i) ++h2_n[d2_cls[i]][static_cast<size_t>(unit_bin(d2[i] / max_d2))];
-  for (size_t i = 0; i < d3.size(); ++i) ++h3_n[d3_cls[i]][static_cast<size_t>(unit_bin(d3[i] / max_d3))];
-  std::array<std::array<double, kB>, 3> a3{}, h2{}, h3{};
-  std::array<double, kB> ratio{};
-  for (size_t t = 0; t < 3; ++t)
-    for (size_t j = 0; j < kB; ++j) {
-      a3[t][j] = static_cast<double>(a3_len[t][j]) / 32.0;
-      h2[t][j] = static_cast<double>(h2_n[t][j]);
-      h3[t][j] = static_cast<double>(h3_n[t][j]);
-    }
-  for (size_t j = 0; j < kB; ++j) ratio[j] = static_cast<double>(ratio_n[j]);
-
-  // Concatenation and weights as PCL: A3 on/off/mixed, D3 on/off/mixed, D2
-  // on/off/mixed, D2 ratio.
-  const std::array<const std::array<double, kB>*, 10> parts = {&a3[kOn], &a3[kOff], &a3[kMixed], &h3[kOn],
-                                                               &h3[kOff], &h3[kMixed], &h2[kOn], &h2[kOff],
-                                                               &h2[kMixed], &ratio};
-  const std::array<double, 10> weights = {0.5, 0.5, 0.5, 0.5, 0.5, 1.0, 0.5, 2.0, 2.0, 1.0};
-  std::array<double, kEsfBins> h{};
-  double sum = 0;
-  for (int k = 0; k < 10; ++k)
-    for (int j = 0; j < kB; ++j) {
-      h[k * kB + j] = (*parts[k])[j] * weights[k];
-      sum += h[k * kB + j];
-    }
-  if (!(sum > 0)) return out;
-  for (int i = 0; i < kEsfBins; ++i) out[i] = static_cast<float>(h[i] / sum);
+  if (valid > 0) acc.histogram(out);
   return out;
 }
 
