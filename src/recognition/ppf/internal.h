@@ -28,19 +28,18 @@ struct PairEntry {
   }
 };
 
-
 // The table's key index: for each distinct key its range [begin, end) of
 // the sorted table, in an open-addressing hash (one probe sequence per
 // scene pair instead of a binary search over the whole table).
 class KeyIndex {
  public:
   void build(const std::vector<PairEntry>& table);
-  // The range of `key` (begin == end when absent).
   // Asks for the cache line of `key`'s first slot (a hint: no effect on
   // any result).
   void prefetch(uint64_t key) const {
     if (!keys_.empty()) __builtin_prefetch(keys_.data() + home(key));
   }
+  // The range of `key` (begin == end when absent).
   std::pair<uint32_t, uint32_t> find(uint64_t key) const {
     if (keys_.empty()) return {0, 0};
     size_t i = home(key);
@@ -215,7 +214,6 @@ class VoteCells {
   void operator()(const uint32_t* ref, const float* alpha_m, size_t n, float alpha_s, uint32_t* cells) const;
   // The one-at-a-time path alone (tests: the reference of the AVX2 one).
   void plain(const uint32_t* ref, const float* alpha_m, size_t n, float alpha_s, uint32_t* cells) const;
-  int n_alpha() const { return n_alpha_; }
 
  private:
   float step_;
