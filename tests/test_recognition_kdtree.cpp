@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include "core/random.h"
 #include "recognition/kdtree.h"
@@ -130,6 +131,27 @@ TEST(KdTree3, LongNeighbourhoodsAreSortedByDistanceThenIndex) {
       tree.within(q, max2, got);
       EXPECT_EQ(got, want);
     }
+  }
+}
+
+// sort_entries (FPFH's thinned supports) orders as std::sort: random lists
+// of every length from 0 to 3000 (short ones by std::sort, long ones by
+// buckets), with equal distances, zeros and one distance for all.
+TEST(KdTree3, SortEntriesEqualsStdSort) {
+  std::mt19937 rng(23);
+  for (int t = 0; t < 300; ++t) {
+    const size_t n = static_cast<size_t>(t < 200 ? t : 200 + 10 * (t - 200) + static_cast<int>(rng() % 7));
+    std::uniform_real_distribution<float> d(0.f, t % 3 == 0 ? 4.f : 2500.f);
+    std::vector<std::pair<float, int>> entries(n);
+    for (size_t k = 0; k < n; ++k) {
+      const int kind = static_cast<int>(rng() % 10);
+      const float v = t % 50 == 7 ? 9.f : kind == 0 ? 0.f : kind == 1 ? std::floor(d(rng)) : d(rng);
+      entries[k] = {v, static_cast<int>(rng() % 100000)};
+    }
+    std::vector<std::pair<float, int>> want = entries;
+    std::sort(want.begin(), want.end());
+    pb::KdTree3::sort_entries(entries);
+    ASSERT_EQ(entries, want) << "list " << t << " of " << n;
   }
 }
 

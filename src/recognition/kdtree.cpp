@@ -254,6 +254,22 @@ void KdTree3::within(const Vec3f& q, float max_sq_dist, std::vector<std::pair<fl
   }
 }
 
+void KdTree3::sort_entries(std::vector<std::pair<float, int>>& entries) {
+  thread_local std::vector<uint64_t> keys;
+  keys.clear();
+  for (const auto& [d, i] : entries) {
+    uint32_t bits;
+    std::memcpy(&bits, &d, sizeof bits);
+    keys.push_back((static_cast<uint64_t>(bits) << 32) | static_cast<uint32_t>(i));
+  }
+  sort_keys(keys);
+  for (size_t k = 0; k < keys.size(); ++k) {
+    const uint32_t bits = static_cast<uint32_t>(keys[k] >> 32);
+    std::memcpy(&entries[k].first, &bits, sizeof bits);
+    entries[k].second = static_cast<int>(keys[k] & 0xffffffffu);
+  }
+}
+
 void KdTree3::radius_unsorted(const Vec3f& q, float r, std::vector<int>& out) const {
   out.clear();
   if (nodes_.empty() || !q.allFinite() || !(r > 0)) return;

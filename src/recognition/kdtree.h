@@ -46,6 +46,10 @@ class KdTree3 {
   size_t within_thinned(const Vec3f& q, float max_sq_dist, int max_points, std::vector<std::pair<float, int>>& out,
                         Thinning how = Thinning::automatic) const;
   size_t size() const { return points_.size(); }
+  // Sorts (squared distance, index) entries as std::sort does (distance,
+  // then index), where every distance is a non-negative float and every
+  // index non-negative (what within() lists): as 64-bit keys, as within().
+  static void sort_entries(std::vector<std::pair<float, int>>& entries);
 
  private:
   struct Node {

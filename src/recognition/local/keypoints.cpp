@@ -43,7 +43,7 @@ size_t CloudNeighbours::within(const Vec3f& q, float r2, std::vector<std::pair<f
   if (thin) {
     found = tree_.within_thinned(q, r2, max_points, out);  // keep_evenly of the tree-order list
     // (squared distance, tree index) pairs order as the kd-tree's sorted keys
-    if (sorted) std::sort(out.begin(), out.end());
+    if (sorted) KdTree3::sort_entries(out);
   } else {
     tree_.within(q, r2, out, sorted);
     found = out.size();
