@@ -135,8 +135,9 @@ TEST(KdTree3, LongNeighbourhoodsAreSortedByDistanceThenIndex) {
 }
 
 // sort_entries (FPFH's thinned supports) orders as std::sort: random lists
-// of every length from 0 to 3000 (short ones by std::sort, long ones by
-// buckets), with equal distances, zeros and one distance for all.
+// of every length from 0 to 199 and of about 200 to 1200 (short ones by
+// std::sort, long ones by buckets), with equal distances, zeros and one
+// distance for all.
 TEST(KdTree3, SortEntriesEqualsStdSort) {
   std::mt19937 rng(23);
   for (int t = 0; t < 300; ++t) {
