@@ -175,16 +175,26 @@ namespace {
 // (FPFH's supports of up to 256: table FPFH's hypothesize stage 27.1 ->
 // 25.7 ms against std::sort from 512 on; from 24 on, no further gain;
 // results/bench/README.md, twenty-fourth round).
+// A (squared distance, index) entry as one 64-bit key: a squared distance
+// is a non-negative float, whose bits order as the values do, so the key
+// order is the pair order (one integer compare instead of two float ones).
+inline uint64_t entry_key(float d, int i) {
+  uint32_t bits;
+  std::memcpy(&bits, &d, sizeof bits);
+  return (static_cast<uint64_t>(bits) << 32) | static_cast<uint32_t>(i);
+}
+inline std::pair<float, int> entry_of(uint64_t k) {
+  const uint32_t bits = static_cast<uint32_t>(k >> 32);
+  float d;
+  std::memcpy(&d, &bits, sizeof d);
+  return {d, static_cast<int>(k & 0xffffffffu)};
+}
+
 void sort_keys(std::vector<uint64_t>& keys) {
   constexpr size_t kBucketFrom = 64;
   constexpr size_t kInsertionUpTo = 16;  // a bucket this short: insertion sort
   const size_t n = keys.size();
-  const auto dist = [](uint64_t k) {
-    const uint32_t bits = static_cast<uint32_t>(k >> 32);
-    float d;
-    std::memcpy(&d, &bits, sizeof d);
-    return d;
-  };
+  const auto dist = [](uint64_t k) { return entry_of(k).first; };
   float dmax = 0;
   if (n >= kBucketFrom)
     for (uint64_t k : keys) dmax = std::max(dmax, dist(k));
@@ -234,43 +244,24 @@ void KdTree3::within(const Vec3f& q, float max_sq_dist, std::vector<std::pair<fl
     visit_radius(0, q, max_sq_dist, add);
     return;
   }
-  // Sorted by (distance, index) as one 64-bit key each: a squared distance
-  // is a non-negative float, whose bits order as the values do, so the key
-  // order is the pair order (one integer compare instead of two float ones).
+  // Sorted by (distance, index) as one 64-bit key each (entry_key).
   thread_local std::vector<uint64_t> keys;
   keys.clear();
   auto add = [max_sq_dist](float d, int i) {
-    if (d < max_sq_dist) {
-      uint32_t bits;
-      std::memcpy(&bits, &d, sizeof bits);
-      keys.push_back((static_cast<uint64_t>(bits) << 32) | static_cast<uint32_t>(i));
-    }
+    if (d < max_sq_dist) keys.push_back(entry_key(d, i));
   };
   visit_radius(0, q, max_sq_dist, add);
   sort_keys(keys);
   out.reserve(keys.size());
-  for (uint64_t k : keys) {
-    const uint32_t bits = static_cast<uint32_t>(k >> 32);
-    float d;
-    std::memcpy(&d, &bits, sizeof d);
-    out.emplace_back(d, static_cast<int>(k & 0xffffffffu));
-  }
+  for (uint64_t k : keys) out.push_back(entry_of(k));
 }
 
 void KdTree3::sort_entries(std::vector<std::pair<float, int>>& entries) {
   thread_local std::vector<uint64_t> keys;
   keys.clear();
-  for (const auto& [d, i] : entries) {
-    uint32_t bits;
-    std::memcpy(&bits, &d, sizeof bits);
-    keys.push_back((static_cast<uint64_t>(bits) << 32) | static_cast<uint32_t>(i));
-  }
+  for (const auto& [d, i] : entries) keys.push_back(entry_key(d, i));
   sort_keys(keys);
-  for (size_t k = 0; k < keys.size(); ++k) {
-    const uint32_t bits = static_cast<uint32_t>(keys[k] >> 32);
-    std::memcpy(&entries[k].first, &bits, sizeof bits);
-    entries[k].second = static_cast<int>(keys[k] & 0xffffffffu);
-  }
+  for (size_t k = 0; k < keys.size(); ++k) entries[k] = entry_of(keys[k]);
 }
 
 void KdTree3::radius_unsorted(const Vec3f& q, float r, std::vector<int>& out) const {

@@ -133,14 +133,13 @@ RefineResult refine_pose(const std::string& method, const PointSet& model, const
   // Fitness: mean squared distance (mm^2) of the model points to their
   // nearest cropped scene point, over pairs within max_correspondence_mm.
   {
-    const KdTree3& tree = tgt_tree;
     double sum = 0;
     size_t n = 0;
     const double lim = max_corr * max_corr;
     for (const auto& x : model.points) {
       const Vec3f q = ((res.T_cam_model * x.cast<double>() - c) * 1e-3).cast<float>();
       float d2 = 0;
-      if (tree.nearest(q, &d2) < 0) continue;
+      if (tgt_tree.nearest(q, &d2) < 0) continue;
       const double dmm2 = static_cast<double>(d2) * 1e6;
       if (dmm2 <= lim) {
         sum += dmm2;
