@@ -94,7 +94,7 @@ void BM_Normals(benchmark::State& st) {
   const PointSet ps = voxel_downsample(cut(f), {f.s.voxel_mm});
   for (auto _ : st) {
     PointSet c = ps;
-    detail::estimate_normals(c, f.s.normal_radius_mm);
+    radius_normals(c, f.s.normal_radius_mm);
     benchmark::DoNotOptimize(c.normals.data());
   }
   st.counters["points"] = static_cast<double>(ps.size());

@@ -307,7 +307,7 @@ TEST(Normals, PlaneAndSphereNormalsAreExactAndFaceTheViewpoint) {
   for (int x = -20; x <= 20; ++x)
     for (int y = -20; y <= 20; ++y) plane.points.emplace_back(5.f * x, 5.f * y, 600.f + 0.5f * x);
   plane.points.emplace_back(0.f, 0.f, 0.f);  // isolated: no neighbours within the radius
-  pb::detail::estimate_normals(plane, 12.0);
+  pb::radius_normals(plane, 12.0);
   ASSERT_EQ(plane.size(), 41u * 41u);
   const Vec3f n_true = Vec3f(0.5f, 0, -5.f).normalized();  // facing the origin (negative z)
   for (size_t i = 0; i < plane.size(); ++i) {
@@ -321,7 +321,7 @@ TEST(Normals, PlaneAndSphereNormalsAreExactAndFaceTheViewpoint) {
     const pb::Vec3 d = pb::Vec3(rng.normal(), rng.normal(), rng.normal()).normalized();
     if (d.z() < -0.3) sphere.points.push_back(c + (d * 100).cast<float>());  // a cap facing the camera
   }
-  pb::detail::estimate_normals(sphere, 15.0);
+  pb::radius_normals(sphere, 15.0);
   for (size_t i = 0; i < sphere.size(); ++i) {
     const Vec3f radial = (sphere.points[i] - c).normalized();
     if (radial.z() > -0.5f) continue;  // away from the cap's rim (one-sided neighbourhoods)

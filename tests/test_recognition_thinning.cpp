@@ -117,8 +117,8 @@ TEST(ThinningNormals, ACappedNeighbourhoodGivesNearlyTheSameNormal) {
                                 4.f * y + static_cast<float>(rng.uniform(-1, 1)),
                                 800.f + 0.3f * x + static_cast<float>(rng.normal(0, 0.5)));
   PointSet full = plane, thin = plane;
-  detail::estimate_normals(full, 22.0, 0);
-  detail::estimate_normals(thin, 22.0, 16);
+  radius_normals(full, 22.0, 0);
+  radius_normals(thin, 22.0, 16);
   ASSERT_EQ(full.size(), thin.size());
   size_t close = 0, differ = 0;
   for (size_t i = 0; i < full.size(); ++i) {
@@ -128,7 +128,7 @@ TEST(ThinningNormals, ACappedNeighbourhoodGivesNearlyTheSameNormal) {
   EXPECT_GT(differ, full.size() / 2) << "the cap must bind here";
   EXPECT_GE(close, full.size() * 99 / 100);
   PointSet same = plane;
-  detail::estimate_normals(same, 22.0, 100000);
+  radius_normals(same, 22.0, 100000);
   EXPECT_EQ(same.normals, full.normals);
 }
 
@@ -156,8 +156,8 @@ TEST(ThinningNormals, ACoarseSupportIsAsCloseToTheTrueNormal) {
     cluster.points.emplace_back(static_cast<float>(rng.uniform(-15, 15)), static_cast<float>(rng.uniform(-15, 15)),
                                 2000.f);
   PointSet thin = cluster, coarse = cluster;
-  detail::estimate_normals(thin, 180.0, 64);
-  detail::estimate_normals(coarse, 180.0, 64, 40.0);
+  radius_normals(thin, 180.0, 64);
+  radius_normals(coarse, 180.0, 64, 40.0);
   ASSERT_EQ(thin.size(), cluster.size());
   ASSERT_EQ(coarse.size(), cluster.size()) << "every point keeps a normal, the isolated patch's included";
   size_t differ = 0;  // the coarse support must serve here, not the fallback to the points

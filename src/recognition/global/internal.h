@@ -1,7 +1,7 @@
 // Internal pieces of the global pipeline (CVFH, ESF, CESF, OUR-CVFH, CRH),
-// shared by the src/recognition/global_*.cpp files. PCL-free: PCL stays in
-// the .cpp files (global_clusters.cpp, global_cvfh.cpp, global_ourcvfh.cpp,
-// global_crh.cpp), so global_method.cpp compiles without PCL.
+// shared by the src/recognition/global/*.cpp files. PCL-free: PCL stays in
+// the .cpp files that use it (clusters.cpp, cvfh_pcl.cpp, ourcvfh.cpp,
+// crh.cpp, esf_pcl.cpp), so the others compile without PCL.
 #pragma once
 
 #include <cstdint>
@@ -61,10 +61,30 @@ struct Region {
 };
 std::vector<Region> stable_regions(const PointSet& cloud, const GlobalSettings& s);
 
-// --- global_cvfh.cpp (PCL) ---
-// pcl::CVFHEstimation: one 308-bin histogram per stable region (or one VFH of
-// the whole cloud if there is none), with its region's centroid and axis.
+// --- cvfh.cpp ---
+// CVFH as pcl::CVFHEstimation: one 308-bin histogram per stable region (or
+// one VFH of the whole cloud if there is none), with its region's centroid
+// and axis.
 std::vector<Signature> cvfh_signatures(const PointSet& cloud, const GlobalSettings& s);
+// The VFH (308 bins: f1, f2, f3, distance in 45 each, viewpoint in 128) of
+// `points` with their `normals`, seen from `centroid` with `normal`; the
+// camera at the origin.
+std::vector<float> vfh_histogram(const std::vector<Vec3f>& points, const std::vector<Vec3f>& normals,
+                                 const Vec3f& centroid, const Vec3f& normal, bool normalize_bins);
+// --- cvfh_pcl.cpp (PCL) ---
+// pcl::CVFHEstimation itself: the reference of cvfh_signatures (tests and
+// benchmarks only).
+std::vector<Signature> cvfh_signatures_pcl(const PointSet& cloud, const GlobalSettings& s);
+// The stable regions as pcl::CVFHEstimation grows them (pcl::NormalEstimation,
+// its region growing skipping the first neighbour each search returns),
+// with the region growing's search `sorted` or not (PCL's CVFH: not, so the
+// first neighbour it skips is not always the seed): the reference of
+// stable_regions, which equals it sorted.
+std::vector<Region> stable_regions_pcl(const PointSet& cloud, const GlobalSettings& s, bool sorted);
+// pcl::VFHEstimation with the given centroid and normal: the reference of
+// vfh_histogram.
+std::vector<float> vfh_histogram_pcl(const std::vector<Vec3f>& points, const std::vector<Vec3f>& normals,
+                                     const Vec3f& centroid, const Vec3f& normal, bool normalize_bins);
 
 // --- global_ourcvfh.cpp (PCL) ---
 // pcl::OURCVFHEstimation (run in metres: PCL hard-codes a 1 cm sigma): one

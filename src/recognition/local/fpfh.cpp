@@ -12,11 +12,10 @@
 //     on dense clouds, but moved estimates and turned one bench-pipeline
 //     warehouse image wrong, 3121 inliers for a wrong pose against 3100 for
 //     the right one: kept in PCL's order).
-// Differences from PCL, all at rounding level: the source point of a pair is
-// chosen by comparing |cos| instead of the arccos of each, and the dot
-// products are summed over three coordinates instead of four.
+// Differences from PCL, all at rounding level: those of the pair features
+// (recognition/darboux.h).
 // A pair of needed points whose two directions give bit-identical features
-// is computed once (pair_features' `symmetric`). Each keypoint's
+// is computed once (darboux_pair's `symmetric`). Each keypoint's
 // neighbourhood is searched once and serves three times: to find the points
 // that need an SPFH, as its own SPFH's list when it needs one, and for its
 // weighted sum (before: three searches). Each row depends on its own
@@ -32,6 +31,7 @@
 #include <limits>
 
 #include "core/atan2_bin.h"
+#include "recognition/darboux.h"
 #include "recognition/local/internal.h"
 
 namespace pb::local {
@@ -39,40 +39,6 @@ namespace pb::local {
 namespace {
 
 constexpr int kBins = 11;  // per angle
-
-// The pair features of (p1, n1) and (p2, n2): false when the points coincide
-// or the frame is degenerate. The source is the point whose normal is closer
-// to the line between them (smaller angle: larger |cos|). *symmetric: the
-// call (p2, p1) gives bit-identical features (and the same return value):
-// both cosines finite and of different magnitude, so both calls pick the
-// same source point and compute the same frame from exactly negated inputs.
-// f1 = atan2(*f1_y, *f1_x): its arguments, binned by count_pair.
-bool pair_features(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2, float* f1_y, float* f1_x,
-                   float& f2, float& f3, bool* symmetric) {
-  Vec3f d = p2 - p1;
-  const float dist = d.norm();
-  *symmetric = false;
-  if (dist == 0.f) return false;
-  const float c1 = n1.dot(d) / dist, c2 = n2.dot(d) / dist;
-  *symmetric = std::isfinite(c1) && std::isfinite(c2) && std::abs(c1) != std::abs(c2);
-  Vec3f u = n1, target = n2;
-  f3 = c1;
-  if (std::abs(c1) < std::abs(c2)) {
-    u = n2;
-    target = n1;
-    d = -d;
-    f3 = -c2;
-  }
-  Vec3f v = d.cross(u);
-  const float vn = v.norm();
-  if (vn == 0.f) return false;
-  v /= vn;
-  const Vec3f w = u.cross(v);
-  f2 = v.dot(target);
-  *f1_y = w.dot(target);
-  *f1_x = u.dot(target);
-  return true;
-}
 
 // Bin of x (PCL's: floor in double, clamped; a NaN lands in bin 0 as PCL's
 // clamped conversion does on x86).
@@ -111,7 +77,7 @@ inline void count_pair(float f1_y, float f1_x, float f2, float f3, uint32_t* c) 
 // warehouse bench's FPFH description 646 instead of about 420 ms: with 256
 // of 2300 neighbours kept few pairs are mutual). Among the other needed
 // points each pair is computed once, by the lower index, and counted for
-// both when symmetric (pair_features), else each point computes its own.
+// both when symmetric (darboux_pair), else each point computes its own.
 // Counts are integers, so their sum over threads does not depend on the
 // order; every addition to a bin of point p adds the same 100 / (pairs of
 // p), so the float histogram is that value added count times, as PCL's loop
@@ -207,12 +173,12 @@ std::vector<Hist> spfh_histograms(const PointSet& cloud, const CloudNeighbours& 
         if (qrow >= 0 && q < p) continue;  // counted from q
         float f1_y, f1_x, f2, f3;
         bool symmetric = false;
-        if (pair_features(pts[p], cloud.normals[p], pts[q], cloud.normals[q], &f1_y, &f1_x, f2, f3, &symmetric)) {
+        if (darboux_pair(pts[p], cloud.normals[p], pts[q], cloud.normals[q], &f1_y, &f1_x, f2, f3, &symmetric)) {
           count_pair(f1_y, f1_x, f2, f3, mine[r].data());
           if (qrow >= 0 && symmetric) count_pair(f1_y, f1_x, f2, f3, mine[static_cast<size_t>(qrow)].data());
         }
         if (qrow >= 0 && !symmetric &&
-            pair_features(pts[q], cloud.normals[q], pts[p], cloud.normals[p], &f1_y, &f1_x, f2, f3, &symmetric))
+            darboux_pair(pts[q], cloud.normals[q], pts[p], cloud.normals[p], &f1_y, &f1_x, f2, f3, &symmetric))
           count_pair(f1_y, f1_x, f2, f3, mine[static_cast<size_t>(qrow)].data());
       }
     }

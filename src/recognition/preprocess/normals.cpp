@@ -12,10 +12,11 @@
 
 #include "recognition/kdtree.h"
 #include "recognition/preprocess/internal.h"
+#include "recognition/preprocess/preprocess.h"
 #include "recognition/preprocess/voxel_grid.h"
 #include "recognition/scatter.h"
 
-namespace pb::detail {
+namespace pb {
 
 namespace {
 
@@ -52,7 +53,7 @@ bool pca_normal(const std::vector<Vec3f>& pts, const std::vector<int>& nb, Vec3f
 
 }  // namespace
 
-void estimate_normals(PointSet& ps, double radius_mm, int max_points, double support_leaf_mm) {
+void radius_normals(PointSet& ps, double radius_mm, int max_points, double support_leaf_mm) {
   ps.normals.clear();
   ps.curvature.clear();
   if (ps.points.empty()) return;
@@ -121,7 +122,7 @@ void estimate_normals(PointSet& ps, double radius_mm, int max_points, double sup
   }
   size_t kept = 0;
   for (char c : keep) kept += c;
-  if (kept != ps.points.size()) ps = select(ps, keep);
+  if (kept != ps.points.size()) ps = detail::select(ps, keep);
 }
 
-}  // namespace pb::detail
+}  // namespace pb

@@ -324,7 +324,7 @@ PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings&
       ps = detail::select(ps, keep);
     }
   }
-  detail::estimate_normals(ps, s.normal_radius_mm, s.normal_max_points, s.normal_support_leaf_mm());
+  radius_normals(ps, s.normal_radius_mm, s.normal_max_points, s.normal_support_leaf_mm());
   return ps;
 }
 
@@ -333,7 +333,7 @@ PointSet preprocess_view(const OrganizedCloud& cloud, const PreprocessSettings& 
   // settings chose: no range cut, no plane.
   PointSet ps = range_cut(cloud, 0.0, std::numeric_limits<double>::infinity());
   ps = voxel_downsample(ps, {s.voxel_mm});
-  detail::estimate_normals(ps, s.normal_radius_mm, s.normal_max_points, s.normal_support_leaf_mm());
+  radius_normals(ps, s.normal_radius_mm, s.normal_max_points, s.normal_support_leaf_mm());
   return ps;
 }
 

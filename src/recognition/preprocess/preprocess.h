@@ -78,6 +78,21 @@ struct PreprocessSettings {
   double normal_support_leaf_mm() const;
 };
 
+// Normals by PCA of the neighbours within `radius_mm` (the point included, as
+// pcl::NormalEstimation; the project's kd-tree, OpenMP threads per
+// omp_get_max_threads(), the same result for any count), flipped toward the
+// viewpoint (origin), and the surface variation as curvature. Points whose
+// normal cannot be estimated (fewer than 3 neighbours) are dropped, with
+// their pixel. max_points > 0: a neighbourhood of more points is thinned
+// evenly in tree order to that many (keep_evenly, kdtree.h).
+// support_leaf_mm > 0: a point's neighbours are instead the centroids of the
+// cloud voxelized at that leaf (a coarse support, built once) within
+// `radius_mm`, thinned the same way; a point with fewer than
+// max_points / 4 of them (a sparse region, where the fine neighbourhood
+// would hardly need thinning) takes the fine neighbourhood as above.
+// Preprocessing and CVFH's stable regions (global/regions.cpp) share it.
+void radius_normals(PointSet& cloud, double radius_mm, int max_points = 0, double support_leaf_mm = 0);
+
 // Scene preprocessing. Every random choice (RANSAC) draws from `seed`.
 PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings& s, uint64_t seed);
 // Training view preprocessing: no plane removal (the model is alone).
