@@ -37,7 +37,8 @@ inline int clamped_bin(double scaled, int bins) {
 }  // namespace
 
 std::vector<float> vfh_histogram(const std::vector<Vec3f>& points, const std::vector<Vec3f>& normals,
-                                 const Vec3f& centroid, const Vec3f& normal, bool normalize_bins) {
+                                 const Vec3f& centroid, const Vec3f& normal, bool normalize_bins,
+                                 bool size_component) {
   std::vector<float> h(kVfhDim, 0.f);
   const size_t n = points.size();
   if (n == 0) return h;
@@ -63,7 +64,8 @@ std::vector<float> vfh_histogram(const std::vector<Vec3f>& points, const std::ve
     h[static_cast<size_t>(binned_atan2(f1_y, f1_x, angle_bin))] += incr;
     h[static_cast<size_t>(kShapeBins + angle_bin(f2))] += incr;
     h[static_cast<size_t>(2 * kShapeBins + angle_bin(f3))] += incr;
-    h[static_cast<size_t>(3 * kShapeBins + clamped_bin(kShapeBins * (f4 / dist_norm), kShapeBins))] += incr;
+    if (size_component)
+      h[static_cast<size_t>(3 * kShapeBins + clamped_bin(kShapeBins * (f4 / dist_norm), kShapeBins))] += incr;
   }
   // The viewpoint component: the camera at the origin.
   const Vec3f to_camera = (-centroid).normalized();

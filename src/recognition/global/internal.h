@@ -54,6 +54,7 @@ std::vector<std::vector<int>> euclidean_clusters_pcl(const std::vector<Vec3f>& p
 // whose normals differ by less than cvfh_eps_angle_deg; regions of at least
 // cvfh_min_region_points points are kept.
 struct Region {
+  std::vector<int> indices;            // of the points in the input cloud, ascending
   std::vector<Vec3f> points;
   std::vector<Vec3f> normals;          // the recomputed normals of the points
   Vec3f centroid = Vec3f::Zero();
@@ -68,9 +69,11 @@ std::vector<Region> stable_regions(const PointSet& cloud, const GlobalSettings& 
 std::vector<Signature> cvfh_signatures(const PointSet& cloud, const GlobalSettings& s);
 // The VFH (308 bins: f1, f2, f3, distance in 45 each, viewpoint in 128) of
 // `points` with their `normals`, seen from `centroid` with `normal`; the
-// camera at the origin.
+// camera at the origin. size_component false: the distance bins stay 0
+// (OUR-CVFH's VFH, whose distance part its shape distribution replaces).
 std::vector<float> vfh_histogram(const std::vector<Vec3f>& points, const std::vector<Vec3f>& normals,
-                                 const Vec3f& centroid, const Vec3f& normal, bool normalize_bins);
+                                 const Vec3f& centroid, const Vec3f& normal, bool normalize_bins,
+                                 bool size_component = true);
 // --- cvfh_pcl.cpp (PCL) ---
 // pcl::CVFHEstimation itself: the reference of cvfh_signatures (tests and
 // benchmarks only).
@@ -86,14 +89,18 @@ std::vector<Region> stable_regions_pcl(const PointSet& cloud, const GlobalSettin
 std::vector<float> vfh_histogram_pcl(const std::vector<Vec3f>& points, const std::vector<Vec3f>& normals,
                                      const Vec3f& centroid, const Vec3f& normal, bool normalize_bins);
 
-// --- global_ourcvfh.cpp (PCL) ---
-// pcl::OURCVFHEstimation (run in metres: PCL hard-codes a 1 cm sigma): one
+// --- ourcvfh.cpp (PCL) ---
+// OUR-CVFH: the stable regions and VFH above, pcl::OURCVFHEstimation's
+// frames and shape distribution (run in metres: PCL hard-codes a 1 cm sigma): one
 // histogram per reference frame (several per region when the axes are
 // ambiguous, PCL issue 737); frames returned in mm. Guards the inputs PCL
 // crashes on (issues 1449, 1491): fewer points than cvfh_min_region_points,
 // non-finite normals. Signatures without a valid frame fall back to the CRH
 // path (has_rf = false).
 std::vector<Signature> ourcvfh_signatures(const PointSet& cloud, const GlobalSettings& s);
+// pcl::OURCVFHEstimation itself, unguarded: the reference of
+// ourcvfh_signatures (tests only).
+std::vector<Signature> ourcvfh_signatures_pcl(const PointSet& cloud, const GlobalSettings& s);
 
 // --- global_crh.cpp (PCL) ---
 // Rotation taking the unit vector `axis` to +z (the shortest arc).

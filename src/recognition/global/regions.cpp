@@ -32,6 +32,7 @@ std::vector<Region> stable_regions(const PointSet& cloud, const GlobalSettings& 
     if (!cloud.points[i].allFinite()) continue;
     if (has_c && !(cloud.curvature[i] <= s.cvfh_curvature_threshold)) continue;
     filtered.points.push_back(cloud.points[i]);
+    filtered.pixel.push_back(static_cast<int>(i));  // the input index, kept through radius_normals
   }
   if (filtered.size() < min_pts) return regions;
   // Normals recomputed on the remaining points, toward the camera (origin);
@@ -67,6 +68,7 @@ std::vector<Region> stable_regions(const PointSet& cloud, const GlobalSettings& 
     Region r;
     Eigen::Vector3d c = Eigen::Vector3d::Zero(), nsum = Eigen::Vector3d::Zero();
     for (const int k : queue) {
+      r.indices.push_back(filtered.pixel[static_cast<size_t>(k)]);
       r.points.push_back(pts[static_cast<size_t>(k)]);
       r.normals.push_back(nrm[static_cast<size_t>(k)]);
       c += pts[static_cast<size_t>(k)].cast<double>();
