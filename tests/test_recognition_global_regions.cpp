@@ -21,6 +21,7 @@ TEST(GlobalRegions, StableRegionsArePclsGrownOnASortedSearch) {
   // CVFH builds the tree unsorted and so skips some other neighbour: there
   // a region loses the points no other seed reaches (1 or 2 of 20-63 here).
   RecognitionSettings s;
+  s.global.cvfh_normal_max_points = 0;  // every neighbour, as PCL
   for (const double elevation : {30.0, 60.0}) {
     const PointSet view = preprocess_view(
         render_cloud(asymmetric_object(), camera_pose(30, elevation, 0, 700), synthetic_camera(), 1.0, 1),
@@ -48,6 +49,7 @@ TEST(GlobalRegions, CvfhMatchesPclCvfh) {
   // within 3 mm, axes within 0.2 degrees and at most 8% of the histogram's
   // mass in other bins; every signature holds five counts per point.
   RecognitionSettings s;
+  s.global.cvfh_normal_max_points = 0;  // every neighbour, as PCL
   for (const double elevation : {30.0, 60.0}) {
     const PointSet view = preprocess_view(
         render_cloud(asymmetric_object(), camera_pose(30, elevation, 0, 700), synthetic_camera(), 1.0, 1),
@@ -80,6 +82,7 @@ TEST(GlobalRegions, OurCvfhMatchesPclOurCvfh) {
   // regions lose the points its unsorted search skips), at most 8% of the
   // histogram's mass in other bins.
   RecognitionSettings s;
+  s.global.cvfh_normal_max_points = 0;  // every neighbour, as PCL
   for (const double elevation : {30.0, 60.0}) {
     const PointSet view = preprocess_view(
         render_cloud(asymmetric_object(), camera_pose(30, elevation, 0, 700), synthetic_camera(), 1.0, 1),
@@ -100,6 +103,37 @@ TEST(GlobalRegions, OurCvfhMatchesPclOurCvfh) {
       }
       EXPECT_GT(total, 0);
       EXPECT_LE(moved, 0.08 * total) << elevation << " " << i;
+    }
+  }
+}
+
+TEST(GlobalRegions, CoarseNormalsKeepTheRegionsOfDenseCloudsAndChangeNoSparseOne) {
+  // cvfh_normal_max_points: on a dense view (5 mm voxels, about 40
+  // neighbours in a 20 mm ball) the normals come from the coarse support
+  // and the regions stay those of every neighbour's normals to a few points
+  // (the same count, centroids within 1 mm, mean normals within 1 degree); on
+  // a sparse one (12 mm voxels: under 16 centroids per ball) every point
+  // takes its own neighbours and nothing changes, bit for bit.
+  RecognitionSettings s;
+  GlobalSettings every = s.global;
+  every.cvfh_normal_max_points = 0;
+  for (const double voxel : {5.0, 12.0}) {
+    PreprocessSettings pre = s.preprocess;
+    pre.voxel_mm = voxel;
+    const PointSet view = preprocess_view(
+        render_cloud(asymmetric_object(), camera_pose(30, 45, 0, 700), synthetic_camera(), 1.0, 1), pre, 2);
+    const auto coarse = global::stable_regions(view, s.global);
+    const auto all = global::stable_regions(view, every);
+    ASSERT_GE(all.size(), 2u) << voxel;
+    ASSERT_EQ(coarse.size(), all.size()) << voxel;
+    for (size_t i = 0; i < all.size(); ++i) {
+      if (voxel > 10) {
+        EXPECT_EQ(coarse[i].points, all[i].points) << i;
+        EXPECT_EQ(coarse[i].normals, all[i].normals) << i;
+        continue;
+      }
+      EXPECT_LT((coarse[i].centroid - all[i].centroid).norm(), 1.0) << i;
+      EXPECT_GT(coarse[i].mean_normal.dot(all[i].mean_normal), std::cos(1.0 * M_PI / 180)) << i;
     }
   }
 }

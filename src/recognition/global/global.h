@@ -64,6 +64,14 @@ struct GlobalSettings {
   bool view_ray_axis = false;
   // Added by the global pipeline (PCL's defaults where PCL has the value):
   double cvfh_normal_radius_mm = 20.0;  // normals recomputed on the low-curvature points (CVFH, CESF)
+  int cvfh_normal_max_points = 64;      // those normals from a coarse support, as preprocess's
+                                        // normal_max_points: the low-curvature points voxelized at
+                                        // cvfh_normal_radius_mm x sqrt(pi / this), at most this many
+                                        // of their centroids per ball (thinned evenly); a point with
+                                        // fewer than this / 4 centroids in its ball (a sparse cloud:
+                                        // the tables' 10 mm voxels against 0.1 d) takes its own
+                                        // neighbours, thinned the same way. 0 = every neighbour, as
+                                        // pcl::CVFHEstimation (the releases before)
   bool cvfh_normalize_bins = false;     // CVFH bins count points (thesis, PCL default); true: percentages
   double crh_peak_distance_deg = 10.0;  // distinct CRH peaks are at least this far apart (PCL: 10)
   double ourcvfh_axis_ratio = 0.8;      // OUR-CVFH: axes this similarly hard to disambiguate -> several frames
@@ -92,6 +100,7 @@ struct GlobalSettings {
     f("esf_pose_from_normals", s.esf_pose_from_normals);
     f("view_ray_axis", s.view_ray_axis);
     f("cvfh_normal_radius_mm", s.cvfh_normal_radius_mm, fields::length(fields::positive()));
+    f("cvfh_normal_max_points", s.cvfh_normal_max_points, fields::at_least(0));
     f("cvfh_normalize_bins", s.cvfh_normalize_bins);
     f("crh_peak_distance_deg", s.crh_peak_distance_deg, fields::nonnegative(180, " degrees"));
     f("ourcvfh_axis_ratio", s.ourcvfh_axis_ratio, fields::positive(1));

@@ -1,7 +1,9 @@
 // CVFH's stable regions (pcl::CVFHEstimation's algorithm, PCL-free), for
-// CVFH, CESF and OUR-CVFH's guard: high-curvature points dropped, normals
+// CVFH, CESF and OUR-CVFH: high-curvature points dropped, normals
 // recomputed on the rest (radius_normals: PCA about the first neighbour in
-// double; PCL sums in float about the origin), then smooth region growing
+// double, PCL sums in float about the origin; from a coarse support of at
+// most cvfh_normal_max_points centroids where the cloud is dense, PCL takes
+// every neighbour), then smooth region growing
 // (CVFH's extractEuclideanClustersSmooth): a neighbour closer than the
 // tolerance joins when its normal is within the angle of the normal of the
 // point that reached it. Neighbours come from the project's kd-tree in tree
@@ -38,7 +40,10 @@ std::vector<Region> stable_regions(const PointSet& cloud, const GlobalSettings& 
   // Normals recomputed on the remaining points, toward the camera (origin);
   // a point with fewer than 3 neighbours has none and is dropped (in PCL its
   // NaN normal joins no region and seeds only itself).
-  radius_normals(filtered, s.cvfh_normal_radius_mm);
+  const double leaf = s.cvfh_normal_max_points > 0
+                          ? s.cvfh_normal_radius_mm * std::sqrt(M_PI / s.cvfh_normal_max_points)
+                          : 0.0;
+  radius_normals(filtered, s.cvfh_normal_radius_mm, s.cvfh_normal_max_points, leaf);
   const std::vector<Vec3f>& pts = filtered.points;
   const std::vector<Vec3f>& nrm = filtered.normals;
   const KdTree3 tree(pts);
