@@ -14,18 +14,44 @@ namespace {
 
 using namespace testing_global;
 
+// The asymmetric object alone, seen from 700 mm at `elevation` degrees,
+// preprocessed as a training view.
+PointSet clean_view(double elevation, const PreprocessSettings& pre) {
+  return preprocess_view(
+      render_cloud(asymmetric_object(), camera_pose(30, elevation, 0, 700), synthetic_camera(), 1.0, 1), pre, 2);
+}
+
+// Two histograms' agreement: the reference's total mass and the mass that
+// lies in other bins (the sum of |ours - reference|).
+struct Mass {
+  double total = 0, moved = 0;
+};
+Mass compare(const std::vector<float>& ours, const std::vector<float>& reference) {
+  Mass m;
+  for (size_t b = 0; b < reference.size() && b < ours.size(); ++b) {
+    m.total += reference[b];
+    m.moved += std::abs(ours[b] - reference[b]);
+  }
+  return m;
+}
+
+// The settings of the comparisons with PCL: every neighbour for the
+// regions' normals, as pcl::CVFHEstimation.
+RecognitionSettings as_pcl() {
+  RecognitionSettings s;
+  s.global.cvfh_normal_max_points = 0;
+  return s;
+}
+
 TEST(GlobalRegions, StableRegionsArePclsGrownOnASortedSearch) {
   // Our stable regions are those of pcl::CVFHEstimation's algorithm when its
   // region growing searches a sorted tree (the first neighbour, which it
   // skips, is then the seed): the same points, so the same centroids. PCL's
   // CVFH builds the tree unsorted and so skips some other neighbour: there
   // a region loses the points no other seed reaches (1 or 2 of 20-63 here).
-  RecognitionSettings s;
-  s.global.cvfh_normal_max_points = 0;  // every neighbour, as PCL
+  const RecognitionSettings s = as_pcl();
   for (const double elevation : {30.0, 60.0}) {
-    const PointSet view = preprocess_view(
-        render_cloud(asymmetric_object(), camera_pose(30, elevation, 0, 700), synthetic_camera(), 1.0, 1),
-        s.preprocess, 2);
+    const PointSet view = clean_view(elevation, s.preprocess);
     const auto ours = global::stable_regions(view, s.global);
     const auto sorted = global::stable_regions_pcl(view, s.global, true);
     const auto unsorted = global::stable_regions_pcl(view, s.global, false);
@@ -48,12 +74,9 @@ TEST(GlobalRegions, CvfhMatchesPclCvfh) {
   // but for the points PCL's unsorted search loses (above), so centroids
   // within 3 mm, axes within 0.2 degrees and at most 8% of the histogram's
   // mass in other bins; every signature holds five counts per point.
-  RecognitionSettings s;
-  s.global.cvfh_normal_max_points = 0;  // every neighbour, as PCL
+  const RecognitionSettings s = as_pcl();
   for (const double elevation : {30.0, 60.0}) {
-    const PointSet view = preprocess_view(
-        render_cloud(asymmetric_object(), camera_pose(30, elevation, 0, 700), synthetic_camera(), 1.0, 1),
-        s.preprocess, 2);
+    const PointSet view = clean_view(elevation, s.preprocess);
     const auto regions = global::stable_regions(view, s.global);
     const auto ours = global::cvfh_signatures(view, s.global);
     const auto pcl = global::cvfh_signatures_pcl(view, s.global);
@@ -64,13 +87,10 @@ TEST(GlobalRegions, CvfhMatchesPclCvfh) {
       EXPECT_LT((ours[i].centroid - pcl[i].centroid).norm(), 3.0) << elevation << " " << i;
       EXPECT_LT((ours[i].axis - pcl[i].axis).norm(), 0.0035) << elevation << " " << i;
       ASSERT_EQ(ours[i].hist.size(), 308u);
-      double total = 0, moved = 0;
-      for (size_t b = 0; b < 308; ++b) {
-        total += ours[i].hist[b];
-        moved += std::abs(ours[i].hist[b] - pcl[i].hist[b]);
-      }
-      EXPECT_EQ(total, 5.0 * static_cast<double>(view.size())) << "five counts per point";
-      EXPECT_LE(moved, 0.08 * total) << elevation << " " << i;
+      EXPECT_EQ(compare(pcl[i].hist, ours[i].hist).total, 5.0 * static_cast<double>(view.size()))
+          << "five counts per point";
+      const Mass m = compare(ours[i].hist, pcl[i].hist);
+      EXPECT_LE(m.moved, 0.08 * m.total) << elevation << " " << i;
     }
   }
 }
@@ -81,12 +101,9 @@ TEST(GlobalRegions, OurCvfhMatchesPclOurCvfh) {
   // the same order, frames within 1 degree and centroids within 3 mm (PCL's
   // regions lose the points its unsorted search skips), at most 8% of the
   // histogram's mass in other bins.
-  RecognitionSettings s;
-  s.global.cvfh_normal_max_points = 0;  // every neighbour, as PCL
+  const RecognitionSettings s = as_pcl();
   for (const double elevation : {30.0, 60.0}) {
-    const PointSet view = preprocess_view(
-        render_cloud(asymmetric_object(), camera_pose(30, elevation, 0, 700), synthetic_camera(), 1.0, 1),
-        s.preprocess, 2);
+    const PointSet view = clean_view(elevation, s.preprocess);
     const auto ours = global::ourcvfh_signatures(view, s.global);
     const auto pcl = global::ourcvfh_signatures_pcl(view, s.global);
     ASSERT_GE(ours.size(), 2u) << elevation;
@@ -96,13 +113,9 @@ TEST(GlobalRegions, OurCvfhMatchesPclOurCvfh) {
       EXPECT_LT((ours[i].centroid - pcl[i].centroid).norm(), 3.0) << elevation << " " << i;
       const double angle = Eigen::AngleAxisd(ours[i].T_rf_cam.R * pcl[i].T_rf_cam.R.transpose()).angle();
       EXPECT_LT(angle * 180 / M_PI, 1.0) << elevation << " " << i;
-      double total = 0, moved = 0;
-      for (size_t b = 0; b < 308; ++b) {
-        total += pcl[i].hist[b];
-        moved += std::abs(ours[i].hist[b] - pcl[i].hist[b]);
-      }
-      EXPECT_GT(total, 0);
-      EXPECT_LE(moved, 0.08 * total) << elevation << " " << i;
+      const Mass m = compare(ours[i].hist, pcl[i].hist);
+      EXPECT_GT(m.total, 0);
+      EXPECT_LE(m.moved, 0.08 * m.total) << elevation << " " << i;
     }
   }
 }
@@ -120,8 +133,7 @@ TEST(GlobalRegions, CoarseNormalsKeepTheRegionsOfDenseCloudsAndChangeNoSparseOne
   for (const double voxel : {5.0, 12.0}) {
     PreprocessSettings pre = s.preprocess;
     pre.voxel_mm = voxel;
-    const PointSet view = preprocess_view(
-        render_cloud(asymmetric_object(), camera_pose(30, 45, 0, 700), synthetic_camera(), 1.0, 1), pre, 2);
+    const PointSet view = clean_view(45, pre);
     const auto coarse = global::stable_regions(view, s.global);
     const auto all = global::stable_regions(view, every);
     ASSERT_GE(all.size(), 2u) << voxel;
@@ -143,24 +155,19 @@ TEST(GlobalRegions, VfhMatchesPclVfh) {
   // normal: bin for bin, but for a point whose value lies on a bin edge
   // (PCL's dot products sum four coordinates, ours three).
   RecognitionSettings s;
-  const PointSet view = preprocess_view(
-      render_cloud(asymmetric_object(), camera_pose(30, 30, 0, 700), synthetic_camera(), 1.0, 1), s.preprocess, 2);
+  const PointSet view = clean_view(30, s.preprocess);
   ASSERT_GT(view.size(), 300u);
   for (const bool normalize : {false, true})
-    for (const auto& region : global::stable_regions(view, s.global)) {
-      const auto ours = global::vfh_histogram(view.points, view.normals, region.centroid, region.mean_normal, normalize);
-      const auto pcl = global::vfh_histogram_pcl(view.points, view.normals, region.centroid, region.mean_normal, normalize);
+    for (const auto& r : global::stable_regions(view, s.global)) {
+      const auto ours = global::vfh_histogram(view.points, view.normals, r.centroid, r.mean_normal, normalize);
+      const auto pcl = global::vfh_histogram_pcl(view.points, view.normals, r.centroid, r.mean_normal, normalize);
       ASSERT_EQ(ours.size(), 308u);
       ASSERT_EQ(pcl.size(), 308u);
-      double total = 0, moved = 0;
-      for (size_t b = 0; b < 308; ++b) {
-        total += pcl[b];
-        moved += std::abs(ours[b] - pcl[b]);
-      }
+      const Mass m = compare(ours, pcl);
       const double per_point = normalize ? 100.0 / static_cast<double>(view.size() - 1) : 1.0;
       const double n = static_cast<double>(view.size());
-      EXPECT_NEAR(total, 4.0 * per_point * n + (normalize ? 100.0 : n), 1e-3 * total) << "five counts per point";
-      EXPECT_LE(moved, 2 * 2 * per_point + 1e-3) << "at most two points' bins on an edge";
+      EXPECT_NEAR(m.total, 4.0 * per_point * n + (normalize ? 100.0 : n), 1e-3 * m.total) << "five counts per point";
+      EXPECT_LE(m.moved, 2 * 2 * per_point + 1e-3) << "at most two points' bins on an edge";
     }
 }
 
@@ -169,17 +176,14 @@ TEST(GlobalRegions, CvfhWithoutRegionsDescribesTheWholeCloud) {
   // both ours and PCL's.
   RecognitionSettings s;
   s.global.cvfh_min_region_points = 100000;
-  const PointSet view = preprocess_view(
-      render_cloud(asymmetric_object(), camera_pose(30, 30, 0, 700), synthetic_camera(), 1.0, 1), s.preprocess, 2);
+  const PointSet view = clean_view(30, s.preprocess);
   const auto ours = global::cvfh_signatures(view, s.global);
   const auto pcl = global::cvfh_signatures_pcl(view, s.global);
   ASSERT_EQ(ours.size(), 1u);
   ASSERT_EQ(pcl.size(), 1u);
   EXPECT_FALSE(ours[0].from_normal);
   EXPECT_LT((ours[0].centroid - pcl[0].centroid).norm(), 1e-3);
-  double moved = 0;
-  for (size_t b = 0; b < 308; ++b) moved += std::abs(ours[0].hist[b] - pcl[0].hist[b]);
-  EXPECT_LE(moved, 2.0) << "at most one point's bin on an edge";
+  EXPECT_LE(compare(ours[0].hist, pcl[0].hist).moved, 2.0) << "at most one point's bin on an edge";
 }
 
 }  // namespace
