@@ -68,10 +68,10 @@ struct GlobalSettings {
                                         // normal_max_points: the low-curvature points voxelized at
                                         // cvfh_normal_radius_mm x sqrt(pi / this), at most this many
                                         // of their centroids per ball (thinned evenly); a point with
-                                        // fewer than this / 4 centroids in its ball (a sparse cloud:
-                                        // the tables' 10 mm voxels against 0.1 d) takes its own
-                                        // neighbours, thinned the same way. 0 = every neighbour, as
-                                        // pcl::CVFHEstimation (the releases before)
+                                        // fewer than this / 4 centroids in its ball (sparse: most
+                                        // points of the tables' 10 mm voxels against 0.1 d) takes its
+                                        // own neighbours, thinned the same way. 0 = every neighbour,
+                                        // as pcl::CVFHEstimation (the releases before)
   bool cvfh_normalize_bins = false;     // CVFH bins count points (thesis, PCL default); true: percentages
   double crh_peak_distance_deg = 10.0;  // distinct CRH peaks are at least this far apart (PCL: 10)
   double ourcvfh_axis_ratio = 0.8;      // OUR-CVFH: axes this similarly hard to disambiguate -> several frames
