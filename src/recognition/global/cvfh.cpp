@@ -16,6 +16,8 @@
 // in double.
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <vector>
 
 #include "core/atan2_bin.h"
 #include "recognition/darboux.h"

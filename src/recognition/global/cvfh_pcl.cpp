@@ -1,10 +1,14 @@
-// CVFH signatures through pcl::CVFHEstimation: the reference of the
-// project's own CVFH (cvfh.cpp; tests and benchmarks only).
+// PCL's CVFH pieces, the references of the project's own (tests only):
+// pcl::CVFHEstimation (cvfh.cpp), pcl::VFHEstimation from a given centroid
+// and normal (vfh_histogram), and CVFH's stable regions grown by PCL's code
+// on a sorted or unsorted FLANN tree (regions.cpp).
 #include <pcl/features/cvfh.h>
 #include <pcl/features/normal_3d.h>
 #include <pcl/features/vfh.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "recognition/global/internal.h"
 #include "recognition/global/pcl_cvfh.h"

@@ -49,10 +49,12 @@ std::vector<std::vector<int>> euclidean_clusters_pcl(const std::vector<Vec3f>& p
 // A stable region: CVFH's smooth region growing after removing high-
 // curvature points (pcl::CVFHEstimation's algorithm and parameters): points
 // with curvature above cvfh_curvature_threshold are dropped, normals are
-// recomputed on the rest (radius cvfh_normal_radius_mm, toward the camera),
-// and regions grow between points closer than cvfh_cluster_tolerance_mm
-// whose normals differ by less than cvfh_eps_angle_deg; regions of at least
-// cvfh_min_region_points points are kept.
+// recomputed on the rest (radius cvfh_normal_radius_mm, toward the camera;
+// from a coarse support where dense, cvfh_normal_max_points), and regions
+// grow between points closer than cvfh_cluster_tolerance_mm whose normals
+// differ by less than cvfh_eps_angle_deg; regions of at least
+// cvfh_min_region_points points are kept (regions.cpp: the regions of PCL's
+// algorithm on a sorted search).
 struct Region {
   std::vector<int> indices;            // of the points in the input cloud, ascending
   std::vector<Vec3f> points;
