@@ -6,6 +6,7 @@
 // coordinates instead of four.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/types.h"
@@ -47,6 +48,14 @@ inline bool darboux_pair(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, cons
   *f1_y = w.dot(target);
   *f1_x = u.dot(target);
   return true;
+}
+
+// A pair feature's bin: floor(scaled) clamped to [0, bins - 1], a NaN in
+// bin 0 (PCL's floor in double, clamped; a NaN lands in bin 0 as PCL's
+// clamped conversion does on x86). FPFH and VFH bin their features so.
+inline int clamped_bin(double scaled, int bins) {
+  if (!(scaled >= 0)) return 0;
+  return std::min(static_cast<int>(std::floor(scaled)), bins - 1);
 }
 
 }  // namespace pb

@@ -29,13 +29,6 @@ namespace {
 
 constexpr int kShapeBins = 45, kViewBins = 128, kVfhDim = 4 * kShapeBins + kViewBins;
 
-// floor(bins * x) clamped to [0, bins - 1] (a NaN lands in bin 0, as PCL's
-// clamped conversion does on x86).
-inline int clamped_bin(double scaled, int bins) {
-  if (!(scaled >= 0)) return 0;
-  return std::min(static_cast<int>(std::floor(scaled)), bins - 1);
-}
-
 }  // namespace
 
 std::vector<float> vfh_histogram(const std::vector<Vec3f>& points, const std::vector<Vec3f>& normals,
@@ -45,18 +38,12 @@ std::vector<float> vfh_histogram(const std::vector<Vec3f>& points, const std::ve
   const size_t n = points.size();
   if (n == 0) return h;
   const double d_pi = static_cast<double>(1.0f / (2.0f * static_cast<float>(M_PI)));
-  // The largest distance to the centroid (the first farthest point, as
-  // pcl::getMaxDistance), recomputed from that point as PCL does.
+  // The distance component's scale: the largest distance to the centroid
+  // (pcl::getMaxDistance's, in float; only with the component).
   float max_dist = std::numeric_limits<float>::lowest();
-  size_t far = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const float d = (centroid - points[i]).norm();
-    if (d > max_dist) {
-      max_dist = d;
-      far = i;
-    }
-  }
-  const double dist_norm = static_cast<double>((centroid - points[far]).norm());
+  if (size_component)
+    for (size_t i = 0; i < n; ++i) max_dist = std::max(max_dist, (centroid - points[i]).norm());
+  const double dist_norm = static_cast<double>(max_dist);
   const float incr = normalize_bins ? 100.0f / static_cast<float>(n - 1) : 1.f;
   for (size_t i = 0; i < n; ++i) {
     float f1_y = 0, f1_x = 0, f2 = 0, f3 = 0, f4 = 0;

@@ -40,13 +40,6 @@ namespace {
 
 constexpr int kBins = 11;  // per angle
 
-// Bin of x (PCL's: floor in double, clamped; a NaN lands in bin 0 as PCL's
-// clamped conversion does on x86).
-inline int bin_of(double x) {
-  if (!(x >= 0)) return 0;
-  return std::min(static_cast<int>(std::floor(x)), kBins - 1);
-}
-
 using Hist = std::array<float, kFpfhDim>;
 using Counts = std::array<uint32_t, kFpfhDim>;
 
@@ -64,9 +57,9 @@ inline int thread_num() {
 // rises with f1).
 inline void count_pair(float f1_y, float f1_x, float f2, float f3, uint32_t* c) {
   const double inv_2pi = static_cast<double>(1.0f / (2.0f * static_cast<float>(M_PI)));
-  ++c[binned_atan2(f1_y, f1_x, [inv_2pi](float f1) { return bin_of(kBins * ((f1 + M_PI) * inv_2pi)); })];
-  ++c[kBins + bin_of(kBins * ((f2 + 1.0) * 0.5))];
-  ++c[2 * kBins + bin_of(kBins * ((f3 + 1.0) * 0.5))];
+  ++c[binned_atan2(f1_y, f1_x, [inv_2pi](float f1) { return clamped_bin(kBins * ((f1 + M_PI) * inv_2pi), kBins); })];
+  ++c[kBins + clamped_bin(kBins * ((f2 + 1.0) * 0.5), kBins)];
+  ++c[2 * kBins + clamped_bin(kBins * ((f3 + 1.0) * 0.5), kBins)];
 }
 
 // SPFH histograms of the `needed` points (row_of: cloud index -> row, or -1).
