@@ -35,7 +35,6 @@ struct Hypothesis {
   double score = 0;      // method-specific (votes, 1/histogram distance, ...), higher is better
   int inliers = 0;       // set by verification
   double verification = 0;  // what verification ranked it by (verify.score: inliers or visibility)
-  double fitness = 0;    // mean squared inlier distance after refinement (mm^2)
   bool refined = false;
 };
 

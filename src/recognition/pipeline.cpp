@@ -74,7 +74,6 @@ void refine_all(std::vector<Hypothesis>& hyps, const std::vector<uint64_t>& stre
                                          derive_seed(s.seed, {kStreamRefine, stream[static_cast<size_t>(i)]}));
       if (finite_pose(r.T_cam_model)) {
         h.T_cam_model = r.T_cam_model;
-        h.fitness = r.fitness;
         h.refined = s.refinement != "none";
       }
     } catch (...) {

@@ -96,7 +96,6 @@ struct RefineSettings {
 struct RefineResult {
   Pose T_cam_model;        // refined pose
   bool converged = false;
-  double fitness = 0;      // mean squared distance of corresponding points (mm^2)
   int iterations = 0;
 };
 
@@ -106,5 +105,14 @@ struct RefineResult {
 // choices draw from `seed`.
 RefineResult refine_pose(const std::string& method, const PointSet& model, const PointSet& scene,
                          const Pose& init, const RefineSettings& s, uint64_t seed);
+
+// How well `model` (model frame) at T_cam_model fits `scene` (camera frame):
+// the mean squared distance (mm^2) of the model points to their nearest
+// scene point, over the points whose nearest lies within max_distance_mm
+// (PCL's Registration::getFitnessScore with a bound); max_distance_mm^2 when
+// none does. Not part of refine_pose (the pipeline ranks by verification and
+// never reads it: one nearest-neighbour search per model point saved).
+double registration_fitness(const PointSet& model, const PointSet& scene, const Pose& T_cam_model,
+                            double max_distance_mm);
 
 }  // namespace pb

@@ -53,7 +53,6 @@ RefineResult refine_pose(const std::string& method, const PointSet& model, const
   RefineResult res;
   res.T_cam_model = init;
   const double max_corr = s.max_correspondence_mm;
-  res.fitness = max_corr * max_corr;
   if (model.empty() || scene.empty()) return res;
   // Model at the initial pose (camera frame, mm), its centre and radius.
   std::vector<Eigen::Vector3d> moved(model.size());
@@ -89,8 +88,8 @@ RefineResult refine_pose(const std::string& method, const PointSet& model, const
   p.tgt.reserve(crop.size());
   for (size_t i : crop) p.tgt.push_back(((scene.points[i].cast<double>() - c) * 1e-3).cast<float>());
 
-  // One tree over the crop, for the method's nearest neighbours and the
-  // fitness below (a nearest neighbour does not depend on the leaf size).
+  // One tree over the crop, for the method's nearest neighbours (a nearest
+  // neighbour does not depend on the leaf size).
   const KdTree3 tgt_tree(p.tgt, refine_detail::kTargetLeafSize);
   p.tgt_tree = &tgt_tree;
   if (entry.run) {
@@ -130,25 +129,28 @@ RefineResult refine_pose(const std::string& method, const PointSet& model, const
     res.converged = true;
   }
 
-  // Fitness: mean squared distance (mm^2) of the model points to their
-  // nearest cropped scene point, over pairs within max_correspondence_mm.
-  {
-    double sum = 0;
-    size_t n = 0;
-    const double lim = max_corr * max_corr;
-    for (const auto& x : model.points) {
-      const Vec3f q = ((res.T_cam_model * x.cast<double>() - c) * 1e-3).cast<float>();
-      float d2 = 0;
-      if (tgt_tree.nearest(q, &d2) < 0) continue;
-      const double dmm2 = static_cast<double>(d2) * 1e6;
-      if (dmm2 <= lim) {
-        sum += dmm2;
-        ++n;
-      }
-    }
-    if (n > 0) res.fitness = sum / static_cast<double>(n);
-  }
   return res;
+}
+
+double registration_fitness(const PointSet& model, const PointSet& scene, const Pose& T_cam_model,
+                            double max_distance_mm) {
+  const double lim = max_distance_mm * max_distance_mm;
+  std::vector<Vec3f> finite;
+  finite.reserve(scene.size());
+  for (const auto& q : scene.points)
+    if (q.allFinite()) finite.push_back(q);
+  const KdTree3 tree(finite);
+  double sum = 0;
+  size_t n = 0;
+  for (const auto& x : model.points) {
+    float d2 = 0;
+    if (tree.nearest((T_cam_model * x.cast<double>()).cast<float>(), &d2) < 0) continue;
+    if (static_cast<double>(d2) <= lim) {
+      sum += static_cast<double>(d2);
+      ++n;
+    }
+  }
+  return n > 0 ? sum / static_cast<double>(n) : lim;
 }
 
 }  // namespace pb
