@@ -78,6 +78,50 @@ TEST(KdTree3, DuplicatesResolveToTheLowestIndexAndEmptyTreesFindNothing) {
   EXPECT_TRUE(out.empty());
 }
 
+// any_within answers "is any point below the bound" as nearest does (and
+// returns such a point); any_preferred(q, i) is -1 exactly when nearest(q)
+// is i: on random clouds, on a grid (many equal distances) and on
+// duplicates, where the lower index is preferred.
+TEST(KdTree3, AnyWithinAndAnyPreferredAnswerAsNearestDoes) {
+  std::vector<std::vector<Vec3f>> clouds = {random_cloud(3000, 17, 100.f), random_cloud(9, 18, 100.f)};
+  std::vector<Vec3f> grid;
+  for (int x = 0; x < 12; ++x)
+    for (int y = 0; y < 12; ++y)
+      for (int z = 0; z < 12; ++z) grid.emplace_back(10.f * x, 10.f * y, 10.f * z);
+  for (int k = 0; k < 40; ++k) grid.push_back(grid[static_cast<size_t>(k * 37)]);  // duplicates, higher index
+  clouds.push_back(grid);
+  for (const auto& pts : clouds) {
+    const pb::KdTree3 tree(pts);
+    auto queries = random_cloud(400, 23, 120.f);
+    for (const Vec3f& p : pts) queries.push_back(p);  // on points: ties everywhere on the grid
+    for (size_t qi = 0; qi < queries.size(); ++qi) {
+      const Vec3f& q = queries[qi];
+      for (const float max2 : {5.f * 5.f, 10.f * 10.f, 30.f * 30.f}) {
+        float d = 0;
+        const bool any = brute_nearest(pts, q, max2, &d) >= 0;
+        const int hint = static_cast<int>(qi % pts.size());
+        for (const int h : {-1, hint}) {
+          const int got = tree.any_within(q, max2, h);
+          ASSERT_EQ(got >= 0, any);
+          if (got >= 0) EXPECT_LT((pts[static_cast<size_t>(got)] - q).squaredNorm(), max2);
+        }
+      }
+      for (const int i : {static_cast<int>(qi % pts.size()), tree.nearest(q)}) {
+        const int better = tree.any_preferred(q, i);
+        EXPECT_EQ(better < 0, tree.nearest(q) == i) << "query " << qi << " point " << i;
+        if (better >= 0) {
+          const float di = (pts[static_cast<size_t>(i)] - q).squaredNorm();
+          const float db = (pts[static_cast<size_t>(better)] - q).squaredNorm();
+          EXPECT_TRUE(db < di || (db == di && better < i));
+        }
+      }
+    }
+  }
+  const pb::KdTree3 empty(std::vector<Vec3f>{});
+  EXPECT_EQ(empty.any_within(Vec3f(0, 0, 0), 1e9f), -1);
+  EXPECT_EQ(empty.any_preferred(Vec3f(0, 0, 0), 0), -1);
+}
+
 // within: strictly below the bound (a point exactly at it is left out, as
 // FLANN's radius search), sorted by (distance, index) with duplicates
 // (equal distances) in index order; unsorted: the same set.

@@ -128,6 +128,47 @@ int KdTree3::nearest(const Vec3f& q, float* sq_dist, float max_sq_dist, int hint
   return best;
 }
 
+// Some point other than tie_below with squared distance below `bound`, or
+// equal to it with an index below tie_below. Depth first, near child first; a far child is
+// skipped when the splitting plane alone is farther than the bound (every
+// point beyond it is too: the float distances are monotonic in each
+// coordinate's difference).
+int KdTree3::any_in(int node, const Vec3f& q, float bound, int tie_below) const {
+  const Node& n = nodes_[static_cast<size_t>(node)];
+  if (n.dim < 0) {
+    float d4[4];
+    for (int i = n.begin; i < n.end; i += 4) {
+      const int m = std::min(4, n.end - i);
+      for (int mask = leaf_distances(q, i, m, bound, d4); mask != 0; mask &= mask - 1) {
+        const int k = __builtin_ctz(static_cast<unsigned>(mask));
+        const int idx = order_[static_cast<size_t>(i + k)];
+        // The mask holds d <= bound; point tie_below itself is never one.
+        if ((d4[k] < bound || idx < tie_below) && idx != tie_below) return idx;
+      }
+    }
+    return -1;
+  }
+  const float diff = q[n.dim] - n.split;
+  const int near = diff < 0 ? n.left : n.right, far = diff < 0 ? n.right : n.left;
+  const int found = any_in(near, q, bound, tie_below);
+  if (found >= 0 || diff * diff > bound) return found;
+  return any_in(far, q, bound, tie_below);
+}
+
+int KdTree3::any_within(const Vec3f& q, float max_sq_dist, int hint) const {
+  if (nodes_.empty() || !q.allFinite()) return -1;
+  if (hint >= 0 && static_cast<size_t>(hint) < position_.size() &&
+      (points_[static_cast<size_t>(position_[static_cast<size_t>(hint)])] - q).squaredNorm() < max_sq_dist)
+    return hint;
+  return any_in(0, q, max_sq_dist, -1);
+}
+
+int KdTree3::any_preferred(const Vec3f& q, int index) const {
+  if (nodes_.empty() || !q.allFinite() || index < 0 || static_cast<size_t>(index) >= position_.size()) return -1;
+  const float d = (points_[static_cast<size_t>(position_[static_cast<size_t>(index)])] - q).squaredNorm();
+  return any_in(0, q, d, index);
+}
+
 template <class F>
 void KdTree3::visit_radius(int node, const Vec3f& q, float r2, F& f) const {
   const Node& n = nodes_[static_cast<size_t>(node)];

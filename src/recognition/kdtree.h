@@ -24,6 +24,16 @@ class KdTree3 {
   // tightens the search bound from the start: the answer is the same.
   int nearest(const Vec3f& q, float* sq_dist = nullptr,
               float max_sq_dist = std::numeric_limits<float>::infinity(), int hint = -1) const;
+  // Some point with squared distance below max_sq_dist (index, or -1 when
+  // none): `hint` (an input index, or -1) if it is one, else the first the
+  // search meets. Whether there is one is what nearest() tells; which one it
+  // returns is not the nearest, and the search ends at it (an inlier count,
+  // a reciprocity check: a yes/no question).
+  int any_within(const Vec3f& q, float max_sq_dist, int hint = -1) const;
+  // Some point that nearest(q) would prefer to input point `index` (nearer
+  // to q, or as near with a lower index), -1 if none: then nearest(q, ...,
+  // index) is `index` (when within its bound). Ends at the first one found.
+  int any_preferred(const Vec3f& q, int index) const;
   // Every point within r (squared distance <= r^2), sorted by distance, then
   // index.
   void radius(const Vec3f& q, float r, std::vector<int>& out) const;
@@ -97,6 +107,7 @@ class KdTree3 {
   };
   int build(std::vector<Entry>& entries, int begin, int end, int leaf_size);
   void nearest_in(int node, const Vec3f& q, int& best, float& best_d) const;
+  int any_in(int node, const Vec3f& q, float bound, int tie_below) const;
   // Squared distances from q of the m <= 4 points at tree positions i..i+m
   // into d4 (as Eigen's squaredNorm computes them); bit k of the result: the
   // k-th is at most `bound`.

@@ -76,8 +76,10 @@ void correspond(const std::vector<Vec3f>& src, const KdTree3& src_tree, const st
     last[i] = j;
     if (j < 0) continue;
     if (s.reciprocal_correspondences) {
+      // Source point i must be the target point's nearest (nearest(back,
+      // max2) == i): within the bound and no point preferred to it.
       const Vec3f back = Ri * (tgt[static_cast<size_t>(j)] - t);
-      if (src_tree.nearest(back, nullptr, max2, static_cast<int>(i)) != static_cast<int>(i)) continue;
+      if (!((src[i] - back).squaredNorm() < max2) || src_tree.any_preferred(back, static_cast<int>(i)) >= 0) continue;
     }
     out.push_back({static_cast<int>(i), j, d2});
   }

@@ -28,6 +28,10 @@ int PointIndex::nearest(const Vec3f& q, float* sq_dist, float max_sq_dist, int h
   return impl_->tree.nearest(q, sq_dist, max_sq_dist, hint);
 }
 
+int PointIndex::any_within(const Vec3f& q, float max_sq_dist, int hint) const {
+  return impl_->tree.any_within(q, max_sq_dist, hint);
+}
+
 std::vector<int> PointIndex::radius(const Vec3f& q, float r) const {
   std::vector<int> out;
   impl_->tree.radius(q, r, out);
@@ -40,15 +44,16 @@ int count_inliers(const std::vector<Vec3f>& model_points, const Pose& T_cam_mode
   const Eigen::Matrix3d R = T_cam_model.R;
   const Vec3 t = T_cam_model.t;
   const float thr2 = static_cast<float>(threshold_mm * threshold_mm);
-  // The search is bounded by the threshold (squared distance <= thr2 is below
-  // the next float up): far points end their search early. The previous
+  // A point is an inlier when some scene point is within the threshold
+  // (squared distance <= thr2 is below the next float up): the search ends
+  // at the first one found, or early when there is none. The previous
   // point's match (model points are stored in scan order, neighbours mostly
-  // adjacent) is the hint; neither changes which points count.
+  // adjacent) is tried first; neither changes which points count.
   const float bound = std::nextafter(thr2, std::numeric_limits<float>::infinity());
   int n = 0, hint = -1;
   for (const auto& p : model_points) {
     const Vec3f q = (R * p.cast<double>() + t).cast<float>();
-    const int k = scene.nearest(q, nullptr, bound, hint);
+    const int k = scene.any_within(q, bound, hint);
     if (k >= 0) {
       ++n;
       hint = k;

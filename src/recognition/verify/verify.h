@@ -101,6 +101,9 @@ class PointIndex {
   // that distance; -1 if none. `hint`: see KdTree3::nearest.
   int nearest(const Vec3f& q, float* sq_dist = nullptr,
               float max_sq_dist = std::numeric_limits<float>::infinity(), int hint = -1) const;
+  // Some point with squared distance below max_sq_dist, -1 if none: see
+  // KdTree3::any_within.
+  int any_within(const Vec3f& q, float max_sq_dist, int hint = -1) const;
   std::vector<int> radius(const Vec3f& q, float r) const;
   size_t size() const;
 
