@@ -13,6 +13,7 @@
 
 namespace {
 
+using pb::Vec3;
 using pb::Vec3f;
 
 std::vector<Vec3f> random_cloud(size_t n, uint64_t seed, float scale) {
@@ -120,6 +121,56 @@ TEST(KdTree3, AnyWithinAndAnyPreferredAnswerAsNearestDoes) {
   const pb::KdTree3 empty(std::vector<Vec3f>{});
   EXPECT_EQ(empty.any_within(Vec3f(0, 0, 0), 1e9f), -1);
   EXPECT_EQ(empty.any_preferred(Vec3f(0, 0, 0), 0), -1);
+}
+
+// restricted: a tree cut down to a subset in shifted and scaled
+// coordinates (refinement's crop in its local frame) answers as a tree
+// built over that subset: nearest (index and distance, ties to the lower
+// index), any_within, any_preferred, radius and the thinned neighbourhoods.
+TEST(KdTree3, RestrictedTreeAnswersAsOneBuiltOverTheSubset) {
+  std::vector<Vec3f> grid;  // duplicates and equal distances
+  for (int x = 0; x < 15; ++x)
+    for (int y = 0; y < 15; ++y)
+      for (int z = 0; z < 6; ++z) grid.emplace_back(30.f * x - 200.f, 30.f * y, 800.f + 30.f * z);
+  for (const auto& cam : {random_cloud(5000, 31, 1000.f), grid}) {
+    const pb::KdTree3 whole(cam);
+    const Vec3 c(12.3, -45.6, 789.0);
+    const auto map = [&c](int a, float x) { return static_cast<float>((static_cast<double>(x) - c[a]) * 1e-3); };
+    std::vector<size_t> keep;
+    std::vector<Vec3f> local;
+    for (size_t i = 0; i < cam.size(); ++i)
+      if ((cam[i].cast<double>() - Vec3(0, 200, 900)).norm() < 400.0) {  // a ball, as refinement's crop
+        keep.push_back(i);
+        local.push_back(((cam[i].cast<double>() - c) * 1e-3).cast<float>());
+      }
+    ASSERT_GT(keep.size(), 50u);
+    const pb::KdTree3 cut = whole.restricted(keep, local, map);
+    const pb::KdTree3 built(local);
+    ASSERT_EQ(cut.size(), local.size());
+    auto queries = random_cloud(300, 37, 0.6f);
+    for (const auto& p : local) queries.push_back(p);
+    for (size_t qi = 0; qi < queries.size(); ++qi) {
+      const Vec3f& q = queries[qi];
+      float d_cut = 0, d_built = 0;
+      ASSERT_EQ(cut.nearest(q, &d_cut), built.nearest(q, &d_built));
+      EXPECT_EQ(d_cut, d_built);
+      const float max2 = 0.05f * 0.05f;
+      const int hint = static_cast<int>(qi % local.size());
+      EXPECT_EQ(cut.nearest(q, nullptr, max2, hint), built.nearest(q, nullptr, max2, hint));
+      EXPECT_EQ(cut.any_within(q, max2) >= 0, built.any_within(q, max2) >= 0);
+      EXPECT_EQ(cut.any_preferred(q, hint) >= 0, built.any_preferred(q, hint) >= 0);
+      std::vector<int> a, b;
+      cut.radius(q, 0.08f, a);
+      built.radius(q, 0.08f, b);
+      EXPECT_EQ(a, b);
+      std::vector<std::pair<float, int>> ta, tb;
+      EXPECT_EQ(cut.within_thinned(q, 0.1f * 0.1f, 16, ta, pb::KdTree3::Thinning::counted),
+                built.within_thinned(q, 0.1f * 0.1f, 16, tb, pb::KdTree3::Thinning::counted));
+      std::sort(ta.begin(), ta.end());  // the same points chosen need not be: the orders differ
+      EXPECT_EQ(ta.size(), tb.size());
+    }
+  }
+  EXPECT_EQ(pb::KdTree3(random_cloud(10, 3, 1.f)).restricted({}, {}, [](int, float x) { return x; }).size(), 0u);
 }
 
 // within: strictly below the bound (a point exactly at it is left out, as

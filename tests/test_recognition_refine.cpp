@@ -9,6 +9,7 @@
 
 #include <tuple>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -17,6 +18,7 @@
 #include "core/error.h"
 #include "core/hash.h"
 #include "core/yaml.h"
+#include "recognition/kdtree.h"
 #include "recognition/refine/refine.h"
 #include "test_recognition_refine_scenes.h"
 
@@ -270,6 +272,42 @@ TEST(Refine, FitnessIsTheMeanSquaredDistanceOfThePointsWithinTheBound) {
   EXPECT_EQ(registration_fitness(model, scene, T, 1.0), 1.0);  // no pair within 1 mm
   T.t = Vec3(0, 0, 2);  // the first five now coincide
   EXPECT_NEAR(registration_fitness(model, scene, T, 10.0), 0.0, 1e-9);
+}
+
+// A crop tree cut from the scene's tree (refine_pose's scene_tree, what the
+// pipeline passes; used when the crop holds at least half the scene) gives
+// the same poses, bit for bit, as one built.
+TEST_F(RefineCases, CropTreeCutFromTheSceneTreeGivesTheSamePoses) {
+  const RefineSettings s;
+  for (const std::string method : {"icp", "icp_plane", "gicp"})
+    for (size_t i = 0; i < cases_.size(); i += 3) {
+      const auto& c = cases_[i];
+      Vec3 centre = Vec3::Zero();
+      for (const auto& x : c.model.points) centre += c.init * x.cast<double>();
+      centre /= static_cast<double>(c.model.size());
+      double radius = 0;
+      for (const auto& x : c.model.points) radius = std::max(radius, (c.init * x.cast<double>() - centre).norm());
+      // The scene (the object's surface alone) and, far off, every other
+      // point of it again: the crop is two thirds of the points.
+      PointSet scene = c.scene;
+      for (size_t k = 0; k < c.scene.size(); k += 2) {
+        scene.points.push_back(c.scene.points[k] + Vec3f(0, 0, static_cast<float>(4 * radius)));
+        scene.normals.push_back(c.scene.normals[k]);
+      }
+      size_t crop = 0;
+      for (const auto& q : scene.points) crop += (q.cast<double>() - centre).norm() <= radius + s.max_correspondence_mm;
+      ASSERT_GE(2 * crop, scene.size());  // cut, not built
+      ASSERT_LT(crop, scene.size());      // with points left out
+      const KdTree3 scene_tree(scene.points, 24);
+      const RefineResult a = refine_pose(method, c.model, scene, c.init, s, 5);
+      const RefineResult b = refine_pose(method, c.model, scene, c.init, s, 5, &scene_tree);
+      EXPECT_EQ(a.T_cam_model.R, b.T_cam_model.R) << method << " case " << i;
+      EXPECT_EQ(a.T_cam_model.t, b.T_cam_model.t) << method << " case " << i;
+      EXPECT_EQ(a.iterations, b.iterations);
+    }
+  const KdTree3 wrong(std::vector<Vec3f>{Vec3f(0, 0, 0)});
+  EXPECT_THROW(refine_pose("icp", cases_[0].model, cases_[0].scene, cases_[0].init, RefineSettings{}, 5, &wrong),
+               std::invalid_argument);
 }
 
 TEST_F(RefineCases, NoneReturnsTheInitialPose) {

@@ -5,6 +5,7 @@
 // and per model cloud, not one per ICP iteration), verification, normals.
 #pragma once
 
+#include <functional>
 #include <limits>
 #include <utility>
 #include <vector>
@@ -56,6 +57,18 @@ class KdTree3 {
   size_t within_thinned(const Vec3f& q, float max_sq_dist, int max_points, std::vector<std::pair<float, int>>& out,
                         Thinning how = Thinning::automatic) const;
   size_t size() const { return points_.size(); }
+  // This tree cut down to some of its points, in other coordinates, without
+  // a new build: input point keep[k] (ascending input indices) becomes
+  // point k of the result, at points[k]; the others are left out. The new
+  // coordinates must be the old ones mapped axis by axis by map(axis, x),
+  // non-decreasing in x (a shift and a scale, rounded: refinement's local
+  // frame). The splits are mapped by it and the boxes taken over the kept
+  // points, so the result is a kd-tree over `points`: nearest and the any_
+  // queries answer as on KdTree3(points), radius and within list the same
+  // points (the unsorted orders differ). O(size) where a build is
+  // O(size log size). kdtree_restricted.cpp.
+  KdTree3 restricted(const std::vector<size_t>& keep, const std::vector<Vec3f>& points,
+                     const std::function<float(int, float)>& map) const;
   // Sorts (squared distance, index) entries as std::sort does (distance,
   // then index), where every distance is a non-negative float and every
   // index non-negative (what within() lists): as 64-bit keys, as within().

@@ -59,9 +59,11 @@ PointSet prepare_scene(const DepthImage& depth, const Intrinsics& K, const Recog
 // method's list (its random stream, the same whether or not others were
 // dropped before refinement).
 // sources: hypothesis i's model points, when given (screening's subsets);
-// else its view's model cloud.
+// else its view's model cloud. index: verification's, over the scene's
+// points (each hypothesis's crop tree is cut from it).
 void refine_all(std::vector<Hypothesis>& hyps, const std::vector<uint64_t>& stream, const TrainedModel& model,
-                const PointSet& scene, const RecognitionSettings& s, const std::vector<PointSet>* sources = nullptr) {
+                const PointSet& scene, const PointIndex& index, const RecognitionSettings& s,
+                const std::vector<PointSet>* sources = nullptr) {
   for (const auto& h : hyps) model.model_cloud(h.view);  // throws for a view index out of range
   const long nh = static_cast<long>(hyps.size());
   std::vector<std::exception_ptr> errors(hyps.size());
@@ -71,7 +73,8 @@ void refine_all(std::vector<Hypothesis>& hyps, const std::vector<uint64_t>& stre
       Hypothesis& h = hyps[static_cast<size_t>(i)];
       const PointSet& source = sources ? (*sources)[static_cast<size_t>(i)] : model.model_cloud(h.view);
       const RefineResult r = refine_pose(s.refinement, source, scene, h.T_cam_model, s.refine,
-                                         derive_seed(s.seed, {kStreamRefine, stream[static_cast<size_t>(i)]}));
+                                         derive_seed(s.seed, {kStreamRefine, stream[static_cast<size_t>(i)]}),
+                                         &index.tree());
       if (finite_pose(r.T_cam_model)) {
         h.T_cam_model = r.T_cam_model;
         h.refined = s.refinement != "none";
@@ -155,7 +158,7 @@ std::vector<uint64_t> keep_most_promising(std::vector<Hypothesis>& hyps, const T
                                                       derive_seed(s.seed, {kStreamScreen, static_cast<uint64_t>(i)}));
       sources.push_back(subset(cloud, std::vector<int>(pick.begin(), pick.end())));
     }
-    refine_all(hyps, kept_at, model, scene, s, &sources);
+    refine_all(hyps, kept_at, model, scene, index, s, &sources);
   }
   std::vector<size_t> order = verification_order(hyps, model, index, s.verify, depth, K);
   order.resize(keep);
@@ -240,7 +243,7 @@ void refine_verify_accept(std::vector<Hypothesis> hyps, const TrainedModel& mode
   res.times.verify = timer.seconds();
   timer.reset();
   const std::vector<uint64_t> stream = keep_most_promising(hyps, model, scene, index, depth, K, s);
-  refine_all(hyps, stream, model, scene, s);
+  refine_all(hyps, stream, model, scene, index, s);
   res.times.refine = timer.seconds();
   timer.reset();
   res.hypotheses = verify_and_rank(std::move(hyps), model, index, s.verify, depth, K);

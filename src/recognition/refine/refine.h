@@ -99,12 +99,18 @@ struct RefineResult {
   int iterations = 0;
 };
 
+class KdTree3;
+
 // Refines `init` (T_cam_model) by aligning `model` (points in the model
 // frame, with normals) to `scene` (camera frame, with normals). method is
 // one of: none icp icp_lm icp_plane gicp ndt (InputError otherwise). Random
-// choices draw from `seed`.
+// choices draw from `seed`. scene_tree (optional): a KdTree3 over
+// scene.points (verification's, PointIndex::tree()); the crop's tree is
+// then cut from it (KdTree3::restricted) instead of built, with the same
+// answers. One caller refining many hypotheses in one scene passes it.
 RefineResult refine_pose(const std::string& method, const PointSet& model, const PointSet& scene,
-                         const Pose& init, const RefineSettings& s, uint64_t seed);
+                         const Pose& init, const RefineSettings& s, uint64_t seed,
+                         const KdTree3* scene_tree = nullptr);
 
 // How well `model` (model frame) at T_cam_model fits `scene` (camera frame):
 // the mean squared distance (mm^2) of the model points to their nearest

@@ -17,12 +17,19 @@ struct PointIndex::Impl {
 PointIndex::PointIndex(const std::vector<Vec3f>& points) : impl_(new Impl) {
   for (const auto& p : points)
     if (!p.allFinite()) throw std::invalid_argument("PointIndex: non-finite point");  // callers pass finite clouds
-  impl_->tree = KdTree3(points);
+  // 24 points per leaf, as refinement's crop trees (refine/internal.h),
+  // which are cut from this one (KdTree3::restricted) and keep its leaves:
+  // searches of a warehouse crop cut from a tree of 8 per leaf were 10-20%
+  // slower than those of a crop tree built (results/bench/README.md,
+  // twenty-sixth round). The answers do not depend on it.
+  impl_->tree = KdTree3(points, 24);
 }
 
 PointIndex::~PointIndex() = default;
 
 size_t PointIndex::size() const { return impl_->tree.size(); }
+
+const KdTree3& PointIndex::tree() const { return impl_->tree; }
 
 int PointIndex::nearest(const Vec3f& q, float* sq_dist, float max_sq_dist, int hint) const {
   return impl_->tree.nearest(q, sq_dist, max_sq_dist, hint);

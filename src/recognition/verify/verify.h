@@ -22,6 +22,8 @@
 
 namespace pb {
 
+class KdTree3;
+
 struct VerifySettings {
   double inlier_threshold_mm = 10.0;  // model point -> nearest scene point distance
   // A threshold left relative to the object's diameter (the default 0.05 d)
@@ -106,6 +108,7 @@ class PointIndex {
   int any_within(const Vec3f& q, float max_sq_dist, int hint = -1) const;
   std::vector<int> radius(const Vec3f& q, float r) const;
   size_t size() const;
+  const KdTree3& tree() const;  // the kd-tree it searches (refinement cuts its crops from it)
 
  private:
   struct Impl;
