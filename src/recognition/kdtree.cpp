@@ -129,10 +129,10 @@ int KdTree3::nearest(const Vec3f& q, float* sq_dist, float max_sq_dist, int hint
 }
 
 // Some point other than tie_below with squared distance below `bound`, or
-// equal to it with an index below tie_below. Depth first, near child first; a far child is
-// skipped when the splitting plane alone is farther than the bound (every
-// point beyond it is too: the float distances are monotonic in each
-// coordinate's difference).
+// equal to it with an index below tie_below. Depth first, near child
+// first; a far child is skipped when the splitting plane alone is farther
+// than the bound (every point beyond it is too: the float distances are
+// monotonic in each coordinate's difference).
 int KdTree3::any_in(int node, const Vec3f& q, float bound, int tie_below) const {
   const Node& n = nodes_[static_cast<size_t>(node)];
   if (n.dim < 0) {
