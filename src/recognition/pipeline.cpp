@@ -90,32 +90,52 @@ void refine_all(std::vector<Hypothesis>& hyps, const std::vector<uint64_t>& stre
 // A hypothesis's score for ranking: NaN (no score) ranks last.
 double score_of(const Hypothesis& h) { return std::isnan(h.score) ? -HUGE_VAL : h.score; }
 
-// Counts every hypothesis's inliers within `threshold_mm` (in parallel; one
-// slot each).
+// Counts the inliers within `threshold_mm` of every hypothesis, or of those
+// `which` marks (in parallel; one slot each).
 void count_all(std::vector<Hypothesis>& hyps, const TrainedModel& model, const PointIndex& index,
-               const VerifySettings& v, double threshold_mm) {
+               const VerifySettings& v, double threshold_mm, const std::vector<char>* which = nullptr) {
   const long nh = static_cast<long>(hyps.size());
 #pragma omp parallel for schedule(dynamic, 1)
   for (long i = 0; i < nh; ++i) {
+    if (which && !(*which)[static_cast<size_t>(i)]) continue;
     Hypothesis& h = hyps[static_cast<size_t>(i)];
     h.inliers = count_inliers(model.verify_cloud(h.view, v).points, h.T_cam_model, index, threshold_mm);
   }
 }
 
-// Counts every hypothesis's inliers and verification (verify.score: inliers,
-// or the depth evidence of visibility); returns the order verification ranks
-// them in: verification first; ties by inliers, score, then view index, then
-// the method's order.
+// Which hypotheses share their verification with another one (where the
+// ranking compares inliers).
+std::vector<char> tied(const std::vector<Hypothesis>& hyps) {
+  std::vector<size_t> by(hyps.size());
+  for (size_t i = 0; i < by.size(); ++i) by[i] = i;
+  std::sort(by.begin(), by.end(), [&](size_t a, size_t b) { return hyps[a].verification < hyps[b].verification; });
+  std::vector<char> out(hyps.size(), 0);
+  for (size_t k = 1; k < by.size(); ++k)
+    if (hyps[by[k]].verification == hyps[by[k - 1]].verification) out[by[k]] = out[by[k - 1]] = 1;
+  return out;
+}
+
+// Computes every hypothesis's verification (verify.score: inliers, or the
+// depth evidence of visibility) and inliers; returns the order verification
+// ranks them in: verification first; ties by inliers, score, then view
+// index, then the method's order. inliers_for_ties: with visibility, only
+// the hypotheses whose verification ties have their inliers counted (the
+// others' are left as they were: the order is the same, their counts are
+// not needed; screening's ranking).
 std::vector<size_t> verification_order(std::vector<Hypothesis>& hyps, const TrainedModel& model,
                                        const PointIndex& index, const VerifySettings& v, const DepthImage& depth,
-                                       const Intrinsics& K) {
-  count_all(hyps, model, index, v, v.inlier_threshold_mm);
+                                       const Intrinsics& K, bool inliers_for_ties = false) {
   const bool visibility = v.score == "visibility";
+  if (!visibility) count_all(hyps, model, index, v, v.inlier_threshold_mm);
   for (Hypothesis& h : hyps)
     h.verification = visibility ? depth_evidence(model.verify_cloud(h.view, v), h.T_cam_model, depth, K,
                                                  v.inlier_threshold_mm)
                                       .score(v.violation_weight)
                                 : h.inliers;
+  if (visibility) {
+    const std::vector<char> which = inliers_for_ties ? tied(hyps) : std::vector<char>(hyps.size(), 1);
+    count_all(hyps, model, index, v, v.inlier_threshold_mm, &which);
+  }
   std::vector<size_t> order(hyps.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
@@ -160,7 +180,7 @@ std::vector<uint64_t> keep_most_promising(std::vector<Hypothesis>& hyps, const T
     }
     refine_all(hyps, kept_at, model, scene, index, s, &sources);
   }
-  std::vector<size_t> order = verification_order(hyps, model, index, s.verify, depth, K);
+  std::vector<size_t> order = verification_order(hyps, model, index, s.verify, depth, K, /*inliers_for_ties=*/true);
   order.resize(keep);
   std::sort(order.begin(), order.end());
   std::vector<Hypothesis> kept;
