@@ -173,6 +173,34 @@ TEST(KdTree3, RestrictedTreeAnswersAsOneBuiltOverTheSubset) {
   EXPECT_EQ(pb::KdTree3(random_cloud(10, 3, 1.f)).restricted({}, {}, [](int, float x) { return x; }).size(), 0u);
 }
 
+// radius_remaining reports radius_unsorted's points, in its order, without
+// those removed from the Remaining set, as points are removed one by one
+// (region growing's use); removing twice changes nothing.
+TEST(KdTree3, RadiusRemainingIsRadiusUnsortedWithoutTheRemovedPoints) {
+  for (const size_t n : {1u, 50u, 4000u}) {
+    const auto pts = random_cloud(n, 41 + n, 100.f);
+    const pb::KdTree3 tree(pts);
+    pb::KdTree3::Remaining left(tree);
+    std::vector<char> removed(n, 0);
+    pb::Rng rng(7);
+    const auto queries = random_cloud(200, 43, 110.f);
+    for (size_t qi = 0; qi < queries.size(); ++qi) {
+      for (int k = 0; k < 25; ++k) {  // remove a few, some twice
+        const int i = static_cast<int>(rng.uniform(0.0, static_cast<double>(n) - 1e-9));
+        left.remove(i);
+        removed[static_cast<size_t>(i)] = 1;
+      }
+      std::vector<int> all, got, want;
+      tree.radius_unsorted(queries[qi], 30.f, all);
+      for (const int i : all)
+        if (!removed[static_cast<size_t>(i)]) want.push_back(i);
+      tree.radius_remaining(queries[qi], 30.f, left, got);
+      ASSERT_EQ(got, want) << "n " << n << " query " << qi;
+      for (size_t i = 0; i < n; ++i) ASSERT_EQ(left.has(static_cast<int>(i)), !removed[i]);
+    }
+  }
+}
+
 // within: strictly below the bound (a point exactly at it is left out, as
 // FLANN's radius search), sorted by (distance, index) with duplicates
 // (equal distances) in index order; unsorted: the same set.

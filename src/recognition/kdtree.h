@@ -44,6 +44,26 @@ class KdTree3 {
   void within(const Vec3f& q, float max_sq_dist, std::vector<std::pair<float, int>>& out, bool sorted = true) const;
   // The same set in tree order (no sort: for sums over the neighbourhood).
   void radius_unsorted(const Vec3f& q, float r, std::vector<int>& out) const;
+  // The points a search still reports (region growing: those no region has
+  // taken yet), counted per node so that a search skips a subtree with none
+  // left. Starts with every point of `tree`, which must outlive it.
+  class Remaining {
+   public:
+    explicit Remaining(const KdTree3& tree);
+    bool has(int index) const { return alive_[static_cast<size_t>(tree_->position_[static_cast<size_t>(index)])] != 0; }
+    void remove(int index);  // an input index; nothing when already removed
+
+   private:
+    friend class KdTree3;
+    const KdTree3* tree_;
+    std::vector<int> count_;   // per node: points left in its subtree
+    std::vector<int> parent_;  // per node (-1: the root)
+    std::vector<int> leaf_;    // per tree position: its leaf
+    std::vector<char> alive_;  // per tree position
+  };
+  // radius_unsorted without the points `left` no longer has: the others in
+  // the same order (kdtree_remaining.cpp).
+  void radius_remaining(const Vec3f& q, float r, const Remaining& left, std::vector<int>& out) const;
   // The list of within(q, max_sq_dist, out, false) thinned by
   // keep_evenly(out, max_points), the same entries in the same order, and
   // how many points were within (before thinning). Counted: without
@@ -121,6 +141,7 @@ class KdTree3 {
   int build(std::vector<Entry>& entries, int begin, int end, int leaf_size);
   void nearest_in(int node, const Vec3f& q, int& best, float& best_d) const;
   int any_in(int node, const Vec3f& q, float bound, int tie_below) const;
+  void remaining_in(int node, const Vec3f& q, float r2, const Remaining& left, std::vector<int>& out) const;
   // Squared distances from q of the m <= 4 points at tree positions i..i+m
   // into d4 (as Eigen's squaredNorm computes them); bit k of the result: the
   // k-th is at most `bound`.

@@ -50,20 +50,21 @@ std::vector<Region> stable_regions(const PointSet& cloud, const GlobalSettings& 
 
   const double cos_eps = std::cos(s.cvfh_eps_angle_deg * M_PI / 180.0);
   const float tol = static_cast<float>(s.cvfh_cluster_tolerance_mm);
-  std::vector<char> processed(pts.size(), 0);
+  // The points not yet processed (in a region or a seed): the searches
+  // report only those, in the order radius_unsorted would.
+  KdTree3::Remaining unprocessed(tree);
   std::vector<int> nn, queue;
   for (size_t i = 0; i < pts.size(); ++i) {
-    if (processed[i]) continue;
-    processed[i] = 1;
+    if (!unprocessed.has(static_cast<int>(i))) continue;
+    unprocessed.remove(static_cast<int>(i));
     queue.assign(1, static_cast<int>(i));
     for (size_t q = 0; q < queue.size(); ++q) {
       const size_t seed = static_cast<size_t>(queue[q]);
       const Vec3f& ns = nrm[seed];
-      tree.radius_unsorted(pts[seed], tol, nn);
+      tree.radius_remaining(pts[seed], tol, unprocessed, nn);
       for (const int j : nn) {
-        if (processed[static_cast<size_t>(j)]) continue;
         if (static_cast<double>(ns.dot(nrm[static_cast<size_t>(j)])) > cos_eps) {
-          processed[static_cast<size_t>(j)] = 1;
+          unprocessed.remove(j);
           queue.push_back(j);
         }
       }
