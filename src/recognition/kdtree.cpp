@@ -148,27 +148,6 @@ int KdTree3::any_preferred(const Vec3f& q, int index) const {
   return any_in(0, q, d, index);
 }
 
-template <class F>
-void KdTree3::visit_radius(int node, const Vec3f& q, float r2, F& f) const {
-  const Node& n = nodes_[static_cast<size_t>(node)];
-  if (n.dim < 0) {
-    // Four at a time, the same distances as squaredNorm, visited in tree order.
-    float d4[4];
-    for (int i = n.begin; i < n.end; i += 4) {
-      const int m = std::min(4, n.end - i);
-      for (int mask = leaf_distances(q, i, m, r2, d4); mask != 0; mask &= mask - 1) {
-        const int k = __builtin_ctz(static_cast<unsigned>(mask));
-        f(d4[k], order_[static_cast<size_t>(i + k)]);
-      }
-    }
-    return;
-  }
-  const float diff = q[n.dim] - n.split;
-  const int near = diff < 0 ? n.left : n.right, far = diff < 0 ? n.right : n.left;
-  visit_radius(near, q, r2, f);
-  if (diff * diff <= r2) visit_radius(far, q, r2, f);
-}
-
 void KdTree3::radius(const Vec3f& q, float r, std::vector<int>& out) const {
   out.clear();
   if (nodes_.empty() || !q.allFinite() || !(r > 0)) return;

@@ -141,14 +141,17 @@ class KdTree3 {
   int build(std::vector<Entry>& entries, int begin, int end, int leaf_size);
   void nearest_in(int node, const Vec3f& q, int& best, float& best_d) const;
   int any_in(int node, const Vec3f& q, float bound, int tie_below) const;
-  void remaining_in(int node, const Vec3f& q, float r2, const Remaining& left, std::vector<int>& out) const;
   // Squared distances from q of the m <= 4 points at tree positions i..i+m
   // into d4 (as Eigen's squaredNorm computes them); bit k of the result: the
   // k-th is at most `bound`.
   int leaf_distances(const Vec3f& q, int i, int m, float bound, float* d4) const;
-  // Calls f(squared distance, input index) for every point within sqrt(r2).
-  template <class F>
-  void visit_radius(int node, const Vec3f& q, float r2, F& f) const;
+  // Calls f(squared distance, input index) for every point within sqrt(r2)
+  // of the subtrees for which skip(node) is false (kdtree_leaf.h).
+  struct NoSkip {
+    bool operator()(int) const { return false; }
+  };
+  template <class F, class Skip = NoSkip>
+  void visit_radius(int node, const Vec3f& q, float r2, F& f, const Skip& skip = Skip()) const;
 
   std::vector<Vec3f> points_;  // in tree order (cache friendly)
   std::vector<float> xyz_[3];  // the same, one array per coordinate (four at a time)

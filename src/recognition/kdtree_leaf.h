@@ -1,7 +1,8 @@
-// KdTree3's leaf kernel, shared by the .cpp files of the tree's searches
-// (kdtree.cpp, kdtree_remaining.cpp): private to them.
+// KdTree3's leaf kernel and radius traversal, shared by the .cpp files of
+// the tree's searches (kdtree.cpp, kdtree_remaining.cpp): private to them.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #ifdef __SSE2__
 #include <xmmintrin.h>
@@ -28,6 +29,29 @@ inline int KdTree3::leaf_distances(const Vec3f& q, int i, int m, float bound, fl
   }
   return mask;
 #endif
+}
+
+
+template <class F, class Skip>
+void KdTree3::visit_radius(int node, const Vec3f& q, float r2, F& f, const Skip& skip) const {
+  if (skip(node)) return;
+  const Node& n = nodes_[static_cast<size_t>(node)];
+  if (n.dim < 0) {
+    // Four at a time, the same distances as squaredNorm, visited in tree order.
+    float d4[4];
+    for (int i = n.begin; i < n.end; i += 4) {
+      const int m = std::min(4, n.end - i);
+      for (int mask = leaf_distances(q, i, m, r2, d4); mask != 0; mask &= mask - 1) {
+        const int k = __builtin_ctz(static_cast<unsigned>(mask));
+        f(d4[k], order_[static_cast<size_t>(i + k)]);
+      }
+    }
+    return;
+  }
+  const float diff = q[n.dim] - n.split;
+  const int near = diff < 0 ? n.left : n.right, far = diff < 0 ? n.right : n.left;
+  visit_radius(near, q, r2, f, skip);
+  if (diff * diff <= r2) visit_radius(far, q, r2, f, skip);
 }
 
 }  // namespace pb

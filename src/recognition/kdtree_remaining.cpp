@@ -36,31 +36,14 @@ void KdTree3::Remaining::remove(int index) {
   for (int node = leaf_[pos]; node >= 0; node = parent_[static_cast<size_t>(node)]) --count_[static_cast<size_t>(node)];
 }
 
-// visit_radius's order and pruning, and a subtree with nothing left skipped.
-void KdTree3::remaining_in(int node, const Vec3f& q, float r2, const Remaining& left, std::vector<int>& out) const {
-  if (left.count_[static_cast<size_t>(node)] == 0) return;
-  const Node& n = nodes_[static_cast<size_t>(node)];
-  if (n.dim < 0) {
-    float d4[4];
-    for (int i = n.begin; i < n.end; i += 4) {
-      const int m = std::min(4, n.end - i);
-      for (int mask = leaf_distances(q, i, m, r2, d4); mask != 0; mask &= mask - 1) {
-        const size_t pos = static_cast<size_t>(i + __builtin_ctz(static_cast<unsigned>(mask)));
-        if (left.alive_[pos]) out.push_back(order_[pos]);
-      }
-    }
-    return;
-  }
-  const float diff = q[n.dim] - n.split;
-  const int near = diff < 0 ? n.left : n.right, far = diff < 0 ? n.right : n.left;
-  remaining_in(near, q, r2, left, out);
-  if (diff * diff <= r2) remaining_in(far, q, r2, left, out);
-}
-
+// visit_radius's order and pruning; a subtree with nothing left is skipped.
 void KdTree3::radius_remaining(const Vec3f& q, float r, const Remaining& left, std::vector<int>& out) const {
   out.clear();
   if (nodes_.empty() || !q.allFinite() || !(r > 0)) return;
-  remaining_in(0, q, r * r, left, out);
+  auto add = [&left, &out](float, int i) {
+    if (left.has(i)) out.push_back(i);
+  };
+  visit_radius(0, q, r * r, add, [&left](int node) { return left.count_[static_cast<size_t>(node)] == 0; });
 }
 
 }  // namespace pb
