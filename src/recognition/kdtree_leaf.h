@@ -31,7 +31,8 @@ inline int KdTree3::leaf_distances(const Vec3f& q, int i, int m, float bound, fl
 #endif
 }
 
-
+// visit_radius (kdtree.h): near child first, the far one when the splitting
+// plane is within the radius.
 template <class F, class Skip>
 void KdTree3::visit_radius(int node, const Vec3f& q, float r2, F& f, const Skip& skip) const {
   if (skip(node)) return;
