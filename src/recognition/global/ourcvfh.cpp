@@ -108,6 +108,14 @@ class GivenRegions : public pcl::OURCVFHEstimation<pcl::PointXYZ, pcl::Normal, p
   }
 };
 
+// The CVFH family's settings (in metres) and OUR-CVFH's axis rules.
+void configure_ourcvfh(pcl::OURCVFHEstimation<pcl::PointXYZ, pcl::Normal, pcl::VFHSignature308>& est,
+                       const PclInput& in, const GlobalSettings& s) {
+  configure_cvfh_family(est, in, s, kToM);
+  est.setAxisRatio(static_cast<float>(s.ourcvfh_axis_ratio));
+  est.setMinAxisValue(static_cast<float>(s.ourcvfh_min_axis_value));
+}
+
 // The signatures, regions and frames PCL computed, in millimetres.
 std::vector<Signature> read_signatures(pcl::OURCVFHEstimation<pcl::PointXYZ, pcl::Normal, pcl::VFHSignature308>& est,
                                        const pcl::PointCloud<pcl::VFHSignature308>& sigs) {
@@ -191,17 +199,13 @@ std::vector<Signature> ourcvfh_signatures(const PointSet& cloud, const GlobalSet
     // No region: PCL's OUR-CVFH falls back to the VFH of all the points
     // (no frame, centroid only).
     pcl::OURCVFHEstimation<pcl::PointXYZ, pcl::Normal, pcl::VFHSignature308> est;
-    configure_cvfh_family(est, in, s, kToM);
-    est.setAxisRatio(static_cast<float>(s.ourcvfh_axis_ratio));
-    est.setMinAxisValue(static_cast<float>(s.ourcvfh_min_axis_value));
+    configure_ourcvfh(est, in, s);
     est.setRefineClusters(static_cast<float>(refine));
     est.compute(sigs);
     return read_signatures(est, sigs);
   }
   GivenRegions est;
-  configure_cvfh_family(est, in, s, kToM);
-  est.setAxisRatio(static_cast<float>(s.ourcvfh_axis_ratio));
-  est.setMinAxisValue(static_cast<float>(s.ourcvfh_min_axis_value));
+  configure_ourcvfh(est, in, s);
   est.describe(in, scaled, std::move(regions), s.cvfh_normalize_bins, sigs);
   return read_signatures(est, sigs);
 }
@@ -210,9 +214,7 @@ std::vector<Signature> ourcvfh_signatures_pcl(const PointSet& cloud, const Globa
   if (!cloud.has_normals()) return {};
   const PclInput in = pcl_input(cloud, kToM, true);
   pcl::OURCVFHEstimation<pcl::PointXYZ, pcl::Normal, pcl::VFHSignature308> est;
-  configure_cvfh_family(est, in, s, kToM);
-  est.setAxisRatio(static_cast<float>(s.ourcvfh_axis_ratio));
-  est.setMinAxisValue(static_cast<float>(s.ourcvfh_min_axis_value));
+  configure_ourcvfh(est, in, s);
   est.setRefineClusters(static_cast<float>(s.ourcvfh_refine_clusters));
   pcl::PointCloud<pcl::VFHSignature308> sigs;
   est.compute(sigs);
