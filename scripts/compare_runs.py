@@ -9,7 +9,10 @@ A cell is (experiment, scene set, descriptor, refinement, added noise, the
 trial's params); its count is the correct records of k/n. Per cell, Fisher's
 exact test (two-sided) of the two counts. Prints the totals (cells, equal,
 up, down, p < 0.05), the significant cells, the cells that moved most, and
-the worker seconds (records' wall_s) per experiment. Records are read with
+the worker seconds (records' wall_s) per experiment, and the trials paired
+across the runs by experiment and trial key (the same image and seed):
+how many are correct in one run only, with McNemar's exact test of the two
+runs' robustness over all cells. Records are read with
 thesis_report.py's loader (checked against the trial record's schema). Exit
 2, naming the file, line and key, for a record that does not fit, and for a
 folder without records. Cells found in one run only are counted as
@@ -24,7 +27,7 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from thesis_report import RECORD_SCHEMA, InputError, load_records  # noqa: E402
-from thesis_stats import fisher_exact  # noqa: E402
+from thesis_stats import fisher_exact, mcnemar_exact  # noqa: E402
 
 
 def record_files(folder):
@@ -35,12 +38,15 @@ def record_files(folder):
     return {os.path.basename(os.path.dirname(p)): p for p in sorted(glob.glob(os.path.join(folder, "*", "records.jsonl")))}
 
 
-def cells(folder):
-    """({cell: [k, n]}, {experiment: worker seconds}) of a folder's records."""
+def cells(folder, trials=None):
+    """({cell: [k, n]}, {experiment: worker seconds}) of a folder's records;
+    with a dict `trials`, also {(experiment, trial key): correct} into it."""
     counts = collections.defaultdict(lambda: [0, 0])
     seconds = collections.Counter()
     for exp, path in record_files(folder).items():
         for r in load_records(path, RECORD_SCHEMA):
+            if trials is not None:
+                trials[(exp, r["key"])] = bool(r.get("correct"))
             key = (exp, r["scene"], r["descriptor"], r["refinement"], r["added_noise_mm"],
                    json.dumps(r["params"], sort_keys=True))
             counts[key][0] += bool(r.get("correct"))
@@ -72,6 +78,16 @@ def compare(before, after):
     return out
 
 
+def paired(before, after):
+    """The trials of both runs ({(experiment, key): correct} each), paired:
+    how many are in both, correct in the first only and in the second only,
+    and McNemar's exact p of those two counts."""
+    both = set(before) & set(after)
+    first = sum(1 for t in both if before[t] and not after[t])
+    second = sum(1 for t in both if after[t] and not before[t])
+    return {"pairs": len(both), "before_only": first, "after_only": second, "p": mcnemar_exact(first, second)}
+
+
 def name(cell):
     exp, scene, desc, ref, noise, params = cell
     return f"{exp} {scene} {desc}+{ref} noise {noise:g}" + ("" if params == "{}" else f" {params}")
@@ -84,10 +100,10 @@ def main(argv=None):
     ap.add_argument("--json", help="also write the comparison as JSON to this file")
     ap.add_argument("--moved", type=int, default=15, help="list this many of the cells that moved most")
     a = ap.parse_args(argv)
-    runs = []
-    for folder in (a.before, a.after):
+    runs, trials = [], ({}, {})
+    for folder, t in zip((a.before, a.after), trials):
         try:
-            c, s = cells(folder)
+            c, s = cells(folder, t)
         except InputError as e:
             print(f"compare_runs.py: {e}", file=sys.stderr)
             return 2
@@ -99,6 +115,9 @@ def main(argv=None):
     print(f"{r['cells']} cells, {r['trials']} trials: correct {r['correct_before']} -> {r['correct_after']}; "
           f"{r['equal']} equal, {r['up']} up, {r['down']} down, {len(r['significant'])} at p < 0.05 "
           f"(Fisher's exact test per cell); {r['unmatched']} in one run only")
+    pr = paired(*trials)
+    print(f"paired trials (experiment, trial key): {pr['pairs']}; correct before only {pr['before_only']}, "
+          f"after only {pr['after_only']}; McNemar's exact test p = {pr['p']:.3g}")
     for c in r["significant"]:
         print(f"  p = {c['p']:.3g}: {name(c['cell'])} {c['before'][0]}/{c['before'][1]} -> {c['after'][0]}/{c['after'][1]}")
     for c in r["moved"][:a.moved]:
@@ -110,7 +129,7 @@ def main(argv=None):
     print(f"  total: {sum(sb.values()):.0f} -> {sum(sa.values()):.0f}")
     if a.json:
         with open(a.json, "w") as f:
-            json.dump({**r, "seconds_before": sb, "seconds_after": sa}, f, indent=1)
+            json.dump({**r, "paired": pr, "seconds_before": sb, "seconds_after": sa}, f, indent=1)
     return 0
 
 

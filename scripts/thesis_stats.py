@@ -2,6 +2,7 @@
 
 wilson(k, n)            the 95% Wilson score interval of k of n
 fisher_exact(a, n, b, m) two-sided Fisher's exact test of a of n against b of m
+mcnemar_exact(b, c)     two-sided exact McNemar test of paired trials (b, c: the discordant pairs)
 kendall_tau(x, y)       Kendall's tau-b of two equally long sequences (None when undefined)
 count_of(value, n)      the count k = round(value * n) behind a printed fraction
 printable_as_count(value, n)  whether a printed percentage can be some k/n
@@ -41,6 +42,19 @@ def fisher_exact(a, n, b, m):
     observed = weights[a - lo]
     p = sum(w for w in weights if w <= observed * (1 + FISHER_REL_TOL)) / math.comb(total, k)
     return min(1.0, p)
+
+
+def mcnemar_exact(b, c):
+    """Two-sided p of McNemar's exact test for paired trials: b pairs correct
+    in the first run only, c in the second only. Under no difference each
+    discordant pair falls either way with probability 1/2, so the p is twice
+    the binomial tail of min(b, c) in b + c draws (at most 1); 1 when no pair
+    differs."""
+    if b < 0 or c < 0:
+        raise ValueError("negative counts: %d, %d" % (b, c))
+    n = b + c
+    tail = sum(math.comb(n, i) for i in range(min(b, c) + 1))
+    return min(1.0, 2 * tail / 2 ** n)
 
 
 def _sign(v, tol=1e-12):

@@ -76,6 +76,22 @@ class CompareRuns(unittest.TestCase):
         self.assertEqual(code, 0)
         self.assertIn("1 down", out)
         self.assertIn("moved: table_4_1 table_synthetic fpfh+icp noise 0 2/2 -> 0/2", out)
+        # Paired by trial: the two fpfh trials correct before only; 2 of 2 discordant pairs one way.
+        self.assertIn("correct before only 2, after only 0; McNemar's exact test p = 0.5", out)
+
+    def test_trials_paired_by_experiment_and_key(self):
+        before = {("e", "k1"): True, ("e", "k2"): False, ("e", "k3"): True, ("f", "k1"): False, ("e", "old"): True}
+        after = {("e", "k1"): True, ("e", "k2"): True, ("e", "k3"): False, ("f", "k1"): True, ("e", "new"): False}
+        pr = cr.paired(before, after)
+        self.assertEqual((pr["pairs"], pr["before_only"], pr["after_only"]), (4, 1, 2))
+        self.assertEqual(pr["p"], 1.0)
+        # The fixture folder against itself: every trial paired, none discordant.
+        trials = ({}, {})
+        cr.cells(self.before, trials[0])
+        cr.cells(self.after, trials[1])
+        pr = cr.paired(*trials)
+        self.assertEqual((pr["pairs"], pr["before_only"], pr["after_only"], pr["p"]), (len(trials[0]), 0, 0, 1.0))
+        self.assertGreater(pr["pairs"], 0)
 
     def test_broken_record_and_empty_folder_are_exit_2(self):
         self.edit(self.after, "fig_4_12", lambda r: {k: v for k, v in r.items() if k != "scene"})

@@ -34,6 +34,17 @@ class Stats(unittest.TestCase):
         with self.assertRaises(ValueError):
             st.fisher_exact(11, 10, 0, 10)
 
+    def test_mcnemar_known_values(self):
+        self.assertEqual(st.mcnemar_exact(0, 0), 1.0)
+        self.assertEqual(st.mcnemar_exact(5, 5), 1.0)
+        # ten discordant pairs all one way: twice 1/1024
+        self.assertEqual(st.mcnemar_exact(10, 0), 2 / 1024)
+        self.assertEqual(st.mcnemar_exact(0, 10), 2 / 1024)
+        # 1 against 6: twice (1 + 7) / 128
+        self.assertEqual(st.mcnemar_exact(1, 6), 0.125)
+        with self.assertRaises(ValueError):
+            st.mcnemar_exact(-1, 3)
+
     def test_fisher_counts_tables_as_probable_as_the_observed(self):
         # 1 of 2 against 1 of 2: the tables 0/2-2/2 and 2/2-0/2 are less probable; 1-1 is the observed: p = 1.
         self.assertEqual(st.fisher_exact(1, 2, 1, 2), 1.0)
