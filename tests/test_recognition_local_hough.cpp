@@ -221,16 +221,51 @@ TEST_P(LocalMethodOnCopy, FindsTransformSaveLoadAndThreads) {
   EXPECT_TRUE(m->hypothesize(PointSet{}, views, 1, times).empty());
 }
 
+// support_from_keypoints: descriptors and frames from the keypoints alone
+// (10 mm keypoints on the 4 mm surface, so a 60 mm support holds about 110
+// of them) still find the transform, and they are another computation:
+// the hypotheses differ from those of every point as support.
+TEST_P(LocalMethodOnCopy, SupportFromKeypointsFindsTheTransform) {
+  const PointSet model = bumpy_surface();
+  const Pose T = known_transform();
+  const PointSet scene = transformed(model, T);
+  std::vector<ViewData> views(1);
+  views[0].cloud = model;
+  views[0].T_cam_model = Pose::identity();
+  LocalSettings s;
+  s.keypoint_voxel_mm = 10;
+  s.descriptor_radius_mm = 60;
+  s.lrf_radius_mm = 40;
+  s.threads = 1;
+  std::vector<std::vector<Hypothesis>> found;
+  for (bool from_keypoints : {false, true}) {
+    s.support_from_keypoints = from_keypoints;
+    auto m = local_method(GetParam(), s);
+    m->train(views, 1);
+    StageTimes times;
+    found.push_back(m->hypothesize(scene, views, 1, times));
+    ASSERT_FALSE(found.back().empty()) << "support_from_keypoints " << from_keypoints;
+    EXPECT_LT(trans_err(found.back()[0].T_cam_model, T), 5.0) << "support_from_keypoints " << from_keypoints;
+    EXPECT_LT(rot_err_deg(found.back()[0].T_cam_model, T), 3.0) << "support_from_keypoints " << from_keypoints;
+  }
+  bool same = found[0].size() == found[1].size();
+  for (size_t i = 0; same && i < found[0].size(); ++i)
+    same = found[0][i].T_cam_model.matrix() == found[1][i].T_cam_model.matrix() && found[0][i].score == found[1][i].score;
+  EXPECT_FALSE(same) << "the keypoints as support gave the hypotheses of every point";
+}
+
 INSTANTIATE_TEST_SUITE_P(Descriptors, LocalMethodOnCopy, ::testing::Values("fpfh", "shot"));
 
 TEST(LocalSettings, ParseAndReject) {
   LocalSettings s;
-  parse_section(YamlNode::load_string("keypoint_voxel_mm: 10\nmatches_per_keypoint: 3\nhough_interpolation: true\n",
+  parse_section(YamlNode::load_string("keypoint_voxel_mm: 10\nmatches_per_keypoint: 3\nhough_interpolation: true\n"
+                                      "support_from_keypoints: true\n",
                                     "cfg.yaml"),
               s);
   EXPECT_EQ(s.keypoint_voxel_mm, 10.0);
   EXPECT_EQ(s.matches_per_keypoint, 3);
   EXPECT_TRUE(s.hough_interpolation);
+  EXPECT_TRUE(s.support_from_keypoints);
   EXPECT_THROW(parse_section(YamlNode::load_string("keypoint_voxl_mm: 10\n", "cfg.yaml"), s), InputError);
   EXPECT_THROW(parse_section(YamlNode::load_string("hough_bin_mm: -5\n", "cfg.yaml"), s), InputError);
   EXPECT_THROW(parse_section(YamlNode::load_string("max_hypotheses: 0\n", "cfg.yaml"), s), InputError);

@@ -20,6 +20,14 @@ struct LocalSettings {
                                         // cost where a support radius holds thousands of points
                                         // (large objects on small voxels, noise that turns a
                                         // surface into a volume)
+  bool support_from_keypoints = false;  // FPFH, SHOT and the BOARD frames take their neighbours
+                                        // from the keypoints alone (the cloud sampled at
+                                        // keypoint_voxel_mm), not from every point of the
+                                        // cloud: for supports that hold hundreds of keypoints
+                                        // (large objects: the warehouse's 545 mm radius at 50 mm
+                                        // keypoints holds about 370), where every point's
+                                        // neighbourhood costs most of the description; false:
+                                        // every point, as PCL
   double lrf_radius_mm = 40.0;          // BOARD local reference frame radius (Hough voting)
   double match_threshold = 0.5;         // SHOT: max squared L2 distance between SHOT
                                         // descriptors (unit L2 norm, so in [0, 2]; PCL's
@@ -51,6 +59,7 @@ struct LocalSettings {
     f("keypoint_voxel_mm", s.keypoint_voxel_mm, fields::length(fields::positive()));
     f("descriptor_radius_mm", s.descriptor_radius_mm, fields::length(fields::positive()));
     f("max_support_points", s.max_support_points, fields::at_least(0));
+    f("support_from_keypoints", s.support_from_keypoints);
     f("lrf_radius_mm", s.lrf_radius_mm, fields::length(fields::positive()));
     f("match_threshold", s.match_threshold, fields::positive());
     f("fpfh_match_threshold", s.fpfh_match_threshold, fields::positive());

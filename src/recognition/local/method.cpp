@@ -54,6 +54,30 @@ std::vector<float> descriptors(Kind kind, const PointSet& cloud, const std::vect
                             : compute_shot(cloud, idx, s.descriptor_radius_mm, s.threads, s.max_support_points);
 }
 
+// The cloud FPFH, SHOT and the BOARD frames take their neighbours from, with
+// the keypoints' indices in it: the cloud itself, or the keypoints alone
+// (LocalSettings::support_from_keypoints). Either way keypoint i is the
+// cloud's point idx[i].
+struct Support {
+  PointSet own;            // the keypoints alone, when they are the support
+  const PointSet* cloud;   // the support
+  std::vector<int> at;     // keypoint i is support point at[i]
+};
+
+Support support_of(const PointSet& cloud, const std::vector<int>& idx, const LocalSettings& s) {
+  Support sp;
+  if (!s.support_from_keypoints) {
+    sp.cloud = &cloud;
+    sp.at = idx;
+    return sp;
+  }
+  sp.own = subset(cloud, idx);
+  sp.cloud = &sp.own;
+  sp.at.resize(idx.size());
+  for (size_t i = 0; i < idx.size(); ++i) sp.at[i] = static_cast<int>(i);
+  return sp;
+}
+
 Described keep_valid(const PointSet& cloud, const std::vector<int>& idx, const std::vector<float>& desc,
                      const std::vector<float>& lrf, int dim) {
   Described d;
@@ -81,8 +105,9 @@ class LocalMethod : public Method {
     views_.clear();
     for (const ViewData& v : views) {
       const std::vector<int> idx = voxel_keypoints(v.cloud, s.keypoint_voxel_mm);
-      const std::vector<float> desc = descriptors(kind_, v.cloud, idx, s);
-      const std::vector<float> lrf = compute_board_lrf(v.cloud, idx, s.lrf_radius_mm);
+      const Support sp = support_of(v.cloud, idx, s);
+      const std::vector<float> desc = descriptors(kind_, *sp.cloud, sp.at, s);
+      const std::vector<float> lrf = compute_board_lrf(*sp.cloud, sp.at, s.lrf_radius_mm);
       views_.push_back(keep_valid(v.cloud, idx, desc, lrf, dim_of(kind_)));
     }
     build_index();
@@ -135,7 +160,8 @@ class LocalMethod : public Method {
     // descriptor are matched.
     Timer timer;
     const std::vector<int> idx = voxel_keypoints(scene, s.keypoint_voxel_mm);
-    const std::vector<float> desc = descriptors(kind_, scene, idx, s);
+    const Support sp = support_of(scene, idx, s);
+    const std::vector<float> desc = descriptors(kind_, *sp.cloud, sp.at, s);
     std::vector<int> described;  // positions in idx
     for (size_t i = 0; i < idx.size(); ++i)
       if (finite_row(desc.data() + i * dim, dim)) described.push_back(static_cast<int>(i));
@@ -173,10 +199,10 @@ class LocalMethod : public Method {
     // has no valid frame is dropped. Each keypoint is matched on its own, so
     // the matches are those of describing every keypoint's frame first.
     timer.reset();
-    std::vector<int> matched;  // scene point indices
+    std::vector<int> matched;  // support point indices
     for (size_t i = 0; i < nn.size(); ++i)
-      if (!nn[i].empty()) matched.push_back(idx[static_cast<size_t>(described[i])]);
-    const std::vector<float> lrf = compute_board_lrf(scene, matched, s.lrf_radius_mm);
+      if (!nn[i].empty()) matched.push_back(sp.at[static_cast<size_t>(described[i])]);
+    const std::vector<float> lrf = compute_board_lrf(*sp.cloud, matched, s.lrf_radius_mm);
     Described sc;  // the voting keypoints (no descriptors)
     std::vector<std::vector<Match>> per_view(views_.size());
     for (size_t i = 0, m = 0; i < nn.size(); ++i) {
