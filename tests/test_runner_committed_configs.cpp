@@ -1,6 +1,8 @@
 // Every experiment config the project commits loads: configs/experiments,
 // configs/thesis, configs/bench and the probes of results/thesis/findings
-// (a YAML with `scenes` and `descriptors` at the top). Loading validates
+// (a YAML with `scenes` and `descriptors` at the top), and so does every
+// ablation experiment scripts/thesis_ablations.py derives from
+// configs/thesis/ablations.yaml. Loading validates
 // every key of every settings section, so a misspelt or removed setting in
 // a committed config fails here, not in a user's run. And a config with a
 // misspelt setting is the InputError a user would get: the file, the key
@@ -8,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -52,6 +55,24 @@ TEST(CommittedConfigs, EveryExperimentLoads) {
     }
   }
   EXPECT_GE(loaded, 20u);
+}
+
+TEST(CommittedConfigs, EveryDerivedAblationLoads) {
+  fs::current_path(POSEBENCH_SOURCE_DIR);
+  const std::string out = ::testing::TempDir() + "/ablations";
+  fs::remove_all(out);
+  const std::string cmd = "python3 scripts/thesis_ablations.py configs/thesis/ablations.yaml " + out + " > /dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  const std::vector<std::string> files = experiments_under(out);
+  EXPECT_GE(files.size(), 20u);
+  for (const std::string& f : files) {
+    SCOPED_TRACE(f);
+    try {
+      EXPECT_FALSE(pb::load_experiment(f).descriptors.empty());
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << e.what();
+    }
+  }
 }
 
 TEST(CommittedConfigs, TheBenchConfigWithAMisspeltSettingNamesFileKeyAndAllowedKeys) {
