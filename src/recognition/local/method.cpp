@@ -57,22 +57,22 @@ std::vector<float> descriptors(Kind kind, const PointSet& cloud, const std::vect
 // The cloud FPFH, SHOT and the BOARD frames take their neighbours from, with
 // the keypoints' indices in it: the cloud itself, or the keypoints alone
 // (LocalSettings::support_from_keypoints). Either way keypoint i is the
-// cloud's point idx[i].
+// cloud's point idx[i]. Safe to copy: no pointer into itself.
 struct Support {
-  PointSet own;            // the keypoints alone, when they are the support
-  const PointSet* cloud;   // the support
-  std::vector<int> at;     // keypoint i is support point at[i]
+  const PointSet* whole = nullptr;  // the cloud, when it is the support
+  PointSet own;                     // else the keypoints alone
+  std::vector<int> at;              // keypoint i is support point at[i]
+  const PointSet& cloud() const { return whole ? *whole : own; }
 };
 
 Support support_of(const PointSet& cloud, const std::vector<int>& idx, const LocalSettings& s) {
   Support sp;
   if (!s.support_from_keypoints) {
-    sp.cloud = &cloud;
+    sp.whole = &cloud;
     sp.at = idx;
     return sp;
   }
   sp.own = subset(cloud, idx);
-  sp.cloud = &sp.own;
   sp.at.resize(idx.size());
   for (size_t i = 0; i < idx.size(); ++i) sp.at[i] = static_cast<int>(i);
   return sp;
@@ -106,8 +106,8 @@ class LocalMethod : public Method {
     for (const ViewData& v : views) {
       const std::vector<int> idx = voxel_keypoints(v.cloud, s.keypoint_voxel_mm);
       const Support sp = support_of(v.cloud, idx, s);
-      const std::vector<float> desc = descriptors(kind_, *sp.cloud, sp.at, s);
-      const std::vector<float> lrf = compute_board_lrf(*sp.cloud, sp.at, s.lrf_radius_mm);
+      const std::vector<float> desc = descriptors(kind_, sp.cloud(), sp.at, s);
+      const std::vector<float> lrf = compute_board_lrf(sp.cloud(), sp.at, s.lrf_radius_mm);
       views_.push_back(keep_valid(v.cloud, idx, desc, lrf, dim_of(kind_)));
     }
     build_index();
@@ -161,7 +161,7 @@ class LocalMethod : public Method {
     Timer timer;
     const std::vector<int> idx = voxel_keypoints(scene, s.keypoint_voxel_mm);
     const Support sp = support_of(scene, idx, s);
-    const std::vector<float> desc = descriptors(kind_, *sp.cloud, sp.at, s);
+    const std::vector<float> desc = descriptors(kind_, sp.cloud(), sp.at, s);
     std::vector<int> described;  // positions in idx
     for (size_t i = 0; i < idx.size(); ++i)
       if (finite_row(desc.data() + i * dim, dim)) described.push_back(static_cast<int>(i));
@@ -202,7 +202,7 @@ class LocalMethod : public Method {
     std::vector<int> matched;  // support point indices
     for (size_t i = 0; i < nn.size(); ++i)
       if (!nn[i].empty()) matched.push_back(sp.at[static_cast<size_t>(described[i])]);
-    const std::vector<float> lrf = compute_board_lrf(*sp.cloud, matched, s.lrf_radius_mm);
+    const std::vector<float> lrf = compute_board_lrf(sp.cloud(), matched, s.lrf_radius_mm);
     Described sc;  // the voting keypoints (no descriptors)
     std::vector<std::vector<Match>> per_view(views_.size());
     for (size_t i = 0, m = 0; i < nn.size(); ++i) {
