@@ -25,9 +25,8 @@ struct LocalSettings {
                                         // keypoint_voxel_mm), not from every point of the
                                         // cloud: for supports that hold hundreds of keypoints
                                         // (large objects: the warehouse's 545 mm radius at 50 mm
-                                        // keypoints holds about 370), where every point's
-                                        // neighbourhood costs most of the description; false:
-                                        // every point, as PCL
+                                        // keypoints), where every point's neighbourhood costs
+                                        // most of the description; false: every point, as PCL
   double lrf_radius_mm = 40.0;          // BOARD local reference frame radius (Hough voting)
   double match_threshold = 0.5;         // SHOT: max squared L2 distance between SHOT
                                         // descriptors (unit L2 norm, so in [0, 2]; PCL's
