@@ -15,6 +15,7 @@ TEST(CliBenchPipeline, WritesOneRowPerSceneAndMethodFromTheRunsRecords) {
   pbcli::write_file(tmp.path + "/scene.yaml", pbcli::kSmallTableScene);
   pbcli::write_file(tmp.path + "/bench.yaml", "name: b\nseed: 1\nobject: ls5\nscenes:\n  - name: small\n"
                                               "    generate: " + tmp.path + "/scene.yaml\n    scenario: table\n"
+                                              "    settings: {global: {esf_samples_from_points: true}}\n"
                                               "descriptors: [cvfh, ppf]\nrefinements: [icp]\n");
   const auto r = pbcli::run("bench-pipeline bench.yaml --out out --cache '' --scenes s -q", tmp.path);
   ASSERT_EQ(r.code, 0) << r.err;
@@ -31,6 +32,10 @@ TEST(CliBenchPipeline, WritesOneRowPerSceneAndMethodFromTheRunsRecords) {
   EXPECT_NE(md.find("| small | cvfh+icp |"), std::string::npos) << md;
   EXPECT_NE(md.find("| small | ppf+icp |"), std::string::npos) << md;
   EXPECT_NE(r.out.find("| small | ppf+icp |"), std::string::npos);
+  // What was timed: the scene set's own settings, in both files.
+  EXPECT_EQ(j.at("settings").at("small").at("global").at("esf_samples_from_points"), true) << j.dump(1);
+  EXPECT_FALSE(j.at("settings").contains("all")) << j.dump(1);
+  EXPECT_NE(md.find("- small: `{\"global\":{\"esf_samples_from_points\":true}}`"), std::string::npos) << md;
 }
 
 TEST(CliBenchPipeline, BadConfigIsExit2NamingTheFile) {

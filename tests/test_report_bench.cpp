@@ -64,6 +64,18 @@ TEST(BenchTable, RowsHoldStageMediansRobustnessAndTheBudgetVerdict) {
   const auto j = pb::bench_json(t);
   EXPECT_EQ(j.at("rows").at(0).at("correct").at("k"), 2);
   EXPECT_NEAR(j.at("rows").at(1).at("median_s").at("total").get<double>(), 1.2, 1e-12);
+  // No settings given: no settings list.
+  EXPECT_EQ(md.find("Settings over the defaults"), std::string::npos) << md;
+  EXPECT_TRUE(j.at("settings").empty());
+
+  // The settings the config gives, listed under the table and in the JSON.
+  pb::BenchTable with = t;
+  with.settings["all"] = {{"refine", {{"max_hypotheses", 5}}}};
+  with.settings["table_astra"] = {{"local", {{"keypoint_voxel_mm", 15}}}};
+  const std::string md2 = pb::bench_markdown(with);
+  EXPECT_NE(md2.find("- every scene set: `{\"refine\":{\"max_hypotheses\":5}}`"), std::string::npos) << md2;
+  EXPECT_NE(md2.find("- table_astra: `{\"local\":{\"keypoint_voxel_mm\":15}}`"), std::string::npos) << md2;
+  EXPECT_EQ(pb::bench_json(with).at("settings").at("table_astra").at("local").at("keypoint_voxel_mm"), 15);
 }
 
 }  // namespace

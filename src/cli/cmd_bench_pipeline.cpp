@@ -87,6 +87,9 @@ static pb::cli::Command bench_cmd(
                 {"experiment", cfg.name},
                 {"experiment_hash", cfg.hash},
                 {"records", out + "/records.jsonl"}};
+      if (!cfg.settings.empty()) t.settings["all"] = cfg.settings;
+      for (const pb::SceneSource& src : cfg.scenes)
+        if (!src.settings.empty()) t.settings[src.name] = src.settings;
       pb::atomic_write_text(out + "/bench.json", pb::bench_json(t).dump(2) + "\n");
       const std::string md = "# bench-pipeline: " + cfg.name + "\n\n" + pb::bench_markdown(t);
       pb::atomic_write_text(out + "/bench.md", md);

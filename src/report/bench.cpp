@@ -95,7 +95,7 @@ nlohmann::json bench_json(const BenchTable& t) {
                     {"median_hypotheses", num(r.hypotheses)},
                     {"budget_s", r.budget_s},
                     {"within_budget", r.within_budget()}});
-  return {{"host", t.host}, {"rows", rows}};
+  return {{"host", t.host}, {"settings", t.settings}, {"rows", rows}};
 }
 
 std::string bench_markdown(const BenchTable& t) {
@@ -116,6 +116,13 @@ std::string bench_markdown(const BenchTable& t) {
       << " | " << ms(r.total_p90_s) << " | " << budget << " | "
       << (std::isfinite(r.hypotheses) ? std::to_string(static_cast<int>(std::lround(r.hypotheses))) : "-")
       << " | " << c << " |\n";
+  }
+  if (!t.settings.empty()) {
+    o << "\nSettings over the defaults (as the config gives them; every resolved value is in the records' "
+         "settings_resolved):\n\n";
+    for (auto it = t.settings.begin(); it != t.settings.end(); ++it)
+      o << "- " << (it.key() == "all" ? std::string("every scene set") : it.key()) << ": `" << it.value().dump()
+        << "`\n";
   }
   return o.str();
 }

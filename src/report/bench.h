@@ -34,6 +34,11 @@ struct BenchRow {
 struct BenchTable {
   std::vector<BenchRow> rows;     // in the records' first-appearance order
   nlohmann::json host;            // machine and run facts (cpu, cores, threads, date)
+  // The recognition settings the config gives over the defaults, so a table
+  // says what it timed: {"all": the experiment's settings, SCENE: that scene
+  // set's own}; empty ones left out (every resolved value is in the records'
+  // settings_resolved).
+  nlohmann::json settings = nlohmann::json::object();
 };
 
 // Budgets per scenario in seconds (issue targets: table 0.033, warehouse 0.1).
