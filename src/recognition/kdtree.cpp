@@ -68,21 +68,16 @@ int KdTree3::build(std::vector<Entry>& e, int begin, int end, int leaf_size) {
 void KdTree3::nearest_in(int node, const Vec3f& q, int& best, float& best_d) const {
   const Node& n = nodes_[static_cast<size_t>(node)];
   if (n.dim < 0) {
-    // Four squared distances at a time, each as Eigen's squaredNorm sums it
-    // (x^2 + (y^2 + z^2)); only those at most the bound are looked at.
-    float d4[4];
-    for (int i = n.begin; i < n.end; i += 4) {
-      const int m = std::min(4, n.end - i);
-      for (int mask = leaf_distances(q, i, m, best_d, d4); mask != 0; mask &= mask - 1) {
-        const int k = __builtin_ctz(static_cast<unsigned>(mask));
-        const float d = d4[k];
-        const int idx = order_[static_cast<size_t>(i + k)];
-        if (d < best_d || (d == best_d && best >= 0 && idx < best)) {
-          best_d = d;
-          best = idx;
-        }
+    // Squared distances as Eigen's squaredNorm sums them (x^2 + (y^2 +
+    // z^2)); only those at most the best so far are looked at.
+    scan_leaf(n, q, best_d, [&](float d, int pos) {
+      const int idx = order_[static_cast<size_t>(pos)];
+      if (d < best_d || (d == best_d && best >= 0 && idx < best)) {
+        best_d = d;
+        best = idx;
       }
-    }
+      return false;
+    });
     return;
   }
   const float diff = q[n.dim] - n.split;
@@ -115,17 +110,14 @@ int KdTree3::nearest(const Vec3f& q, float* sq_dist, float max_sq_dist, int hint
 int KdTree3::any_in(int node, const Vec3f& q, float bound, int tie_below) const {
   const Node& n = nodes_[static_cast<size_t>(node)];
   if (n.dim < 0) {
-    float d4[4];
-    for (int i = n.begin; i < n.end; i += 4) {
-      const int m = std::min(4, n.end - i);
-      for (int mask = leaf_distances(q, i, m, bound, d4); mask != 0; mask &= mask - 1) {
-        const int k = __builtin_ctz(static_cast<unsigned>(mask));
-        const int idx = order_[static_cast<size_t>(i + k)];
-        // The mask holds d <= bound; point tie_below itself is never one.
-        if ((d4[k] < bound || idx < tie_below) && idx != tie_below) return idx;
-      }
-    }
-    return -1;
+    int found = -1;
+    scan_leaf(n, q, bound, [&](float d, int pos) {
+      const int idx = order_[static_cast<size_t>(pos)];
+      // Every d here is <= bound; point tie_below itself is never one.
+      if ((d < bound || idx < tie_below) && idx != tie_below) found = idx;
+      return found >= 0;
+    });
+    return found;
   }
   const float diff = q[n.dim] - n.split;
   const int near = diff < 0 ? n.left : n.right, far = diff < 0 ? n.right : n.left;
@@ -307,14 +299,10 @@ void KdTree3::runs_of(int node, const Vec3f& q, float bound, std::vector<Run>& r
   }
   if (n.dim < 0) {
     const int first = static_cast<int>(hits.size());
-    float d4[4];
-    for (int i = n.begin; i < n.end; i += 4) {
-      const int m = std::min(4, n.end - i);
-      for (int mask = leaf_distances(q, i, m, bound, d4); mask != 0; mask &= mask - 1) {
-        const int k = __builtin_ctz(static_cast<unsigned>(mask));
-        if (d4[k] < bound) hits.push_back(i + k);  // strictly, as within
-      }
-    }
+    scan_leaf(n, q, bound, [&](float d, int pos) {
+      if (d < bound) hits.push_back(pos);  // strictly, as within
+      return false;
+    });
     const int count = static_cast<int>(hits.size()) - first;
     if (count > 0) runs.push_back({node, first, count});
     return;

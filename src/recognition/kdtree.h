@@ -145,6 +145,12 @@ class KdTree3 {
   // into d4 (as Eigen's squaredNorm computes them); bit k of the result: the
   // k-th is at most `bound`.
   int leaf_distances(const Vec3f& q, int i, int m, float bound, float* d4) const;
+  // Calls f(squared distance, tree position) for each point of leaf `n` at
+  // most `bound` from q, in tree order, four distances at a time; `bound` is
+  // read again for every four, so f may lower it. f returns true to stop the
+  // scan; then so does scan_leaf (kdtree_leaf.h).
+  template <class F>
+  bool scan_leaf(const Node& n, const Vec3f& q, const float& bound, F&& f) const;
   // Calls f(squared distance, input index) for every point within sqrt(r2)
   // of the subtrees for which skip(node) is false (kdtree_leaf.h).
   struct NoSkip {

@@ -31,22 +31,30 @@ inline int KdTree3::leaf_distances(const Vec3f& q, int i, int m, float bound, fl
 #endif
 }
 
+template <class F>
+bool KdTree3::scan_leaf(const Node& n, const Vec3f& q, const float& bound, F&& f) const {
+  float d4[4];
+  for (int i = n.begin; i < n.end; i += 4) {
+    const int m = std::min(4, n.end - i);
+    for (int mask = leaf_distances(q, i, m, bound, d4); mask != 0; mask &= mask - 1) {
+      const int k = __builtin_ctz(static_cast<unsigned>(mask));
+      if (f(d4[k], i + k)) return true;
+    }
+  }
+  return false;
+}
+
 // visit_radius (kdtree.h): near child first, the far one when the splitting
 // plane is within the radius.
 template <class F, class Skip>
 void KdTree3::visit_radius(int node, const Vec3f& q, float r2, F& f, const Skip& skip) const {
   if (skip(node)) return;
   const Node& n = nodes_[static_cast<size_t>(node)];
-  if (n.dim < 0) {
-    // Four at a time, the same distances as squaredNorm, visited in tree order.
-    float d4[4];
-    for (int i = n.begin; i < n.end; i += 4) {
-      const int m = std::min(4, n.end - i);
-      for (int mask = leaf_distances(q, i, m, r2, d4); mask != 0; mask &= mask - 1) {
-        const int k = __builtin_ctz(static_cast<unsigned>(mask));
-        f(d4[k], order_[static_cast<size_t>(i + k)]);
-      }
-    }
+  if (n.dim < 0) {  // the same distances as squaredNorm, visited in tree order
+    scan_leaf(n, q, r2, [&](float d, int pos) {
+      f(d, order_[static_cast<size_t>(pos)]);
+      return false;
+    });
     return;
   }
   const float diff = q[n.dim] - n.split;
