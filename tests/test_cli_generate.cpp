@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <map>
+#include <tuple>
 
 #include "cli_test_util.h"
 #include "io/bop.h"
@@ -58,6 +59,19 @@ TEST(CliGenerate, SameSeedSameBytesOtherSeedOtherScenes) {
   const auto scene = ds.load_scene("test", 1);
   EXPECT_EQ(scene.images.size(), 3u);
   EXPECT_EQ(scene.images.at(0).gt.at(0).obj_id, 2);
+  // The test targets: every object instance visible at least 10% (BOP 2019),
+  // so `object: all` runs every object of the set.
+  ASSERT_TRUE(ta.count("test_targets_bop19.json"));
+  std::map<std::tuple<int, int>, int> expected, listed;  // (im_id, obj_id) -> instances
+  for (const auto& [im, info] : scene.images)
+    for (size_t k = 0; k < info.gt.size(); ++k)
+      if (info.gt_info.at(k).visib_fract >= 0.1) ++expected[{im, info.gt[k].obj_id}];
+  for (const auto& t : pb::read_test_targets(tmp.path + "/a/test_targets_bop19.json")) {
+    EXPECT_EQ(t.scene_id, 1);
+    listed[{t.im_id, t.obj_id}] = t.inst_count;
+  }
+  EXPECT_EQ(listed, expected);
+  EXPECT_GE(expected.size(), 3u);  // the target in each of the 3 images, at least
 
   auto c = pbcli::run("generate small_table.yaml --out c --seed 6 --quiet", tmp.path);
   ASSERT_EQ(c.code, 0) << c.err;

@@ -108,6 +108,43 @@ TEST(TestTargets, ReadsTheBopLayout) {
   EXPECT_EQ(t[2].obj_id, 2);
 }
 
+// BOP 2019's rule: per image and object, the instances visible at least 10%;
+// an object with none is no target; an image without gt_info gives none.
+// Written, the list reads back as it was.
+TEST(TestTargets, FromTheGroundTruthByVisibilityAndBack) {
+  pb::SceneInfo scene;
+  scene.scene_id = 3;
+  const auto add = [](pb::ImageInfo& im, int obj, double visib) {
+    im.gt.push_back({obj, pb::Pose{}});
+    pb::GtInfo gi;
+    gi.visib_fract = visib;
+    im.gt_info.push_back(gi);
+  };
+  pb::ImageInfo& a = scene.images[0];
+  add(a, 5, 0.9);
+  add(a, 2, 0.1);    // at the threshold: counted
+  add(a, 5, 0.4);
+  add(a, 7, 0.09);   // under it: no target
+  pb::ImageInfo& b = scene.images[4];
+  b.im_id = 4;
+  b.gt.push_back({2, pb::Pose{}});  // no gt_info: unknown visibility, no target
+  const auto t = pb::scene_test_targets(scene);
+  ASSERT_EQ(t.size(), 2u);
+  EXPECT_EQ(std::make_tuple(t[0].scene_id, t[0].im_id, t[0].obj_id, t[0].inst_count), std::make_tuple(3, 0, 2, 1));
+  EXPECT_EQ(std::make_tuple(t[1].scene_id, t[1].im_id, t[1].obj_id, t[1].inst_count), std::make_tuple(3, 0, 5, 2));
+  EXPECT_EQ(pb::scene_test_targets(scene, 0.5).size(), 1u);  // only object 5's first instance
+
+  Dataset ds;
+  pb::write_test_targets(ds.root + "/written.json", t);
+  const auto back = pb::read_test_targets(ds.root + "/written.json");
+  ASSERT_EQ(back.size(), t.size());
+  for (size_t i = 0; i < t.size(); ++i)
+    EXPECT_EQ(std::make_tuple(back[i].scene_id, back[i].im_id, back[i].obj_id, back[i].inst_count),
+              std::make_tuple(t[i].scene_id, t[i].im_id, t[i].obj_id, t[i].inst_count));
+  pb::write_test_targets(ds.root + "/empty.json", {});
+  EXPECT_TRUE(pb::read_test_targets(ds.root + "/empty.json").empty());
+}
+
 TEST(TestTargets, BadEntriesAreInputErrorsNamingTheEntry) {
   Dataset ds;
   const std::string file = ds.root + "/targets.json";

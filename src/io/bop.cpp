@@ -182,6 +182,30 @@ std::vector<TestTarget> read_test_targets(const std::string& path) {
   return out;
 }
 
+std::vector<TestTarget> scene_test_targets(const SceneInfo& scene, double min_visib_fract) {
+  std::vector<TestTarget> out;
+  for (const auto& [id, im] : scene.images) {
+    if (im.gt_info.size() != im.gt.size()) continue;
+    std::map<int, int> count;  // obj_id -> instances visible enough
+    for (size_t k = 0; k < im.gt.size(); ++k)
+      if (im.gt_info[k].visib_fract >= min_visib_fract) ++count[im.gt[k].obj_id];
+    for (const auto& [obj, n] : count) out.push_back({scene.scene_id, id, obj, n});
+  }
+  return out;
+}
+
+void write_test_targets(const std::string& path, const std::vector<TestTarget>& targets) {
+  // One entry per line, as bop_toolkit writes them.
+  std::string out = "[";
+  for (size_t i = 0; i < targets.size(); ++i) {
+    const TestTarget& t = targets[i];
+    const ojson e = {{"im_id", t.im_id}, {"inst_count", t.inst_count}, {"obj_id", t.obj_id}, {"scene_id", t.scene_id}};
+    out += (i == 0 ? "\n  " : ",\n  ") + e.dump();
+  }
+  out += targets.empty() ? "]\n" : "\n]\n";
+  atomic_write_text(path, out);
+}
+
 // ---------------------------------------------------------------- models_info
 
 std::map<int, ModelInfo> read_models_info(const std::string& path) {

@@ -114,6 +114,13 @@ struct TestTarget {
 // inst_count}, every field required, ids >= 0, inst_count >= 1. InputError
 // naming the file and the entry ("[3].obj_id") on any problem.
 std::vector<TestTarget> read_test_targets(const std::string& path);
+// The test targets of a scene by BOP 2019's rule: per image and object, the
+// instances visible at least min_visib_fract (scene_gt_info's visib_fract;
+// BOP: 0.1), an entry when there is one or more; sorted by image, then
+// object. Images without gt_info give none.
+std::vector<TestTarget> scene_test_targets(const SceneInfo& scene, double min_visib_fract = 0.1);
+// Writes a test-targets file (the list read_test_targets reads).
+void write_test_targets(const std::string& path, const std::vector<TestTarget>& targets);
 
 std::string bop_id(int id);  // 6 digits: 000042
 // SCENE_DIR/depth/IIIIII.png

@@ -137,7 +137,7 @@ void run_workers(SceneGenerator& gen, int images, int workers, void (*progress)(
   if (error) std::rethrow_exception(error);
 }
 
-// scene_*.json and posebench_scene.json (written last: its presence marks a
+// scene_*.json, test_targets_bop19.json and posebench_scene.json (written last: its presence marks a
 // complete scene set); fills the summary's counts.
 void write_scene_files(const fs::path& tmp, const fs::path& scene_dir, const SceneGenerator& gen,
                        std::vector<Done>& done, GenerateSummary& sum) {
@@ -154,6 +154,8 @@ void write_scene_files(const fs::path& tmp, const fs::path& scene_dir, const Sce
     scene.images[im] = std::move(done[im].info);
   }
   write_scene_json(scene_dir.string(), scene);
+  // Every object visible enough, BOP 2019's rule: `object: all` runs them.
+  write_test_targets((tmp / "test_targets_bop19.json").string(), scene_test_targets(scene));
 
   sum.images = s.images;
   sum.mean_target_visib = visib_sum / s.images;
