@@ -48,25 +48,40 @@ class CompareRuns(unittest.TestCase):
 
     def test_cells_of_the_fixture_records(self):
         counts, seconds = cr.cells(self.before)
-        self.assertEqual(counts[("table_4_1", "table_synthetic", "fpfh", "icp", 0.0, "{}")], [2, 2])
-        self.assertEqual(counts[("table_4_1", "table_synthetic", "cvfh", "icp", 0.0, "{}")], [1, 2])
-        self.assertEqual(counts[("fig_4_12", "warehouse_synthetic", "none", "icp_plane", 2.0, "{}")], [1, 2])
+        self.assertEqual(counts[("table_4_1", "table_synthetic", 1, "fpfh", "icp", 0.0, "{}")], [2, 2])
+        self.assertEqual(counts[("table_4_1", "table_synthetic", 1, "cvfh", "icp", 0.0, "{}")], [1, 2])
+        self.assertEqual(counts[("fig_4_12", "warehouse_synthetic", 1, "none", "icp_plane", 2.0, "{}")], [1, 2])
         self.assertEqual(set(seconds), {"table_4_1", "table_4_5", "fig_4_12"})
         # One run's folder alone: named by its folder.
         one, _ = cr.cells(os.path.join(self.before, "table_4_1"))
         self.assertEqual({k[0] for k in one}, {"table_4_1"})
 
+    def test_a_cell_per_object(self):
+        # An `object: all` run: the same experiment, scene and method, two
+        # objects, two cells; one object losing all is significant alone.
+        def obj(r):
+            return dict(r, obj_id=7) if r["descriptor"] == "cvfh" else r
+        self.edit(self.before, "table_4_1", obj)
+        counts, _ = cr.cells(self.before)
+        self.assertEqual(counts[("table_4_1", "table_synthetic", 7, "cvfh", "icp", 0.0, "{}")], [1, 2])
+        self.assertNotIn(("table_4_1", "table_synthetic", 1, "cvfh", "icp", 0.0, "{}"), counts)
+        before = {("e", "s", 1, "ppf", "icp", 0.0, "{}"): [10, 10], ("e", "s", 2, "ppf", "icp", 0.0, "{}"): [0, 10]}
+        after = {("e", "s", 1, "ppf", "icp", 0.0, "{}"): [0, 10], ("e", "s", 2, "ppf", "icp", 0.0, "{}"): [10, 10]}
+        r = cr.compare(before, after)  # pooled 10 -> 10; per object, both significant
+        self.assertEqual((r["correct_before"], r["correct_after"], len(r["significant"])), (10, 10, 2))
+        self.assertEqual(cr.name(r["significant"][0]["cell"]), "e s obj 1 ppf+icp noise 0")
+
     def test_verdicts(self):
-        before = {("e", "s", "a", "icp", 0.0, "{}"): [10, 10], ("e", "s", "b", "icp", 0.0, "{}"): [5, 10],
-                  ("e", "s", "c", "icp", 0.0, "{}"): [3, 4], ("e", "s", "d", "icp", 0.0, "{}"): [1, 1]}
-        after = {("e", "s", "a", "icp", 0.0, "{}"): [0, 10], ("e", "s", "b", "icp", 0.0, "{}"): [6, 10],
-                 ("e", "s", "c", "icp", 0.0, "{}"): [3, 4]}
+        before = {("e", "s", 1, "a", "icp", 0.0, "{}"): [10, 10], ("e", "s", 1, "b", "icp", 0.0, "{}"): [5, 10],
+                  ("e", "s", 1, "c", "icp", 0.0, "{}"): [3, 4], ("e", "s", 1, "d", "icp", 0.0, "{}"): [1, 1]}
+        after = {("e", "s", 1, "a", "icp", 0.0, "{}"): [0, 10], ("e", "s", 1, "b", "icp", 0.0, "{}"): [6, 10],
+                 ("e", "s", 1, "c", "icp", 0.0, "{}"): [3, 4]}
         r = cr.compare(before, after)
         self.assertEqual((r["cells"], r["equal"], r["up"], r["down"], r["unmatched"]), (3, 1, 1, 1, 1))
         self.assertEqual((r["correct_before"], r["correct_after"], r["trials"]), (18, 9, 24))
-        self.assertEqual([c["cell"][2] for c in r["significant"]], ["a"])
+        self.assertEqual([c["cell"][3] for c in r["significant"]], ["a"])
         self.assertAlmostEqual(r["significant"][0]["p"], 2 / 184756, places=12)
-        self.assertEqual([c["cell"][2] for c in r["moved"]], ["a", "b"])
+        self.assertEqual([c["cell"][3] for c in r["moved"]], ["a", "b"])
 
     def test_printed_totals(self):
         # The after run loses every correct fpfh record of table_4_1.
@@ -75,7 +90,7 @@ class CompareRuns(unittest.TestCase):
         code, out, _ = run(self.before, self.after)
         self.assertEqual(code, 0)
         self.assertIn("1 down", out)
-        self.assertIn("moved: table_4_1 table_synthetic fpfh+icp noise 0 2/2 -> 0/2", out)
+        self.assertIn("moved: table_4_1 table_synthetic obj 1 fpfh+icp noise 0 2/2 -> 0/2", out)
         # Paired by trial: the two fpfh trials correct before only; 2 of 2 discordant pairs one way.
         self.assertIn("correct before only 2, after only 0; McNemar's exact test p = 0.5", out)
 
