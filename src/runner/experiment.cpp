@@ -275,10 +275,15 @@ ExperimentConfig load_experiment(const std::string& path) {
   std::set<std::string> names;
   for (size_t i = 0; i < scenes.size(); ++i) c.scenes.push_back(parse_scene(scenes.at(i), path, names));
   if (c.object == kEveryTargetObject) {
-    for (size_t i = 0; i < scenes.size(); ++i)
-      if (c.scenes[i].targets.empty() || c.scenes[i].dataset.empty())
-        scenes.at(i).fail("'object: all' takes the objects from the scene's BOP test targets: give 'dataset' "
-                          "and 'targets' (e.g. test_targets_bop19.json)");
+    for (size_t i = 0; i < scenes.size(); ++i) {
+      SceneSource& src = c.scenes[i];
+      // A generated set lists its own targets (scene_test_targets).
+      if (!src.generate.empty() && src.targets.empty()) src.targets = kGeneratedTargets;
+      if (src.targets.empty() || (src.dataset.empty() && src.generate.empty()))
+        scenes.at(i).fail("'object: all' takes the objects from the scene's BOP test targets: give 'generate' "
+                          "(the generated set lists its own), or 'dataset' and 'targets' (e.g. "
+                          "test_targets_bop19.json)");
+    }
     if (c.registration_only) root["registration_only"].fail("not with 'object: all'");
   }
   c.judgements = parse_judgements(root["judgements"]);
@@ -308,7 +313,10 @@ Targets read_targets(const SceneSource& src, const BopDataset& ds, const std::st
   if (src.targets.empty()) return out;
   out.file = fs::path(src.targets).is_absolute() ? src.targets : (fs::path(src.dataset) / src.targets).string();
   if (std::error_code ec; !fs::is_regular_file(out.file, ec))
-    throw InputError(out.file, "targets", "test-targets file not found");
+    throw InputError(out.file, "targets",
+                     src.generate.empty() ? "test-targets file not found"
+                                          : "test-targets file not found: the scene set was generated before "
+                                            "posebench wrote it; delete the set's folder to generate it again");
   const bool every = object == kEveryTargetObject;
   const int obj = every ? 0 : ds.resolve_object(object);
   const auto targets = read_test_targets(out.file);

@@ -67,6 +67,9 @@ struct Judgement {
 // ExperimentConfig::object that takes every object of each scene's BOP test
 // targets (one trial per target, recognizing up to its inst_count).
 inline constexpr const char* kEveryTargetObject = "all";
+// The test targets a generated scene set lists (`generate` writes them; with
+// `object: all` a generated scene takes them).
+inline constexpr const char* kGeneratedTargets = "test_targets_bop19.json";
 
 struct ExperimentConfig {
   std::string file;                 // the YAML it came from
