@@ -8,6 +8,7 @@
 // triple-key path), and a rendered table frame: the same bits.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -273,7 +274,9 @@ TEST(VoxelGrid, FourPointKernelsEqualTheOnePointLoops) {
 }
 
 // A rendered table frame, range-cut as the scene preprocessing cuts it
-// (pixels in image order): every pixel's point at the scene's voxel sizes.
+// (pixels in image order): every pixel's point at the scene's voxel sizes;
+// with the image's width given (the grid's guesses from the pixel above)
+// and without, and with pixels out of image order (the guesses stop).
 TEST(VoxelGrid, EqualsThePlainReferenceOnATableFrame) {
   const pb::Mesh mesh = pbtest::make_l_block();
   const pbtest::TableScene scene = pbtest::render_table_scene(mesh);
@@ -285,12 +288,21 @@ TEST(VoxelGrid, EqualsThePlainReferenceOnATableFrame) {
       in.pixel.push_back(static_cast<int>(i));
     }
   ASSERT_GT(in.size(), 10000u);
-  for (const double leaf : {3.0, 5.0, 10.0, 20.0}) {
-    const VoxelGridOptions o{leaf};
-    const PointSet got = pb::voxel_downsample(in, o);
-    EXPECT_GT(got.size(), 100u);
-    expect_same(got, reference_downsample(in, o), "table frame, leaf " + std::to_string(leaf));
-  }
+  PointSet organized = in;
+  organized.source_width = cloud.width;
+  organized.source_height = cloud.height;
+  PointSet shuffled = organized;  // two halves swapped: pixels fall back once
+  std::rotate(shuffled.points.begin(), shuffled.points.begin() + shuffled.size() / 2, shuffled.points.end());
+  std::rotate(shuffled.pixel.begin(), shuffled.pixel.begin() + shuffled.size() / 2, shuffled.pixel.end());
+  for (const double leaf : {3.0, 5.0, 10.0, 20.0})
+    for (const PointSet* ps : {&in, &organized, &shuffled}) {
+      const VoxelGridOptions o{leaf};
+      const PointSet got = pb::voxel_downsample(*ps, o);
+      EXPECT_GT(got.size(), 100u);
+      expect_same(got, reference_downsample(*ps, o),
+                  "table frame, leaf " + std::to_string(leaf) + ", width " + std::to_string(ps->source_width) +
+                      (ps == &shuffled ? ", halves swapped" : ""));
+    }
 }
 
 // The whole scene preprocessing (range cut, grid, RANSAC plane, normals)
