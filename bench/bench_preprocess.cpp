@@ -122,6 +122,18 @@ void BM_PreprocessScene(benchmark::State& st) {
   st.counters["points"] = static_cast<double>(n);
 }
 
+// The same with the planes removed before the grid
+// (preprocess.planes_before_grid).
+void BM_PreprocessScenePlanesFirst(benchmark::State& st) {
+  const Frame& f = frame(static_cast<int>(st.range(0)));
+  const OrganizedCloud c = OrganizedCloud::from_depth(f.depth, f.K);
+  PreprocessSettings s = f.s;
+  s.planes_before_grid = true;
+  size_t n = 0;
+  for (auto _ : st) n = preprocess_scene(c, s, 1).size();
+  st.counters["points"] = static_cast<double>(n);
+}
+
 void Args(benchmark::internal::Benchmark* b) {
   b->Arg(0)->Arg(1)->ArgName("warehouse")->Unit(benchmark::kMillisecond);
 }
@@ -134,5 +146,6 @@ BENCHMARK(BM_Plane)->Apply(Args);
 BENCHMARK(BM_Normals)->Apply(Args);
 BENCHMARK(BM_KdTreeBuild)->Apply(Args);
 BENCHMARK(BM_PreprocessScene)->Apply(Args);
+BENCHMARK(BM_PreprocessScenePlanesFirst)->Apply(Args);
 
 BENCHMARK_MAIN();

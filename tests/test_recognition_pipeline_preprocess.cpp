@@ -170,15 +170,18 @@ TEST(Preprocess, MaxPlanesRemovesFloorAndWall) {
   auto on_floor = [](const Vec3f& p) { return std::abs(p.y() - 800) < 5; };
   auto on_wall = [](const Vec3f& p) { return std::abs(p.z() - 5000) < 5; };
   auto on_ball = [](const Vec3f& p) { return (p - Vec3f(0, 400, 3500)).norm() < 230; };
-  s.max_planes = 1;
-  const PointSet one = pb::preprocess_scene(cloud, s, 3);
-  EXPECT_EQ(count_near(one, on_floor), 0);
-  EXPECT_GT(count_near(one, on_wall), 1000);
-  s.max_planes = 2;
-  const PointSet two = pb::preprocess_scene(cloud, s, 3);
-  EXPECT_EQ(count_near(two, on_floor), 0);
-  EXPECT_EQ(count_near(two, on_wall), 0);
-  EXPECT_GT(count_near(two, on_ball), 400);
+  for (const bool first : {false, true}) {  // planes after the grid, and before it
+    s.planes_before_grid = first;
+    s.max_planes = 1;
+    const PointSet one = pb::preprocess_scene(cloud, s, 3);
+    EXPECT_EQ(count_near(one, on_floor), 0) << "planes first " << first;
+    EXPECT_GT(count_near(one, on_wall), 1000) << "planes first " << first;
+    s.max_planes = 2;
+    const PointSet two = pb::preprocess_scene(cloud, s, 3);
+    EXPECT_EQ(count_near(two, on_floor), 0) << "planes first " << first;
+    EXPECT_EQ(count_near(two, on_wall), 0) << "planes first " << first;
+    EXPECT_GT(count_near(two, on_ball), 400) << "planes first " << first;
+  }
 }
 
 // A table seen through heavy noise (Gaussian, sigma 20 mm along the view
@@ -226,6 +229,15 @@ TEST(Preprocess, PlaneNoiseFactorRemovesANoisyTableWhole) {
   EXPECT_GT(table_left(fixed), 10000);  // 62% of the table lies beyond 10 mm
   EXPECT_LT(table_left(wide), 2000);    // about 6% beyond 2 x 20 x 0.93 (the rays' median cos)
   EXPECT_GT(box_top(wide), 700);        // 60 of the box's 150 mm
+  // Planes before the grid: the widening's median |cos| over about
+  // plane_sample_points (here 1000) of the table's 20000 points: the same.
+  s.planes_before_grid = true;
+  s.plane_sample_points = 1000;
+  const PointSet first = pb::preprocess_scene(noisy, s, 1);
+  EXPECT_LT(table_left(first), 2000);
+  EXPECT_GT(box_top(first), 700);
+  s.planes_before_grid = false;
+  s.plane_sample_points = 5000;
   // A clean table: the measured 1 mm x 2 is below the threshold.
   const pb::OrganizedCloud clean = scene(1);
   s.plane_noise_factor = 0;
@@ -345,10 +357,25 @@ class TableScenePreprocess : public ::testing::Test {
 pb::Mesh* TableScenePreprocess::mesh_ = nullptr;
 pbtest::TableScene* TableScenePreprocess::scene_ = nullptr;
 
+// Both orders: the grid before the planes (default) and the planes among
+// the range-cut points before the grid (planes_before_grid).
 TEST_F(TableScenePreprocess, RemovesTheTableKeepsTheObjectWithOrientedNormals) {
   const pb::OrganizedCloud cloud = pb::OrganizedCloud::from_depth(scene_->depth, scene_->K);
+  PointSet grid_first;
+  for (const bool first : {false, true}) {
+  SCOPED_TRACE(first ? "planes before the grid" : "grid first");
   pb::PreprocessSettings s;
+  s.planes_before_grid = first;
   const PointSet ps = pb::preprocess_scene(cloud, s, 5);
+  // The same object left either way: the two counts within 15%.
+  // The same object left either way (the two counts within 15%), but not
+  // the same points: the grid's cells at the object's foot hold no table.
+  if (!first) {
+    grid_first = ps;
+  } else {
+    EXPECT_NEAR(static_cast<double>(ps.size()), static_cast<double>(grid_first.size()), 0.15 * grid_first.size());
+    EXPECT_NE(ps.points, grid_first.points);
+  }
   ASSERT_GT(ps.size(), 50u);
   ASSERT_TRUE(ps.has_normals());
   ASSERT_EQ(ps.curvature.size(), ps.size());
@@ -382,6 +409,7 @@ TEST_F(TableScenePreprocess, RemovesTheTableKeepsTheObjectWithOrientedNormals) {
   pb::PreprocessSettings near = s;
   near.max_range_mm = 300;
   EXPECT_EQ(pb::preprocess_scene(cloud, near, 5).size(), 0u);
+  }
 }
 
 TEST_F(TableScenePreprocess, SameBitsWithOneAndTwoThreads) {

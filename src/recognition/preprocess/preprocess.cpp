@@ -290,40 +290,63 @@ PointSet range_cut(const OrganizedCloud& cloud, double min_z, double max_z, cons
 
 }  // namespace
 
+namespace {
+
+// The dominant planes removed from `ps`, one after the other (max_planes,
+// min_plane_fraction of the points it had first), each RANSAC'd with its
+// own seed and widened by the image's depth noise (plane_noise_factor).
+// The median |cos| of the widening is taken over every plane point, or with
+// `median_points` > 0 over about that many of them, evenly spaced in point
+// order (a table frame's raw points: a quarter million).
+void remove_planes(PointSet& ps, const OrganizedCloud& cloud, const PreprocessSettings& s, uint64_t seed,
+                   size_t median_points = 0) {
+  const double min_count = s.min_plane_fraction * static_cast<double>(ps.size());
+  const double depth_sigma = s.plane_noise_factor > 0 ? detail::depth_noise_sigma(cloud) : 0.0;
+  for (int k = 0; k < s.max_planes && ps.size() >= 3; ++k) {
+    Eigen::Vector4d plane;
+    std::vector<char> on_plane = detail::ransac_plane(ps.points, s.plane_threshold_mm, s.plane_iterations,
+                                                      k == 0 ? seed : derive_seed(seed, {static_cast<uint64_t>(k)}),
+                                                      &plane, s.plane_sample_points, s.plane_probability);
+    if (depth_sigma * s.plane_noise_factor > s.plane_threshold_mm) {
+      // Depth noise along the rays, seen across the plane: x the median
+      // |cos| between the plane's normal and the rays to its points.
+      std::vector<double> cosines;
+      size_t stride = 1;
+      if (median_points > 0) {
+        const size_t on = static_cast<size_t>(std::count(on_plane.begin(), on_plane.end(), 1));
+        stride = std::max<size_t>(1, on / median_points);
+      }
+      for (size_t i = 0, seen = 0; i < ps.size(); ++i)
+        if (on_plane[i] && seen++ % stride == 0)
+          cosines.push_back(std::abs(plane.head<3>().dot(ps.points[i].cast<double>().normalized())));
+      if (!cosines.empty()) {
+        const auto mid = cosines.begin() + static_cast<std::ptrdiff_t>(cosines.size() / 2);
+        std::nth_element(cosines.begin(), mid, cosines.end());
+        const double wide = s.plane_noise_factor * depth_sigma * *mid;
+        if (wide > s.plane_threshold_mm)
+          for (size_t i = 0; i < ps.size(); ++i)
+            on_plane[i] = std::abs(plane.head<3>().dot(ps.points[i].cast<double>()) + plane[3]) <= wide;
+      }
+    }
+    const size_t cnt = static_cast<size_t>(std::count(on_plane.begin(), on_plane.end(), 1));
+    if (cnt == 0 || static_cast<double>(cnt) < min_count) break;
+    std::vector<char> keep(on_plane.size());
+    for (size_t i = 0; i < keep.size(); ++i) keep[i] = !on_plane[i];
+    ps = detail::select(ps, keep);
+  }
+}
+
+}  // namespace
+
 PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings& s, uint64_t seed) {
   PointSet ps = range_cut(cloud, s.min_range_mm, s.max_range_mm,
                           s.veil_angle_deg > 0 ? detail::veil_pixels(cloud, s.veil_angle_deg) : std::vector<char>{});
+  // Before the grid: the range-cut points, the widening's median over
+  // about plane_sample_points of the plane's (all with 0).
+  if (s.remove_plane && s.planes_before_grid)
+    remove_planes(ps, cloud, s, seed, static_cast<size_t>(s.plane_sample_points));
   ps = voxel_downsample(ps, {s.voxel_mm});
-  if (s.remove_plane) {
-    const double min_count = s.min_plane_fraction * static_cast<double>(ps.size());
-    const double depth_sigma = s.plane_noise_factor > 0 ? detail::depth_noise_sigma(cloud) : 0.0;
-    for (int k = 0; k < s.max_planes && ps.size() >= 3; ++k) {
-      Eigen::Vector4d plane;
-      std::vector<char> on_plane = detail::ransac_plane(ps.points, s.plane_threshold_mm, s.plane_iterations,
-                                                        k == 0 ? seed : derive_seed(seed, {static_cast<uint64_t>(k)}),
-                                                        &plane, s.plane_sample_points, s.plane_probability);
-      if (depth_sigma * s.plane_noise_factor > s.plane_threshold_mm) {
-        // Depth noise along the rays, seen across the plane: x the median
-        // |cos| between the plane's normal and the rays to its points.
-        std::vector<double> cosines;
-        for (size_t i = 0; i < ps.size(); ++i)
-          if (on_plane[i]) cosines.push_back(std::abs(plane.head<3>().dot(ps.points[i].cast<double>().normalized())));
-        if (!cosines.empty()) {
-          const auto mid = cosines.begin() + static_cast<std::ptrdiff_t>(cosines.size() / 2);
-          std::nth_element(cosines.begin(), mid, cosines.end());
-          const double wide = s.plane_noise_factor * depth_sigma * *mid;
-          if (wide > s.plane_threshold_mm)
-            for (size_t i = 0; i < ps.size(); ++i)
-              on_plane[i] = std::abs(plane.head<3>().dot(ps.points[i].cast<double>()) + plane[3]) <= wide;
-        }
-      }
-      const size_t cnt = static_cast<size_t>(std::count(on_plane.begin(), on_plane.end(), 1));
-      if (cnt == 0 || static_cast<double>(cnt) < min_count) break;
-      std::vector<char> keep(on_plane.size());
-      for (size_t i = 0; i < keep.size(); ++i) keep[i] = !on_plane[i];
-      ps = detail::select(ps, keep);
-    }
-  }
+  if (s.remove_plane && !s.planes_before_grid) remove_planes(ps, cloud, s, seed);
   radius_normals(ps, s.normal_radius_mm, s.normal_max_points, s.normal_support_leaf_mm());
   return ps;
 }

@@ -40,6 +40,13 @@ struct PreprocessSettings {
   int plane_sample_points = 5000;   // RANSAC scores its candidate planes on a seeded random subset
                                     // of this many points (0 = all); the winner's inliers are then
                                     // selected among all points and refitted
+  bool planes_before_grid = false;  // the planes are found and removed among the range-cut points
+                                    // (RANSAC scores its plane_sample_points among them), then the
+                                    // voxel grid grids only what is left: on a table frame the table
+                                    // is most of the points, so the grid has a fraction of them to
+                                    // do. false = the grid first, then the planes among its voxels
+                                    // (the thesis's order, section 3.1.1). Measured:
+                                    // results/bench/README.md, twenty-eighth round
   double normal_radius_mm = 20.0;   // PCA neighbourhood radius for normals
   int normal_max_points = 64;       // a normal's neighbourhood of more points than this is thinned
                                     // evenly (in kd-tree order: spatially stratified) to this many
@@ -68,6 +75,7 @@ struct PreprocessSettings {
     f("min_plane_fraction", s.min_plane_fraction, fields::in_range(0, 1));
     f("max_planes", s.max_planes, fields::at_least(0));
     f("plane_sample_points", s.plane_sample_points, fields::at_least(0));
+    f("planes_before_grid", s.planes_before_grid);
     f("normal_radius_mm", s.normal_radius_mm, fields::length(fields::positive()));
     f("normal_max_points", s.normal_max_points, fields::at_least(0));
     f("normal_coarse_support", s.normal_coarse_support);
