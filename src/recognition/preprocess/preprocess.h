@@ -44,9 +44,14 @@ struct PreprocessSettings {
                                     // (RANSAC scores its plane_sample_points among them), then the
                                     // voxel grid grids only what is left: on a table frame the table
                                     // is most of the points, so the grid has a fraction of them to
-                                    // do. false = the grid first, then the planes among its voxels
-                                    // (the thesis's order, section 3.1.1). Measured:
-                                    // results/bench/README.md, twenty-eighth round
+                                    // do (a simulated Astra frame: 8.6-9.9 -> 5.2-6.4 ms). Not the
+                                    // default, nor the bench's: over the thesis's table experiments it
+                                    // lost robustness where single raw points are noisy or the object's
+                                    // foot matters (Figure 4.6's one-view CVFH / CESF: 1951 against
+                                    // 1991 of 2400; added noise: 166 against 188 of 1440). false = the
+                                    // grid first, then the planes among its voxels (the thesis's
+                                    // order, section 3.1.1). Measured: results/bench/README.md,
+                                    // twenty-eighth round
   double normal_radius_mm = 20.0;   // PCA neighbourhood radius for normals
   int normal_max_points = 64;       // a normal's neighbourhood of more points than this is thinned
                                     // evenly (in kd-tree order: spatially stratified) to this many
