@@ -8,6 +8,7 @@
 // against PCL's, the alpha bins against the formula).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -376,6 +377,105 @@ TEST(PpfSinSign, EqualsSinfTimesZ) {
                         std::numeric_limits<float>::quiet_NaN()})
     check(a);
   EXPECT_EQ(wrong, 0u) << "of " << checked;
+}
+
+// Pose clustering with its grid of cluster leads equals the plain greedy
+// scan (each pose, most votes first, joins the first cluster in creation
+// order whose lead is within both thresholds): random poses around a few
+// centres at spreads near the thresholds, translations exactly a threshold
+// apart, equal votes, and non-finite translations (never rejected by the
+// distance test), every hypothesis the same bits.
+TEST(PpfClusterPoses, GridEqualsThePlainScan) {
+  const auto plain = [](std::vector<ppf::PoseVote> poses, const PpfSettings& s) {
+    std::stable_sort(poses.begin(), poses.end(),
+                     [](const ppf::PoseVote& a, const ppf::PoseVote& b) { return a.votes > b.votes; });
+    struct C {
+      Pose lead;
+      Eigen::Quaterniond q;
+      Vec3 t = Vec3::Zero();
+      Eigen::Vector4d qs = Eigen::Vector4d::Zero();
+      double votes = 0;
+      int n = 0;
+    };
+    std::vector<C> cs;
+    for (const auto& pv : poses) {
+      const Eigen::Quaterniond q(pv.pose.R);
+      C* home = nullptr;
+      for (auto& c : cs) {
+        if ((pv.pose.t - c.lead.t).norm() >= s.position_cluster_mm) continue;
+        if (std::abs(Eigen::AngleAxisd(c.lead.R.transpose() * pv.pose.R).angle()) >=
+            s.rotation_cluster_deg * M_PI / 180.0)
+          continue;
+        home = &c;
+        break;
+      }
+      if (!home) {
+        cs.push_back({pv.pose, q});
+        home = &cs.back();
+      }
+      home->t += pv.pose.t;
+      Eigen::Vector4d qc = q.coeffs();
+      if (qc.dot(home->q.coeffs()) < 0) qc = -qc;
+      home->qs += qc;
+      home->votes += pv.votes;
+      ++home->n;
+    }
+    std::stable_sort(cs.begin(), cs.end(), [](const C& a, const C& b) { return a.votes > b.votes; });
+    if (cs.size() > static_cast<size_t>(s.max_hypotheses)) cs.resize(static_cast<size_t>(s.max_hypotheses));
+    std::vector<Hypothesis> out;
+    for (const auto& c : cs) {
+      Hypothesis h;
+      h.T_cam_model.t = c.t / c.n;
+      Eigen::Quaterniond q;
+      q.coeffs() = c.qs.normalized();
+      h.T_cam_model.R = q.toRotationMatrix();
+      h.score = c.votes;
+      out.push_back(h);
+    }
+    return out;
+  };
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> normal;
+  std::uniform_real_distribution<double> uni(0, 1);
+  int compared = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    PpfSettings s;
+    s.position_cluster_mm = trial % 3 == 0 ? 30 : 5 + 50 * uni(rng);
+    s.rotation_cluster_deg = 10 + 40 * uni(rng);
+    s.max_hypotheses = trial % 2 ? 5 : 1000;
+    std::vector<ppf::PoseVote> poses;
+    const int centres = 1 + trial % 6;
+    for (int i = 0; i < 400; ++i) {
+      ppf::PoseVote pv;
+      const int c = i % centres;
+      const double spread = s.position_cluster_mm * (0.2 + 2 * uni(rng));
+      pv.pose.t = Vec3(100.0 * c, 50.0 * c, 800) + spread * Vec3(normal(rng), normal(rng), normal(rng));
+      pv.pose.R = Eigen::AngleAxisd(0.5 * c + 0.6 * normal(rng) * uni(rng),
+                                    Vec3(normal(rng), normal(rng), normal(rng)).normalized())
+                      .toRotationMatrix();
+      pv.votes = std::floor(20 * uni(rng));  // many equal counts: the stable order matters
+      poses.push_back(pv);
+      if (i % 50 == 7) {  // a twin exactly one threshold away along x
+        pv.pose.t.x() += s.position_cluster_mm;
+        poses.push_back(pv);
+      }
+    }
+    if (trial % 5 == 4) poses[static_cast<size_t>(trial % 17)].pose.t.y() = std::numeric_limits<double>::quiet_NaN();
+    if (trial % 7 == 6) poses[3].pose.t.z() = 1e12;  // beyond the grid: scanned
+    const auto want = plain(poses, s);
+    const auto got = ppf::cluster_poses(poses, s);
+    ASSERT_EQ(got.size(), want.size()) << "trial " << trial;
+    for (size_t k = 0; k < got.size(); ++k) {
+      EXPECT_EQ(got[k].score, want[k].score) << "trial " << trial << " hypothesis " << k;
+      for (int j = 0; j < 3; ++j) {
+        const double a = got[k].T_cam_model.t[j], b = want[k].T_cam_model.t[j];
+        EXPECT_TRUE(a == b || (std::isnan(a) && std::isnan(b))) << "trial " << trial << " hypothesis " << k;
+      }
+      EXPECT_TRUE(got[k].T_cam_model.R == want[k].T_cam_model.R) << "trial " << trial << " hypothesis " << k;
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 1000);
 }
 
 TEST(Ppf, ParseReadsEveryFieldAndRejectsBadOnes) {
