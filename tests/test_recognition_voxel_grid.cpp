@@ -294,14 +294,18 @@ TEST(VoxelGrid, EqualsThePlainReferenceOnATableFrame) {
   PointSet shuffled = organized;  // two halves swapped: pixels fall back once
   std::rotate(shuffled.points.begin(), shuffled.points.begin() + shuffled.size() / 2, shuffled.points.end());
   std::rotate(shuffled.pixel.begin(), shuffled.pixel.begin() + shuffled.size() / 2, shuffled.pixel.end());
+  PointSet unknown = organized;  // points without a pixel (-1): first, and from the middle on
+  unknown.pixel[0] = -1;
+  PointSet unknown_later = organized;
+  for (size_t i = unknown_later.size() / 2; i < unknown_later.size(); i += 7) unknown_later.pixel[i] = -1;
   for (const double leaf : {3.0, 5.0, 10.0, 20.0})
-    for (const PointSet* ps : {&in, &organized, &shuffled}) {
+    for (const PointSet* ps : {&in, &organized, &shuffled, &unknown, &unknown_later}) {
       const VoxelGridOptions o{leaf};
       const PointSet got = pb::voxel_downsample(*ps, o);
       EXPECT_GT(got.size(), 100u);
       expect_same(got, reference_downsample(*ps, o),
                   "table frame, leaf " + std::to_string(leaf) + ", width " + std::to_string(ps->source_width) +
-                      (ps == &shuffled ? ", halves swapped" : ""));
+                      (ps == &shuffled ? ", halves swapped" : ps == &in || ps == &organized ? "" : ", pixels -1"));
     }
 }
 

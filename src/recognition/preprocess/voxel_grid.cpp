@@ -110,7 +110,7 @@ Cells group_by(size_t n, KeyOf key_of, Skip skip, std::vector<K>& keys, const in
   // Per pixel column: the key and slot of the last point seen there. The
   // column comes from the pixel index less the row's first, kept as pixels
   // grow (no division per point); a pixel below the previous one (not
-  // pixel order) ends the column guesses.
+  // pixel order) or none (-1) ends the column guesses.
   const bool columns = pixel != nullptr && width > 0;
   std::vector<K> col_key(columns ? static_cast<size_t>(width) : 0);
   std::vector<int> col_slot(columns ? static_cast<size_t>(width) : 0, -1);
@@ -122,10 +122,12 @@ Cells group_by(size_t n, KeyOf key_of, Skip skip, std::vector<K>& keys, const in
     size_t u = 0;
     if (in_order) {
       const int64_t px = pixel[i];
-      in_order = px >= prev_px;
-      prev_px = px;
-      while (px - row_start >= width) row_start += width;
-      u = static_cast<size_t>(px - row_start);
+      in_order = px >= 0 && px >= prev_px;
+      if (in_order) {
+        prev_px = px;
+        while (px - row_start >= width) row_start += width;
+        u = static_cast<size_t>(px - row_start);
+      }
     }
     int s = last_slot;
     if (s < 0 || !(k == last)) {
