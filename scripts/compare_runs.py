@@ -6,9 +6,10 @@
 BEFORE and AFTER are results folders of `posebench run` (one experiment, with
 records.jsonl) or folders holding several of them (e.g. results/thesis/raw).
 A cell is (experiment, scene set, object, descriptor, refinement, added
-noise, the trial's params; an `object: all` run has a cell per object); its count is the correct records of k/n. Per cell, Fisher's
-exact test (two-sided) of the two counts. Prints the totals (cells, equal,
-up, down, p < 0.05), the significant cells, the cells that moved most, and
+noise, the trial's params; an `object: all` run has a cell per object); its
+count is the correct records of k/n. Per cell, Fisher's exact test
+(two-sided) of the two counts. Prints the totals (cells, equal, up, down,
+p < 0.05), the significant cells, the cells that moved most, and
 the worker seconds (records' wall_s) per experiment, and the trials paired
 across the runs by experiment and trial key (the same image and seed):
 how many are correct in one run only, with McNemar's exact test of the two
@@ -47,7 +48,7 @@ def cells(folder, trials=None):
         for r in load_records(path, RECORD_SCHEMA):
             if trials is not None:
                 trials[(exp, r["key"])] = bool(r.get("correct"))
-            key = (exp, r["scene"], r["obj_id"], r["descriptor"], r["refinement"], r["added_noise_mm"],
+            key = (exp, r["scene"], r.get("obj_id"), r["descriptor"], r["refinement"], r["added_noise_mm"],
                    json.dumps(r["params"], sort_keys=True))
             counts[key][0] += bool(r.get("correct"))
             counts[key][1] += 1
@@ -90,7 +91,8 @@ def paired(before, after):
 
 def name(cell):
     exp, scene, obj, desc, ref, noise, params = cell
-    return f"{exp} {scene} obj {obj} {desc}+{ref} noise {noise:g}" + ("" if params == "{}" else f" {params}")
+    where = f"{exp} {scene}" + ("" if obj is None else f" obj {obj}")  # no obj_id: a failed trial's record
+    return f"{where} {desc}+{ref} noise {noise:g}" + ("" if params == "{}" else f" {params}")
 
 
 def main(argv=None):

@@ -70,6 +70,15 @@ class CompareRuns(unittest.TestCase):
         r = cr.compare(before, after)  # pooled 10 -> 10; per object, both significant
         self.assertEqual((r["correct_before"], r["correct_after"], len(r["significant"])), (10, 10, 2))
         self.assertEqual(cr.name(r["significant"][0]["cell"]), "e s obj 1 ppf+icp noise 0")
+        self.assertEqual(cr.name(("e", "s", None, "ppf", "icp", 0.0, "{}")), "e s ppf+icp noise 0")
+        # A failed trial's record without obj_id (the schema asks for it on
+        # ok records only) is read, in a cell without an object.
+        self.edit(self.after, "table_4_1",
+                  lambda r: r if r["status"] == "ok" else {k: v for k, v in r.items() if k != "obj_id"})
+        counts, _ = cr.cells(self.after)
+        self.assertTrue(any(k[0] == "table_4_1" and k[2] is None for k in counts))
+        code, _, _ = run(self.before, self.after)
+        self.assertEqual(code, 0)
 
     def test_verdicts(self):
         before = {("e", "s", 1, "a", "icp", 0.0, "{}"): [10, 10], ("e", "s", 1, "b", "icp", 0.0, "{}"): [5, 10],
