@@ -114,25 +114,20 @@ void BM_KdTreeBuild(benchmark::State& st) {
   st.counters["points"] = static_cast<double>(ps.size());
 }
 
-void BM_PreprocessScene(benchmark::State& st) {
-  const Frame& f = frame(static_cast<int>(st.range(0)));
-  const OrganizedCloud c = OrganizedCloud::from_depth(f.depth, f.K);
-  size_t n = 0;
-  for (auto _ : st) n = preprocess_scene(c, f.s, 1).size();
-  st.counters["points"] = static_cast<double>(n);
-}
-
-// The same with the planes removed before the grid
-// (preprocess.planes_before_grid).
-void BM_PreprocessScenePlanesFirst(benchmark::State& st) {
+// The whole preprocess_scene at the frame's settings, the planes removed
+// after the grid (default) or before it (preprocess.planes_before_grid).
+void preprocess_scene_bench(benchmark::State& st, bool planes_first) {
   const Frame& f = frame(static_cast<int>(st.range(0)));
   const OrganizedCloud c = OrganizedCloud::from_depth(f.depth, f.K);
   PreprocessSettings s = f.s;
-  s.planes_before_grid = true;
+  s.planes_before_grid = planes_first;
   size_t n = 0;
   for (auto _ : st) n = preprocess_scene(c, s, 1).size();
   st.counters["points"] = static_cast<double>(n);
 }
+
+void BM_PreprocessScene(benchmark::State& st) { preprocess_scene_bench(st, false); }
+void BM_PreprocessScenePlanesFirst(benchmark::State& st) { preprocess_scene_bench(st, true); }
 
 void Args(benchmark::internal::Benchmark* b) {
   b->Arg(0)->Arg(1)->ArgName("warehouse")->Unit(benchmark::kMillisecond);
