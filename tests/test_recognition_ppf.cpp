@@ -13,13 +13,16 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <random>
+#include <set>
 #include <sstream>
 
 #include "core/cpu.h"
 #include "core/error.h"
 #include "core/rotation.h"
 #include "core/yaml.h"
+#include "recognition/kdtree.h"
 #include "recognition/method.h"
 #include "recognition/pipeline.h"
 #include "recognition/ppf/internal.h"
@@ -377,6 +380,114 @@ TEST(PpfSinSign, EqualsSinfTimesZ) {
                         std::numeric_limits<float>::quiet_NaN()})
     check(a);
   EXPECT_EQ(wrong, 0u) << "of " << checked;
+}
+
+// ppf::vote, written plainly from its definition: every other scene point
+// within the model's diameter paired with the reference (in the kd-tree's
+// order, as vote takes them: with vote_once the first pair of a (key,
+// alpha_s bin) votes, so the order counts), the pair's key looked up in the sorted table,
+// each (key, alpha_s bin) voting once per reference point (a std::set), an
+// accumulator per reference point, its best cell the most votes, the lowest
+// cell among equals.
+std::vector<ppf::PoseVote> plain_vote(const ppf::Model& m, const PointSet& scene) {
+  const int n_alpha = std::max(1, static_cast<int>(std::floor(2 * M_PI / m.angle_step)));
+  const ppf::AlphaBins bins(m.angle_step, n_alpha);
+  const KdTree3 tree(scene.points);
+  std::vector<ppf::PoseVote> out;
+  std::vector<int> partners;
+  for (size_t r = 0; r < scene.size(); ++r) {
+    const Vec3f sr = scene.points[r], nr = scene.normals[r];
+    const Eigen::Affine3f T_sg = ppf::to_reference_frame(sr, nr);
+    std::map<uint32_t, uint32_t> acc;
+    std::set<std::pair<uint64_t, int>> voted;
+    tree.radius_unsorted(sr, m.diameter, partners);
+    for (const int pi : partners) {
+      const size_t i = static_cast<size_t>(pi);
+      float f[4];
+      if (i == r || !ppf::pair_feature(sr, nr, scene.points[i], scene.normals[i], f)) continue;
+      if (!std::isfinite(f[0]) || !std::isfinite(f[1]) || !std::isfinite(f[2]) || !std::isfinite(f[3])) continue;
+      const uint64_t key = ppf::feature_key(f[0], f[1], f[2], f[3], m.angle_step, m.distance_step);
+      const auto range = std::equal_range(m.table.begin(), m.table.end(), key, [](const auto& a, const auto& b) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(a)>, uint64_t>) return a < b.key;
+        else return a.key < b;
+      });
+      if (range.first == range.second) continue;
+      const float alpha_s = ppf::pcl_alpha(T_sg, scene.points[i]);
+      if (!std::isfinite(alpha_s)) continue;
+      const int alpha_s_bin = static_cast<int>(std::floor((alpha_s + M_PI) / m.angle_step));
+      if (!voted.insert({key, alpha_s_bin}).second) continue;
+      for (auto e = range.first; e != range.second; ++e)
+        ++acc[e->ref * static_cast<uint32_t>(n_alpha) + static_cast<uint32_t>(bins.exact(ppf::wrapped_alpha(e->alpha_m, alpha_s)))];
+    }
+    if (acc.empty()) continue;
+    auto best = acc.begin();
+    for (auto it = acc.begin(); it != acc.end(); ++it)
+      if (it->second > best->second) best = it;
+    const size_t mr = best->first / static_cast<uint32_t>(n_alpha);
+    const float alpha = static_cast<float>((best->first % static_cast<uint32_t>(n_alpha) + 0.5) * m.angle_step - M_PI);
+    const Eigen::Affine3f T = T_sg.inverse() * Eigen::AngleAxisf(alpha, Vec3f::UnitX()) *
+                              ppf::to_reference_frame(m.points[mr], m.normals[mr]);
+    ppf::PoseVote pv;
+    pv.pose.R = T.linear().cast<double>();
+    pv.pose.t = T.translation().cast<double>();
+    pv.votes = best->second;
+    out.push_back(pv);
+  }
+  return out;
+}
+
+// ppf::vote with vote_once equals plain_vote on a model whose pairs share
+// few keys: points on a plane, so every pair has the same angles and the
+// distance bin (a quarter of the diameter) alone tells keys apart, and a
+// reference point meets one key with alpha_s in every bin. At 12 degrees
+// (30 alpha bins) and at 4 degrees (90 bins, more than the 64 flags of one
+// word: bins 64 apart must not share a flag).
+TEST(PpfVote, VoteOnceEqualsAPlainReference) {
+  for (const double deg : {12.0, 4.0}) {
+    Rng rng(21);
+    ppf::Model m;
+    for (int k = 0; k < 120; ++k) {
+      m.points.emplace_back(static_cast<float>(rng.uniform(-50, 50)), static_cast<float>(rng.uniform(-50, 50)), 0.f);
+      m.normals.emplace_back(0.f, 0.f, 1.f);
+    }
+    const size_t n = m.points.size();
+    for (size_t i = 0; i < n; ++i)
+      for (size_t j = 0; j < n; ++j) {
+        float f[4];
+        const float nan = std::numeric_limits<float>::quiet_NaN();
+        ppf::PairFeature pf{nan, nan, nan, nan, nan};
+        if (i != j && ppf::pair_feature(m.points[i], m.normals[i], m.points[j], m.normals[j], f))
+          pf = {f[0], f[1], f[2], f[3], ppf::pcl_alpha(ppf::to_reference_frame(m.points[i], m.normals[i]), m.points[j])};
+        m.features.push_back(pf);
+      }
+    m.angle_step = static_cast<float>(deg * M_PI / 180.0);
+    m.distance_step = 0.25f * 142.f;
+    ppf::build_table(m);
+    ASSERT_FALSE(m.table.empty());
+    m.diameter = 1000;  // every scene point a partner: no radius boundary to agree on
+    // The scene: the model moved.
+    const Eigen::Matrix3f R = Eigen::AngleAxisf(0.7f, Vec3f(1, 2, 3).normalized()).toRotationMatrix();
+    const Vec3f t(30, -20, 600);
+    PointSet scene;
+    for (size_t i = 0; i < n; ++i) {
+      scene.points.push_back(R * m.points[i] + t);
+      scene.normals.push_back(R * m.normals[i]);
+    }
+    std::vector<int> refs(n);
+    for (size_t i = 0; i < n; ++i) refs[i] = static_cast<int>(i);
+    ppf::VoteOptions opt;
+    opt.vote_once = true;
+    const std::vector<ppf::PoseVote> got = ppf::vote(m, scene, refs, opt), want = plain_vote(m, scene);
+    ASSERT_EQ(got.size(), want.size()) << deg << " deg";
+    size_t differ = 0;
+    for (size_t k = 0; k < got.size(); ++k) {
+      const bool same = got[k].votes == want[k].votes && (got[k].pose.R - want[k].pose.R).norm() < 1e-9 &&
+                        (got[k].pose.t - want[k].pose.t).norm() < 1e-9;
+      if (!same && ++differ <= 3)
+        ADD_FAILURE() << deg << " deg, reference " << k << ": " << got[k].votes << " votes, want " << want[k].votes;
+    }
+    EXPECT_EQ(differ, 0u) << deg << " deg, of " << got.size();
+  }
 }
 
 // Pose clustering with its grid of cluster leads equals the plain greedy

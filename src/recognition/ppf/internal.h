@@ -30,9 +30,14 @@ struct PairEntry {
 
 // The table's key index: for each distinct key its range [begin, end) of
 // the sorted table, in an open-addressing hash (one probe sequence per
-// scene pair instead of a binary search over the whole table).
+// scene pair instead of a binary search over the whole table), and an id of
+// its own (its slot).
 class KeyIndex {
  public:
+  struct Range {
+    uint32_t begin = 0, end = 0;  // begin == end: the key is not in the table
+    uint32_t id = 0;              // one per key in the table
+  };
   void build(const std::vector<PairEntry>& table);
   // Asks for the cache line of `key`'s first slot (a hint: no effect on
   // any result).
@@ -40,13 +45,13 @@ class KeyIndex {
     if (!keys_.empty()) __builtin_prefetch(keys_.data() + home(key));
   }
   // The range of `key` (begin == end when absent).
-  std::pair<uint32_t, uint32_t> find(uint64_t key) const {
-    if (keys_.empty()) return {0, 0};
+  Range find(uint64_t key) const {
+    if (keys_.empty()) return {};
     size_t i = home(key);
     while (true) {
       const Slot& s = keys_[i];
-      if (s.end == 0) return {0, 0};
-      if (s.key == key) return {s.begin, s.end};
+      if (s.end == 0) return {};
+      if (s.key == key) return {s.begin, s.end, static_cast<uint32_t>(i)};
       i = (i + 1) & (keys_.size() - 1);
     }
   }
@@ -130,6 +135,12 @@ struct Model {
   KeyIndex index;                 // over table
   float angle_step = 0, distance_step = 0, diameter = 0;
 };
+
+// The feature table of m.features (every model pair with a defined
+// feature, sorted by key, then by pair, so equal keys come in a fixed
+// order), its voting arrays and its key index. Fewer than three points or
+// features not n x n: an empty table (nothing to match).
+void build_table(Model& m);
 
 struct PoseVote {
   Pose pose;

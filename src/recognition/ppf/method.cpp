@@ -212,33 +212,7 @@ class PpfMethod : public Method {
     for (size_t i = 0; i < f.size(); ++i) m_.features[i] = {f[i].f1, f[i].f2, f[i].f3, f[i].f4, f[i].alpha_m};
   }
 
-  // The feature table: every model pair with a defined feature, sorted by
-  // key (then by pair, so equal keys come in a fixed order).
-  void build_search() {
-    m_.table.clear();
-    m_.vote_ref.clear();
-    m_.vote_alpha.clear();
-    const size_t n = m_.points.size();
-    if (n < 3 || m_.features.size() != n * n) return;
-    m_.table.reserve(m_.features.size());
-    for (size_t i = 0; i < n; ++i)
-      for (size_t j = 0; j < n; ++j) {
-        const auto& f = m_.features[i * n + j];
-        if (i == j || !std::isfinite(f.f1) || !std::isfinite(f.f2) || !std::isfinite(f.f3) ||
-            !std::isfinite(f.f4) || !std::isfinite(f.alpha_m))
-          continue;
-        m_.table.push_back({ppf::feature_key(f.f1, f.f2, f.f3, f.f4, m_.angle_step, m_.distance_step),
-                            static_cast<uint32_t>(i), static_cast<uint32_t>(j), f.alpha_m});
-      }
-    std::sort(m_.table.begin(), m_.table.end());
-    m_.vote_ref.resize(m_.table.size());
-    m_.vote_alpha.resize(m_.table.size());
-    for (size_t e = 0; e < m_.table.size(); ++e) {
-      m_.vote_ref[e] = m_.table[e].ref;
-      m_.vote_alpha[e] = m_.table[e].alpha_m;
-    }
-    m_.index.build(m_.table);
-  }
+  void build_search() { ppf::build_table(m_); }
 
   PpfSettings s_;
   ppf::Model m_;

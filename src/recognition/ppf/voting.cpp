@@ -48,6 +48,35 @@ std::vector<int> reference_points(size_t n, double fraction, uint64_t seed) {
   return refs;
 }
 
+void build_table(Model& m) {
+  m.table.clear();
+  m.vote_ref.clear();
+  m.vote_alpha.clear();
+  const size_t n = m.points.size();
+  if (n < 3 || m.features.size() != n * n) {
+    m.index.build(m.table);
+    return;
+  }
+  m.table.reserve(m.features.size());
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j) {
+      const auto& f = m.features[i * n + j];
+      if (i == j || !std::isfinite(f.f1) || !std::isfinite(f.f2) || !std::isfinite(f.f3) || !std::isfinite(f.f4) ||
+          !std::isfinite(f.alpha_m))
+        continue;
+      m.table.push_back({feature_key(f.f1, f.f2, f.f3, f.f4, m.angle_step, m.distance_step),
+                         static_cast<uint32_t>(i), static_cast<uint32_t>(j), f.alpha_m});
+    }
+  std::sort(m.table.begin(), m.table.end());
+  m.vote_ref.resize(m.table.size());
+  m.vote_alpha.resize(m.table.size());
+  for (size_t e = 0; e < m.table.size(); ++e) {
+    m.vote_ref[e] = m.table[e].ref;
+    m.vote_alpha[e] = m.table[e].alpha_m;
+  }
+  m.index.build(m.table);
+}
+
 void KeyIndex::build(const std::vector<PairEntry>& table) {
   keys_.clear();
   size_t distinct = 0;
@@ -91,20 +120,21 @@ int neighbour_keys(const float f[4], const float step[4], float margin, uint64_t
 namespace {
 
 // Hinterstoisser et al.'s flags for one reference point: per looked-up model
-// key, a bit per alpha_s bin already voted. Open addressing, emptied per
-// reference by a generation count.
+// key (its KeyIndex id) and word of 64 alpha_s bins, a bit per bin already
+// voted. Open addressing, emptied per reference by a generation count.
 class VoteFlags {
  public:
-  // True the first time (key, bit) is seen since the last next_reference().
-  bool first(uint64_t key, int bit) {
+  // True the first time (id, bin) is seen since the last next_reference().
+  bool first(uint32_t id, int bin) {
     if (2 * (used_ + 1) > slots_.size()) grow();
+    const uint64_t key = (static_cast<uint64_t>(id) << 32) | (static_cast<uint32_t>(bin) >> 6);
     size_t i = slot(key);
     Slot& s = slots_[i];
     if (s.gen != gen_) {
       s = {key, 0, gen_};
       ++used_;
     }
-    const uint64_t m = uint64_t(1) << (bit & 63);
+    const uint64_t m = uint64_t(1) << (static_cast<uint32_t>(bin) & 63);
     if (s.mask & m) return false;
     s.mask |= m;
     return true;
@@ -120,7 +150,7 @@ class VoteFlags {
     uint32_t gen = 0;
   };
   size_t slot(uint64_t key) const {
-    uint64_t h = key * 0x9e3779b97f4a7c15ull;
+    const uint64_t h = (key ^ (key >> 32)) * 0x9e3779b97f4a7c15ull;  // the id is in the high half
     size_t i = static_cast<size_t>(h >> 20) & (slots_.size() - 1);
     while (slots_[i].gen == gen_ && slots_[i].key != key) i = (i + 1) & (slots_.size() - 1);
     return i;
@@ -247,13 +277,16 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
   std::vector<int> pair_point;                    // the pair's second point
   std::vector<uint32_t> pair_keys_end;            // its keys end here in keys
   std::vector<uint64_t> keys;
-  std::vector<std::pair<uint32_t, uint32_t>> ranges;  // keys[q]'s range in the table
+  std::vector<KeyIndex::Range> ranges;  // keys[q]'s range in the table and its id
   uint64_t pair_keys[16];
   for (int r : refs) {
     const Vec3f sr = scene.points[r], nr = scene.normals[r];
     if (!sr.allFinite() || !nr.allFinite()) continue;
     const Eigen::Affine3f T_sg = to_reference_frame(sr, nr);
-    tree.radius_unsorted(sr, m.diameter, nn);  // votes add up: the neighbour order does not matter
+    // The kd-tree's order of the partners: deterministic, and with vote_once
+    // it counts (the first pair of a (key, alpha_s bin) votes, with its own
+    // alpha_s).
+    tree.radius_unsorted(sr, m.diameter, nn);
     acc.next_reference();
     flags.next_reference();
     pair_point.clear();
@@ -295,11 +328,11 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
       bool have_alpha_s = false;
       for (; q < pair_keys_end[p]; ++q) {
         if (q + kRangesAhead < ranges.size()) {
-          const uint32_t ahead = ranges[q + kRangesAhead].first;
+          const uint32_t ahead = ranges[q + kRangesAhead].begin;
           __builtin_prefetch(m.vote_ref.data() + ahead);
           __builtin_prefetch(m.vote_alpha.data() + ahead);
         }
-        const auto [begin, end] = ranges[q];
+        const auto [begin, end, id] = ranges[q];
         if (begin == end) continue;
         if (!have_alpha_s) {
           alpha_s = pcl_alpha(T_sg, scene.points[i]);
@@ -310,7 +343,7 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
           alpha_s_bin = static_cast<int>(std::floor((alpha_s + M_PI) / m.angle_step));
           have_alpha_s = true;
         }
-        if (opt.vote_once && !flags.first(keys[q], alpha_s_bin)) continue;
+        if (opt.vote_once && !flags.first(id, alpha_s_bin)) continue;
         if (opt.margin > 0) {
           vote_with_margin(m, begin, end, alpha_s, n_alpha, opt.margin, acc);
           continue;
