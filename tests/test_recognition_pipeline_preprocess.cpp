@@ -259,6 +259,25 @@ TEST(Preprocess, PlaneNoiseFactorRemovesANoisyTableWhole) {
   image.points[5].z() = std::numeric_limits<float>::quiet_NaN();  // invalid pixels are skipped
   EXPECT_NEAR(pb::detail::depth_noise_sigma(image), 3, 0.3);
   EXPECT_EQ(pb::detail::depth_noise_sigma(steps), 0);
+  // depth_noise_exceeds decides sigma * factor > threshold as the median
+  // does, on either side of the boundary and at it (ties: not above), at
+  // every row step, and is false where sigma is 0 or undefined.
+  for (const int row_step : {1, 2, 4, 7}) {
+    const double sigma = pb::detail::depth_noise_sigma(image, row_step);
+    for (const double factor : {1.0, 2.0, 2.5}) {
+      const double at = sigma * factor;
+      for (const double thr : {0.0, 0.5 * at, std::nextafter(at, 0.0), at, std::nextafter(at, 1e9), 2 * at})
+        EXPECT_EQ(pb::detail::depth_noise_exceeds(image, factor, thr, row_step), sigma * factor > thr)
+            << "row step " << row_step << ", factor " << factor << ", threshold " << thr;
+    }
+    EXPECT_FALSE(pb::detail::depth_noise_exceeds(steps, 2.0, 0.0, row_step));
+  }
+  pb::OrganizedCloud few = image;
+  few.height = 1;
+  few.points.resize(80);  // 78 triples: fewer than 100, sigma 0
+  few.width = 80;
+  EXPECT_EQ(pb::detail::depth_noise_sigma(few, 1), 0);
+  EXPECT_FALSE(pb::detail::depth_noise_exceeds(few, 2.0, 0.0, 1));
 }
 
 // Mixed pixels at a depth edge: a wall at 1000 mm, a square 200 mm before

@@ -58,6 +58,9 @@ size_t count_within(const PlanePoints& pts, const Eigen::Vector4d& plane, double
 // apart because each set of results was measured with its own, and either
 // one replacing the other would move them.
 double depth_noise_sigma(const OrganizedCloud& cloud, int row_step = 4);
+// Whether depth_noise_sigma(cloud, row_step) * factor > threshold, from a
+// count of the second differences (no median unless it is needed).
+bool depth_noise_exceeds(const OrganizedCloud& cloud, double factor, double threshold, int row_step = 4);
 
 
 // Mixed ("flying", "veil") pixels of an organized cloud: flags a valid pixel

@@ -214,21 +214,48 @@ std::vector<char> ransac_plane(const std::vector<Vec3f>& all, double thr, int it
   return flags;
 }
 
-double depth_noise_sigma(const OrganizedCloud& cloud, int row_step) {
-  std::vector<float> e;
+namespace {
+
+// The second differences |z[i-1] - 2 z[i] + z[i+1]| of depth_noise_sigma,
+// each passed to visit; false (none visited) if the cloud is not
+// organized.
+template <class Visit>
+bool visit_second_differences(const OrganizedCloud& cloud, int row_step, Visit visit) {
   const int w = cloud.width, h = cloud.height;
-  if (w < 3 || h < 1 || cloud.points.size() != static_cast<size_t>(w) * static_cast<size_t>(h)) return 0;
+  if (w < 3 || h < 1 || cloud.points.size() != static_cast<size_t>(w) * static_cast<size_t>(h)) return false;
   for (int y = 0; y < h; y += std::max(1, row_step)) {
     const Vec3f* row = cloud.points.data() + static_cast<size_t>(y) * static_cast<size_t>(w);
     for (int x = 1; x + 1 < w; ++x) {
       const float a = row[x - 1].z(), b = row[x].z(), c = row[x + 1].z();
-      if (std::isfinite(a) && std::isfinite(b) && std::isfinite(c)) e.push_back(std::abs(a - 2 * b + c));
+      if (std::isfinite(a) && std::isfinite(b) && std::isfinite(c)) visit(std::abs(a - 2 * b + c));
     }
   }
+  return true;
+}
+
+double sigma_of_median(float e) { return static_cast<double>(e) / 0.6745 / std::sqrt(6.0); }
+
+}  // namespace
+
+double depth_noise_sigma(const OrganizedCloud& cloud, int row_step) {
+  std::vector<float> e;
+  visit_second_differences(cloud, row_step, [&e](float v) { e.push_back(v); });
   if (e.size() < 100) return 0;
   const auto mid = e.begin() + static_cast<std::ptrdiff_t>(e.size() / 2);
   std::nth_element(e.begin(), mid, e.end());
-  return static_cast<double>(*mid) / 0.6745 / std::sqrt(6.0);
+  return sigma_of_median(*mid);
+}
+
+bool depth_noise_exceeds(const OrganizedCloud& cloud, double factor, double threshold, int row_step) {
+  // sigma_of_median(e) * factor > threshold is non-decreasing in e, so it
+  // holds for the median (the element at n / 2 in ascending order) exactly
+  // when at most n / 2 of the values fail it.
+  size_t n = 0, fail = 0;
+  visit_second_differences(cloud, row_step, [&](float v) {
+    ++n;
+    fail += sigma_of_median(v) * factor > threshold ? 0 : 1;
+  });
+  return n >= 100 && fail <= n / 2;
 }
 
 std::vector<char> veil_pixels(const OrganizedCloud& cloud, double angle_deg) {
@@ -301,13 +328,17 @@ namespace {
 void remove_planes(PointSet& ps, const OrganizedCloud& cloud, const PreprocessSettings& s, uint64_t seed,
                    size_t median_points = 0) {
   const double min_count = s.min_plane_fraction * static_cast<double>(ps.size());
-  const double depth_sigma = s.plane_noise_factor > 0 ? detail::depth_noise_sigma(cloud) : 0.0;
+  // The noise's widening applies when depth_noise_sigma * plane_noise_factor
+  // exceeds the threshold; the median itself is found only then.
+  const bool widen = s.plane_noise_factor > 0 &&
+                     detail::depth_noise_exceeds(cloud, s.plane_noise_factor, s.plane_threshold_mm);
+  const double depth_sigma = widen ? detail::depth_noise_sigma(cloud) : 0.0;
   for (int k = 0; k < s.max_planes && ps.size() >= 3; ++k) {
     Eigen::Vector4d plane;
     std::vector<char> on_plane = detail::ransac_plane(ps.points, s.plane_threshold_mm, s.plane_iterations,
                                                       k == 0 ? seed : derive_seed(seed, {static_cast<uint64_t>(k)}),
                                                       &plane, s.plane_sample_points, s.plane_probability);
-    if (depth_sigma * s.plane_noise_factor > s.plane_threshold_mm) {
+    if (widen) {
       // Depth noise along the rays, seen across the plane: x the median
       // |cos| between the plane's normal and the rays to its points.
       std::vector<double> cosines;
