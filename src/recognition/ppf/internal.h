@@ -164,6 +164,20 @@ bool pair_feature_parts(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const
 // pcl::computePairFeatures itself (tests: the reference of pair_feature).
 bool pcl_pair_feature(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2, float f[4]);
 
+// The key of a scene pair (PCL's pair feature binned: f1's bin from
+// atan2_bin, the others' from feature_bin, packed): false where the pair
+// has no feature (coincident points, a degenerate frame, a NaN).
+bool pair_key(const Vec3f& sr, const Vec3f& nr, const Vec3f& p, const Vec3f& n, const float step[4], uint64_t* key);
+// The keys of reference point (sr, nr) paired with scene points
+// partners[0..n) (a partner equal to `self` skipped), in order: the pairs
+// with a key in out_point[0..m), their keys in out_key[0..m) (each room
+// for n); returns m. Eight pairs at a time where the CPU has AVX2, the same
+// bits as pair_keys_plain, one at a time with pair_key.
+size_t pair_keys(const Vec3f& sr, const Vec3f& nr, const PointSet& scene, const int* partners, size_t n, int self,
+                 const float step[4], int* out_point, uint64_t* out_key);
+size_t pair_keys_plain(const Vec3f& sr, const Vec3f& nr, const PointSet& scene, const int* partners, size_t n,
+                       int self, const float step[4], int* out_point, uint64_t* out_key);
+
 // Rigid transform taking point p to the origin and the unit normal n onto
 // +x (PCL's PPF convention).
 Eigen::Affine3f to_reference_frame(const Vec3f& p, const Vec3f& n);

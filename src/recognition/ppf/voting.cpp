@@ -278,7 +278,7 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
   std::vector<uint32_t> pair_keys_end;            // its keys end here in keys
   std::vector<uint64_t> keys;
   std::vector<KeyIndex::Range> ranges;  // keys[q]'s range in the table and its id
-  uint64_t pair_keys[16];
+  uint64_t margin_keys[16];
   for (int r : refs) {
     const Vec3f sr = scene.points[r], nr = scene.normals[r];
     if (!sr.allFinite() || !nr.allFinite()) continue;
@@ -292,26 +292,30 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
     pair_point.clear();
     pair_keys_end.clear();
     keys.clear();
-    for (int i : nn) {
-      if (i == r) continue;
-      float f[4], y0, x0;
-      if (!pair_feature_parts(sr, nr, scene.points[static_cast<size_t>(i)], scene.normals[static_cast<size_t>(i)], f,
-                              &y0, &x0))
-        continue;
-      // f[0] = atan2(y0, x0) is finite unless an argument is NaN.
-      if (std::isnan(y0) || std::isnan(x0) || !std::isfinite(f[1]) || !std::isfinite(f[2]) || !std::isfinite(f[3]))
-        continue;
-      int n_keys = 1;
-      if (opt.margin > 0) {  // the bins' fractions count: the angle itself
-        f[0] = std::atan2(y0, x0);
-        n_keys = neighbour_keys(f, step, opt.margin, pair_keys);
-      } else {  // its bin alone (neighbour_keys with no margin)
-        pair_keys[0] = pack_key(atan2_bin(y0, x0, step[0]), feature_bin(f[1], step[1]), feature_bin(f[2], step[2]),
-                                feature_bin(f[3], step[3]));
+    if (opt.margin > 0) {
+      for (int i : nn) {
+        if (i == r) continue;
+        float f[4], y0, x0;
+        if (!pair_feature_parts(sr, nr, scene.points[static_cast<size_t>(i)], scene.normals[static_cast<size_t>(i)],
+                                f, &y0, &x0))
+          continue;
+        // f[0] = atan2(y0, x0) is finite unless an argument is NaN.
+        if (std::isnan(y0) || std::isnan(x0) || !std::isfinite(f[1]) || !std::isfinite(f[2]) || !std::isfinite(f[3]))
+          continue;
+        f[0] = std::atan2(y0, x0);  // the bins' fractions count: the angle itself
+        const int n_keys = neighbour_keys(f, step, opt.margin, margin_keys);
+        pair_point.push_back(i);
+        keys.insert(keys.end(), margin_keys, margin_keys + n_keys);
+        pair_keys_end.push_back(static_cast<uint32_t>(keys.size()));
       }
-      pair_point.push_back(i);
-      keys.insert(keys.end(), pair_keys, pair_keys + n_keys);
-      pair_keys_end.push_back(static_cast<uint32_t>(keys.size()));
+    } else {  // one key per pair, its own bin
+      pair_point.resize(nn.size());
+      keys.resize(nn.size());
+      const size_t n_pairs = pair_keys(sr, nr, scene, nn.data(), nn.size(), r, step, pair_point.data(), keys.data());
+      pair_point.resize(n_pairs);
+      keys.resize(n_pairs);
+      pair_keys_end.resize(n_pairs);
+      std::iota(pair_keys_end.begin(), pair_keys_end.end(), 1u);
     }
     ranges.resize(keys.size());
     for (size_t q = 0; q < keys.size(); ++q) {
