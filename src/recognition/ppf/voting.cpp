@@ -253,6 +253,34 @@ int AlphaBins::exact(float alpha) const {
   return std::max(0, std::min(n_ - 1, static_cast<int>(std::floor(alpha_bin_value(alpha, step_)))));
 }
 
+namespace {
+
+// The keys of reference point (sr, nr) paired with each of `partners` but
+// itself, with neighbouring bins (Vidal et al.'s margin > 0): per pair with
+// a feature its point, its keys appended to `keys`, their end.
+void margin_pair_keys(const Vec3f& sr, const Vec3f& nr, const PointSet& scene, const std::vector<int>& partners,
+                      int self, const float step[4], float margin, std::vector<int>& pair_point,
+                      std::vector<uint64_t>& keys, std::vector<uint32_t>& pair_keys_end) {
+  uint64_t margin_keys[16];
+  for (int i : partners) {
+    if (i == self) continue;
+    float f[4], y0, x0;
+    if (!pair_feature_parts(sr, nr, scene.points[static_cast<size_t>(i)], scene.normals[static_cast<size_t>(i)], f,
+                            &y0, &x0))
+      continue;
+    // f[0] = atan2(y0, x0) is finite unless an argument is NaN.
+    if (std::isnan(y0) || std::isnan(x0) || !std::isfinite(f[1]) || !std::isfinite(f[2]) || !std::isfinite(f[3]))
+      continue;
+    f[0] = std::atan2(y0, x0);  // the bins' fractions count: the angle itself
+    const int n_keys = neighbour_keys(f, step, margin, margin_keys);
+    pair_point.push_back(i);
+    keys.insert(keys.end(), margin_keys, margin_keys + n_keys);
+    pair_keys_end.push_back(static_cast<uint32_t>(keys.size()));
+  }
+}
+
+}  // namespace
+
 std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vector<int>& refs,
                            const VoteOptions& opt) {
   const KdTree3 tree(scene.points);
@@ -278,7 +306,6 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
   std::vector<uint32_t> pair_keys_end;            // its keys end here in keys
   std::vector<uint64_t> keys;
   std::vector<KeyIndex::Range> ranges;  // keys[q]'s range in the table and its id
-  uint64_t margin_keys[16];
   for (int r : refs) {
     const Vec3f sr = scene.points[r], nr = scene.normals[r];
     if (!sr.allFinite() || !nr.allFinite()) continue;
@@ -293,21 +320,7 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
     pair_keys_end.clear();
     keys.clear();
     if (opt.margin > 0) {
-      for (int i : nn) {
-        if (i == r) continue;
-        float f[4], y0, x0;
-        if (!pair_feature_parts(sr, nr, scene.points[static_cast<size_t>(i)], scene.normals[static_cast<size_t>(i)],
-                                f, &y0, &x0))
-          continue;
-        // f[0] = atan2(y0, x0) is finite unless an argument is NaN.
-        if (std::isnan(y0) || std::isnan(x0) || !std::isfinite(f[1]) || !std::isfinite(f[2]) || !std::isfinite(f[3]))
-          continue;
-        f[0] = std::atan2(y0, x0);  // the bins' fractions count: the angle itself
-        const int n_keys = neighbour_keys(f, step, opt.margin, margin_keys);
-        pair_point.push_back(i);
-        keys.insert(keys.end(), margin_keys, margin_keys + n_keys);
-        pair_keys_end.push_back(static_cast<uint32_t>(keys.size()));
-      }
+      margin_pair_keys(sr, nr, scene, nn, r, step, opt.margin, pair_point, keys, pair_keys_end);
     } else {  // one key per pair, its own bin
       pair_point.resize(nn.size());
       keys.resize(nn.size());
