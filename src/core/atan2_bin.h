@@ -36,13 +36,13 @@ inline double series_atan2(float yf, float xf) {
 // series' both ways; where `bin` is the same at both ends of that window it
 // is atan2f's bin. Otherwise (an edge within the window, a zero argument
 // with its sign, a non-finite one) atan2f decides.
+inline constexpr double kAtan2BinWindow = 1e-5;
 template <class Bin>
 inline auto binned_atan2(float y, float x, const Bin& bin) -> decltype(bin(0.0f)) {
   if (y != 0.0f && x != 0.0f && std::isfinite(y) && std::isfinite(x)) {
     const double a = series_atan2(y, x);
-    constexpr double kWindow = 1e-5;
-    const auto lo = bin(static_cast<float>(a - kWindow));
-    if (lo == bin(static_cast<float>(a + kWindow))) return lo;
+    const auto lo = bin(static_cast<float>(a - kAtan2BinWindow));
+    if (lo == bin(static_cast<float>(a + kAtan2BinWindow))) return lo;
   }
   return bin(std::atan2(y, x));
 }

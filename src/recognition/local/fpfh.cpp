@@ -38,7 +38,7 @@ namespace pb::local {
 
 namespace {
 
-constexpr int kBins = 11;  // per angle
+constexpr int kBins = kSpfhBins;  // per angle
 
 using Hist = std::array<float, kFpfhDim>;
 using Counts = std::array<uint32_t, kFpfhDim>;
@@ -56,8 +56,7 @@ inline int thread_num() {
 // without atan2f where the bin is in no doubt (core/atan2_bin.h; the bin
 // rises with f1).
 inline void count_pair(float f1_y, float f1_x, float f2, float f3, uint32_t* c) {
-  const double inv_2pi = static_cast<double>(1.0f / (2.0f * static_cast<float>(M_PI)));
-  ++c[binned_atan2(f1_y, f1_x, [inv_2pi](float f1) { return clamped_bin(kBins * ((f1 + M_PI) * inv_2pi), kBins); })];
+  ++c[binned_atan2(f1_y, f1_x, [](float f1) { return clamped_bin(kBins * ((f1 + M_PI) * kSpfhInv2Pi), kBins); })];
   ++c[kBins + clamped_bin(kBins * ((f2 + 1.0) * 0.5), kBins)];
   ++c[2 * kBins + clamped_bin(kBins * ((f3 + 1.0) * 0.5), kBins)];
 }
@@ -84,6 +83,43 @@ struct Known {
   std::vector<std::vector<std::pair<float, int>>> lists;  // per slot: thinned, sorted by distance
   std::vector<size_t> found;                              // per slot: neighbours before thinning
 };
+
+// The buffers of count_pairs, kept from row to row.
+struct PairWork {
+  std::vector<uint8_t> decided;
+  std::vector<int> bins;
+};
+
+// The counts of point p's pairs with todo[j] added to `own` and, where
+// todo_row[j] >= 0, to that row's counts in `rows`: their bins eight at a
+// time where spfh_pair_bins decides them (symmetric pairs: the same bins
+// both ways), the others one at a time with darboux_pair both ways.
+void count_pairs(const PointSet& cloud, int p, const std::vector<int>& todo, const std::vector<int>& todo_row,
+                 uint32_t* own, std::vector<Counts>& rows, PairWork& work) {
+  const std::vector<Vec3f>& pts = cloud.points;
+  work.decided.resize(todo.size());
+  work.bins.resize(3 * todo.size());
+  spfh_pair_bins(cloud, p, todo.data(), todo.size(), work.decided.data(), work.bins.data());
+  for (size_t j = 0; j < todo.size(); ++j) {
+    const int q = todo[j], qrow = todo_row[j];
+    uint32_t* other = qrow >= 0 ? rows[static_cast<size_t>(qrow)].data() : nullptr;
+    if (work.decided[j]) {
+      const int* b = work.bins.data() + 3 * j;
+      ++own[b[0]], ++own[b[1]], ++own[b[2]];
+      if (other) ++other[b[0]], ++other[b[1]], ++other[b[2]];
+      continue;
+    }
+    float f1_y, f1_x, f2, f3;
+    bool symmetric = false;
+    if (darboux_pair(pts[p], cloud.normals[p], pts[q], cloud.normals[q], &f1_y, &f1_x, f2, f3, &symmetric)) {
+      count_pair(f1_y, f1_x, f2, f3, own);
+      if (other && symmetric) count_pair(f1_y, f1_x, f2, f3, other);
+    }
+    if (other && !symmetric &&
+        darboux_pair(pts[q], cloud.normals[q], pts[p], cloud.normals[p], &f1_y, &f1_x, f2, f3, &symmetric))
+      count_pair(f1_y, f1_x, f2, f3, other);
+  }
+}
 
 std::vector<Hist> spfh_histograms(const PointSet& cloud, const CloudNeighbours& tree, float r2,
                                   const std::vector<int>& needed, const std::vector<int>& row_of, int max_support,
@@ -140,7 +176,8 @@ std::vector<Hist> spfh_histograms(const PointSet& cloud, const CloudNeighbours& 
     std::vector<Counts>& mine = counts[static_cast<size_t>(thread_num())];
     mine.assign(rows, Counts{});
     std::vector<std::pair<float, int>> nn;
-    std::vector<int> searched;
+    std::vector<int> searched, todo, todo_row;
+    PairWork pair_work;
 #pragma omp for schedule(dynamic, 64)
     for (long i = 0; i < static_cast<long>(rows); ++i) {
       const size_t r = static_cast<size_t>(i);
@@ -159,21 +196,19 @@ std::vector<Hist> spfh_histograms(const PointSet& cloud, const CloudNeighbours& 
       }
       pairs_of[r] = static_cast<int>(len);
       const bool alone = thinned[r];
+      // The pairs this row computes, their bins eight at a time where
+      // decided (symmetric pairs), the others one at a time.
+      todo.clear();
+      todo_row.clear();
       for (size_t j = 0; j < len; ++j) {
         const int q = list[j];
         int qrow = row_of[static_cast<size_t>(q)];
         if (alone || (qrow >= 0 && thinned[static_cast<size_t>(qrow)])) qrow = -1;  // q counts its own
         if (qrow >= 0 && q < p) continue;  // counted from q
-        float f1_y, f1_x, f2, f3;
-        bool symmetric = false;
-        if (darboux_pair(pts[p], cloud.normals[p], pts[q], cloud.normals[q], &f1_y, &f1_x, f2, f3, &symmetric)) {
-          count_pair(f1_y, f1_x, f2, f3, mine[r].data());
-          if (qrow >= 0 && symmetric) count_pair(f1_y, f1_x, f2, f3, mine[static_cast<size_t>(qrow)].data());
-        }
-        if (qrow >= 0 && !symmetric &&
-            darboux_pair(pts[q], cloud.normals[q], pts[p], cloud.normals[p], &f1_y, &f1_x, f2, f3, &symmetric))
-          count_pair(f1_y, f1_x, f2, f3, mine[static_cast<size_t>(qrow)].data());
+        todo.push_back(q);
+        todo_row.push_back(qrow);
       }
+      count_pairs(cloud, p, todo, todo_row, mine[r].data(), mine, pair_work);
     }
   }
   kept = {};

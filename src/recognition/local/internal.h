@@ -30,6 +30,17 @@ constexpr int kLrfDim = 9;     // x, y, z axes (rows of R_local_cam)
 // by voxel key (deterministic).
 std::vector<int> voxel_keypoints(const PointSet& cloud, double voxel_mm);
 
+// SPFH's bins per angle (FPFH: three of them) and count_pair's 1 / (2 pi),
+// PCL's float value (fpfh.cpp).
+constexpr int kSpfhBins = 11;
+constexpr double kSpfhInv2Pi = static_cast<double>(1.0f / (2.0f * static_cast<float>(M_PI)));
+// The SPFH bins of darboux_pair(cloud point p, partners[j]) for j < n
+// (fpfh_pairs.cpp), eight at a time where the CPU has AVX2: where
+// decided[j], the pair is symmetric and its three bins, each histogram's
+// offset added, are bins[3 j .. 3 j + 2]; elsewhere (every pair without
+// AVX2) the caller computes it one at a time.
+void spfh_pair_bins(const PointSet& cloud, int p, const int* partners, size_t n, uint8_t* decided, int* bins);
+
 // Descriptors at `keypoints` (indices into `cloud`) with the whole cloud as
 // search surface and its normals (fpfh.cpp, shot.cpp: PCL's definitions,
 // our code); row-major, keypoints.size() x dim. Rows that have no

@@ -12,8 +12,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
+#include "core/lanes_avx2.h"
 #include "core/cpu.h"
 #include "recognition/ppf/internal.h"
 
@@ -49,26 +49,11 @@ size_t pair_keys_plain(const Vec3f& sr, const Vec3f& nr, const PointSet& scene, 
 
 namespace {
 
-struct V3 {
-  __m256 x, y, z;
-};
-
 // Eigen's Vector4f dot product with a zero fourth lane, (x + z) + (y + 0),
 // as pair_feature_parts' dot4.
-__attribute__((target("avx2"))) inline __m256 dot4(const V3& a, const V3& b) {
+__attribute__((target("avx2"))) inline __m256 dot4(const Lanes3& a, const Lanes3& b) {
   return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(a.x, b.x), _mm256_mul_ps(a.z, b.z)),
                        _mm256_add_ps(_mm256_mul_ps(a.y, b.y), _mm256_setzero_ps()));
-}
-
-// Eigen's cross product of 3-vectors, coefficient by coefficient.
-__attribute__((target("avx2"))) inline V3 cross(const V3& a, const V3& b) {
-  return {_mm256_sub_ps(_mm256_mul_ps(a.y, b.z), _mm256_mul_ps(a.z, b.y)),
-          _mm256_sub_ps(_mm256_mul_ps(a.z, b.x), _mm256_mul_ps(a.x, b.z)),
-          _mm256_sub_ps(_mm256_mul_ps(a.x, b.y), _mm256_mul_ps(a.y, b.x))};
-}
-
-__attribute__((target("avx2"))) inline V3 select(__m256 mask, const V3& a, const V3& b) {  // mask ? a : b
-  return {_mm256_blendv_ps(b.x, a.x, mask), _mm256_blendv_ps(b.y, a.y, mask), _mm256_blendv_ps(b.z, a.z, mask)};
 }
 
 // feature_bin: clamped_bin(floor(f / step)), as int32 lanes.
@@ -78,43 +63,12 @@ __attribute__((target("avx2"))) inline __m256i bins(__m256 f, __m256 step) {
   return _mm256_cvttps_epi32(c);
 }
 
-// series_atan2 of four lanes (double), then the two ends of its window as
-// floats.
-__attribute__((target("avx2"))) inline void series_window(__m128 yf, __m128 xf, __m128* lo, __m128* hi) {
-  const __m256d y = _mm256_cvtps_pd(yf), x = _mm256_cvtps_pd(xf);
-  const __m256d sign = _mm256_set1_pd(-0.0), zero = _mm256_setzero_pd();
-  const __m256d ay = _mm256_andnot_pd(sign, y), ax = _mm256_andnot_pd(sign, x);
-  const __m256d steep = _mm256_cmp_pd(ay, ax, _CMP_GT_OQ);
-  __m256d t = _mm256_div_pd(_mm256_blendv_pd(ay, ax, steep), _mm256_blendv_pd(ax, ay, steep));
-  const __m256d big = _mm256_cmp_pd(t, _mm256_set1_pd(0.41421356237309503), _CMP_GT_OQ);
-  const __m256d one = _mm256_set1_pd(1.0);
-  t = _mm256_blendv_pd(t, _mm256_div_pd(_mm256_sub_pd(t, one), _mm256_add_pd(t, one)), big);
-  const __m256d base = _mm256_blendv_pd(zero, _mm256_set1_pd(M_PI / 4), big);
-  const __m256d t2 = _mm256_mul_pd(t, t);
-  __m256d s = _mm256_set1_pd(-1.0 / 15);
-  for (const double c : {1.0 / 13, -1.0 / 11, 1.0 / 9, -1.0 / 7, 1.0 / 5, -1.0 / 3, 1.0})
-    s = _mm256_add_pd(_mm256_mul_pd(s, t2), _mm256_set1_pd(c));
-  __m256d r = _mm256_add_pd(base, _mm256_mul_pd(t, s));
-  r = _mm256_blendv_pd(r, _mm256_sub_pd(_mm256_set1_pd(M_PI / 2), r), steep);
-  r = _mm256_blendv_pd(r, _mm256_sub_pd(_mm256_set1_pd(M_PI), r), _mm256_cmp_pd(x, zero, _CMP_LT_OQ));
-  r = _mm256_blendv_pd(r, _mm256_xor_pd(r, sign), _mm256_cmp_pd(y, zero, _CMP_LT_OQ));
-  const __m256d window = _mm256_set1_pd(1e-5);
-  *lo = _mm256_cvtpd_ps(_mm256_sub_pd(r, window));
-  *hi = _mm256_cvtpd_ps(_mm256_add_pd(r, window));
-}
-
-__attribute__((target("avx2"))) inline __m256 finite(__m256 v) {  // all bits set where v is finite
-  const __m256 abs = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), v);
-  return _mm256_cmp_ps(abs, _mm256_set1_ps(std::numeric_limits<float>::max()), _CMP_LE_OQ);
-}
-
 __attribute__((target("avx2"))) size_t pair_keys_avx2(const Vec3f& sr, const Vec3f& nr, const PointSet& scene,
                                                       const int* partners, size_t n, int self, const float step[4],
                                                       int* out_point, uint64_t* out_key) {
   const float* pts = scene.points.front().data();
   const float* nrm = scene.normals.front().data();
-  const V3 p1{_mm256_set1_ps(sr.x()), _mm256_set1_ps(sr.y()), _mm256_set1_ps(sr.z())};
-  const V3 n1{_mm256_set1_ps(nr.x()), _mm256_set1_ps(nr.y()), _mm256_set1_ps(nr.z())};
+  const Lanes3 p1 = broadcast3(sr), n1 = broadcast3(nr);
   const __m256 zero = _mm256_setzero_ps(), sign = _mm256_set1_ps(-0.0f), one = _mm256_set1_ps(1.0f),
                sure = _mm256_set1_ps(1e-6f);
   const __m256 step0 = _mm256_set1_ps(step[0]), step1 = _mm256_set1_ps(step[1]), step2 = _mm256_set1_ps(step[2]),
@@ -122,49 +76,41 @@ __attribute__((target("avx2"))) size_t pair_keys_avx2(const Vec3f& sr, const Vec
   size_t m = 0;
   alignas(32) int lane[8], ok[8], b[4][8];
   for (size_t k = 0; k < n; k += 8) {
-    const size_t count = std::min<size_t>(8, n - k);
-    for (size_t j = 0; j < 8; ++j) lane[j] = partners[k + (j < count ? j : 0)];
-    const __m256i at = _mm256_mullo_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(lane)),
-                                          _mm256_set1_epi32(3));
-    const V3 p2{_mm256_i32gather_ps(pts, at, 4), _mm256_i32gather_ps(pts + 1, at, 4),
-                _mm256_i32gather_ps(pts + 2, at, 4)};
-    const V3 n2{_mm256_i32gather_ps(nrm, at, 4), _mm256_i32gather_ps(nrm + 1, at, 4),
-                _mm256_i32gather_ps(nrm + 2, at, 4)};
-    V3 d{_mm256_sub_ps(p2.x, p1.x), _mm256_sub_ps(p2.y, p1.y), _mm256_sub_ps(p2.z, p1.z)};
-    const __m256 f3 = _mm256_sqrt_ps(dot4(d, d));
-    const __m256 c1 = _mm256_div_ps(dot4(n1, d), f3), c2 = _mm256_div_ps(dot4(n2, d), f3);
+    const PairLanes pl = pair_lanes<dot4>(pts, nrm, partners, k, n, lane, p1, n1);
+    Lanes3 d = pl.d;
     // The source point: decided here where the cosines are 1e-6 apart.
-    const __m256 a1 = _mm256_andnot_ps(sign, c1), a2 = _mm256_andnot_ps(sign, c2);
+    const __m256 a1 = _mm256_andnot_ps(sign, pl.c1), a2 = _mm256_andnot_ps(sign, pl.c2);
     const __m256 swap = _mm256_and_ps(_mm256_cmp_ps(a2, one, _CMP_LE_OQ),
                                       _mm256_cmp_ps(a1, _mm256_sub_ps(a2, sure), _CMP_LT_OQ));
     const __m256 keep = _mm256_and_ps(_mm256_cmp_ps(a1, one, _CMP_LE_OQ),
                                       _mm256_cmp_ps(a2, _mm256_sub_ps(a1, sure), _CMP_LT_OQ));
     __m256 good = _mm256_or_ps(swap, keep);
-    good = _mm256_and_ps(good, _mm256_cmp_ps(f3, zero, _CMP_NEQ_OQ));
-    const V3 u = select(swap, n2, n1), target = select(swap, n1, n2);
-    d = select(swap, V3{_mm256_xor_ps(d.x, sign), _mm256_xor_ps(d.y, sign), _mm256_xor_ps(d.z, sign)}, d);
-    const __m256 f2 = _mm256_blendv_ps(c1, _mm256_xor_ps(c2, sign), swap);
-    V3 v = cross(d, u);
+    good = _mm256_and_ps(good, _mm256_cmp_ps(pl.length, zero, _CMP_NEQ_OQ));
+    const Lanes3 u = select(swap, pl.n2, n1), target = select(swap, n1, pl.n2);
+    d = select(swap, negated(d), d);
+    const __m256 f2 = _mm256_blendv_ps(pl.c1, _mm256_xor_ps(pl.c2, sign), swap);
+    Lanes3 v = cross(d, u);
     const __m256 vn = _mm256_sqrt_ps(dot4(v, v));
     good = _mm256_and_ps(good, _mm256_cmp_ps(vn, zero, _CMP_NEQ_OQ));
     v = {_mm256_div_ps(v.x, vn), _mm256_div_ps(v.y, vn), _mm256_div_ps(v.z, vn)};
-    const V3 w = cross(u, v);
+    const Lanes3 w = cross(u, v);
     const __m256 f1 = dot4(v, target), y = dot4(w, target), x = dot4(u, target);
-    good = _mm256_and_ps(good, _mm256_and_ps(_mm256_and_ps(finite(f1), finite(f2)), finite(f3)));
-    good = _mm256_and_ps(good, _mm256_and_ps(finite(y), finite(x)));
+    good = _mm256_and_ps(good,
+                         _mm256_and_ps(_mm256_and_ps(finite_lanes(f1), finite_lanes(f2)), finite_lanes(pl.length)));
+    good = _mm256_and_ps(good, _mm256_and_ps(finite_lanes(y), finite_lanes(x)));
     good = _mm256_and_ps(good, _mm256_and_ps(_mm256_cmp_ps(y, zero, _CMP_NEQ_OQ), _mm256_cmp_ps(x, zero, _CMP_NEQ_OQ)));
     // f1's bin from the series where its window leaves no doubt.
     __m128 lo_a, hi_a, lo_b, hi_b;
-    series_window(_mm256_castps256_ps128(y), _mm256_castps256_ps128(x), &lo_a, &hi_a);
-    series_window(_mm256_extractf128_ps(y, 1), _mm256_extractf128_ps(x, 1), &lo_b, &hi_b);
+    series_atan2_window(_mm256_castps256_ps128(y), _mm256_castps256_ps128(x), &lo_a, &hi_a);
+    series_atan2_window(_mm256_extractf128_ps(y, 1), _mm256_extractf128_ps(x, 1), &lo_b, &hi_b);
     const __m256i b0 = bins(_mm256_set_m128(lo_b, lo_a), step0);
     good = _mm256_and_ps(good, _mm256_castsi256_ps(_mm256_cmpeq_epi32(b0, bins(_mm256_set_m128(hi_b, hi_a), step0))));
     _mm256_store_si256(reinterpret_cast<__m256i*>(ok), _mm256_castps_si256(good));
     _mm256_store_si256(reinterpret_cast<__m256i*>(b[0]), b0);
     _mm256_store_si256(reinterpret_cast<__m256i*>(b[1]), bins(f1, step1));
     _mm256_store_si256(reinterpret_cast<__m256i*>(b[2]), bins(f2, step2));
-    _mm256_store_si256(reinterpret_cast<__m256i*>(b[3]), bins(f3, step3));
-    for (size_t j = 0; j < count; ++j) {
+    _mm256_store_si256(reinterpret_cast<__m256i*>(b[3]), bins(pl.length, step3));
+    for (size_t j = 0; j < pl.count; ++j) {
       const int i = lane[j];
       if (i == self) continue;
       if (ok[j]) {
