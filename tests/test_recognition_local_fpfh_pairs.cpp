@@ -18,14 +18,11 @@
 #include "core/random.h"
 #include "recognition/darboux.h"
 #include "recognition/local/internal.h"
+#include "pair_feature_clouds.h"
 
 namespace pb {
 namespace {
 
-Vec3f unit(Rng& rng) {
-  return Vec3f(static_cast<float>(rng.normal()), static_cast<float>(rng.normal()), static_cast<float>(rng.normal()))
-      .normalized();
-}
 
 // Every point of `cloud` against every point (or, `mates`, point 2i against
 // 2i + 1 and back): decided pairs checked against the definition; returns
@@ -74,57 +71,17 @@ TEST(SpfhPairBins, EightAtATimeEqualTheDefinition) {
   Rng rng(31);
   size_t pairs = 0, taken = 0;
   for (const float scale : {0.01f, 1.f, 100.f, 5000.f}) {
-    PointSet cloud;  // 203 points: the last block of eight is short
-    for (int k = 0; k < 203; ++k) {
-      cloud.points.emplace_back(static_cast<float>(rng.uniform(-scale, scale)),
-                                static_cast<float>(rng.uniform(-scale, scale)),
-                                static_cast<float>(rng.uniform(-scale, scale)));
-      cloud.normals.push_back(unit(rng));
-    }
-    const auto [np, nt] = check(cloud, "random, scale " + std::to_string(scale));
+    const std::string at_scale = ", scale " + std::to_string(scale);
+    const auto [np, nt] = check(pair_clouds::random_cloud(rng, scale), "random" + at_scale);
     pairs += np;
     taken += nt;
-    // A plane with its normal (equal cosines), a line with normals along
-    // it, duplicates, non-finite values.
-    PointSet special;
-    const Vec3f n0 = unit(rng), a = n0.unitOrthogonal(), b = n0.cross(a);
-    for (int k = 0; k < 30; ++k) {
-      special.points.push_back(scale * (static_cast<float>(rng.uniform(-1, 1)) * a +
-                                        static_cast<float>(rng.uniform(-1, 1)) * b));
-      special.normals.push_back(k % 2 ? n0 : Vec3f(-n0));
-    }
-    for (int k = 0; k < 8; ++k) {
-      special.points.push_back(scale * static_cast<float>(k) * 0.1f * n0);
-      special.normals.push_back(n0);
-    }
-    for (int k = 0; k < 5; ++k) {
-      special.points.push_back(special.points[static_cast<size_t>(k)]);
-      special.normals.push_back(unit(rng));
-    }
-    const float nan = std::numeric_limits<float>::quiet_NaN();
-    special.points.emplace_back(nan, 0.f, 0.f);
-    special.normals.push_back(n0);
-    special.points.emplace_back(scale, scale, scale);
-    special.normals.emplace_back(nan, nan, nan);
-    check(special, "special, scale " + std::to_string(scale));
-    // f1 = atan2(y, x) at its bin edges (f1 = -a, as in PpfPairKeys): the
-    // point at the origin, its normal leaned by a from +x toward +z, the
-    // other on the z axis with its normal in the xy plane.
-    PointSet edges;
+    check(pair_clouds::special_cloud(rng, scale), "special" + at_scale);
+    // f1 = atan2(y, x) at its bin edges -pi + m width, m = 0..11, which are
+    // (k + 1/2) width.
+    std::vector<float> at;
     const double width = 2 * M_PI / local::kSpfhBins;
-    for (int k = -6; k <= 5; ++k)  // the edges -pi + m width, m = 0..11, are (k + 1/2) width
-      for (int u = -3; u <= 3; ++u) {
-        const float e = static_cast<float>((k + 0.5) * width);
-        const float t = std::nextafter(e, u < 0 ? -10.f : 10.f) + static_cast<float>(u) * 1e-7f;
-        edges.points.emplace_back(0.f, 0.f, 0.f);
-        edges.normals.emplace_back(std::cos(t), 0.f, std::sin(t));
-      }
-    for (int k = 0; k < 8; ++k) {
-      const float t = static_cast<float>(rng.uniform(-1.5, 1.5));
-      edges.points.emplace_back(0.f, 0.f, 0.7f * scale);
-      edges.normals.emplace_back(std::cos(t), std::sin(t), 0.f);
-    }
-    check(edges, "edges, scale " + std::to_string(scale));
+    for (int k = -6; k <= 5; ++k) at.push_back(static_cast<float>((k + 0.5) * width));
+    check(pair_clouds::edge_cloud(rng, scale, at), "edges" + at_scale);
   }
   // Pairs whose f3 (the source normal's cosine to the line) lies within a
   // few ulps of a bin edge: there its last bit decides the bin, so the
@@ -143,7 +100,7 @@ TEST(SpfhPairBins, EightAtATimeEqualTheDefinition) {
     const int m = rng.uniform_int(0, 3) + (rng.uniform_int(0, 1) ? 0 : 8);  // 2m/11 - 1 in +-(0.45..1)
     const float c = 2.f * static_cast<float>(m + 1) / local::kSpfhBins - 1.f;
     const Vec3f n1 = (c * line + std::sqrt(1 - c * c) * side).normalized();
-    const Vec3f n2 = (line.cross(side) + 0.05f * unit(rng)).normalized();
+    const Vec3f n2 = (line.cross(side) + 0.05f * pair_clouds::unit(rng)).normalized();
     for (int k = 0; k < 24; ++k) {
       Vec3f n = n1;
       const float to = k % 2 ? 10.f : -10.f;

@@ -16,15 +16,12 @@
 
 #include "core/cpu.h"
 #include "core/random.h"
+#include "pair_feature_clouds.h"
 #include "recognition/ppf/internal.h"
 
 namespace pb {
 namespace {
 
-Vec3f unit(Rng& rng) {
-  Vec3f v(static_cast<float>(rng.normal()), static_cast<float>(rng.normal()), static_cast<float>(rng.normal()));
-  return v.normalized();
-}
 
 // Every point of `scene` as a reference, paired with every point (itself
 // included, in a shuffled order), both ways; the count of pairs compared.
@@ -65,44 +62,15 @@ TEST(PpfPairKeys, EightAtATimeEqualOneAtATime) {
   for (const float scale : {0.01f, 1.f, 100.f, 5000.f}) {
     for (const float angle : {deg12, deg7}) {
       const float step[4] = {angle, angle, angle, 0.05f * scale};
-      // Random points in a cube, random unit normals; 203 of them, so the
-      // last block of eight is short.
-      PointSet cloud;
-      for (int k = 0; k < 203; ++k) {
-        cloud.points.emplace_back(static_cast<float>(rng.uniform(-scale, scale)),
-                                  static_cast<float>(rng.uniform(-scale, scale)),
-                                  static_cast<float>(rng.uniform(-scale, scale)));
-        cloud.normals.push_back(unit(rng));
-      }
-      compared += compare_all(cloud, step, rng, "random, scale " + std::to_string(scale));
-      // Points on a plane with its normal (every cosine 0: PCL's acos test
-      // decides the source), on a line with normals along it (a degenerate
-      // frame), duplicates, and non-finite values.
-      PointSet special;
-      const Vec3f n0 = unit(rng);
+      const std::string at_scale = ", scale " + std::to_string(scale);
+      compared += compare_all(pair_clouds::random_cloud(rng, scale), step, rng, "random" + at_scale);
+      // The cases a lane leaves to the one-at-a-time path (PCL's acos test
+      // decides the source on the plane, where every cosine is 0), and
+      // second normals turned about the plane's normal by multiples of the
+      // step.
+      Vec3f n0;
+      PointSet special = pair_clouds::special_cloud(rng, scale, &n0);
       const Vec3f a = n0.unitOrthogonal(), b = n0.cross(a);
-      for (int k = 0; k < 40; ++k) {
-        special.points.push_back(scale * (static_cast<float>(rng.uniform(-1, 1)) * a +
-                                          static_cast<float>(rng.uniform(-1, 1)) * b));
-        special.normals.push_back(k % 2 ? n0 : Vec3f(-n0));
-      }
-      for (int k = 0; k < 10; ++k) {
-        special.points.push_back(scale * static_cast<float>(k) * 0.1f * n0);
-        special.normals.push_back(n0);
-      }
-      for (int k = 0; k < 6; ++k) {  // duplicates of earlier points
-        special.points.push_back(special.points[static_cast<size_t>(k)]);
-        special.normals.push_back(unit(rng));
-      }
-      const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
-      special.points.emplace_back(nan, 0.f, 0.f);
-      special.normals.push_back(n0);
-      special.points.emplace_back(scale, scale, scale);
-      special.normals.emplace_back(nan, nan, nan);
-      special.points.emplace_back(inf, 0.f, scale);
-      special.normals.push_back(n0);
-      special.points.emplace_back(0.f, 0.f, 0.f);
-      special.normals.emplace_back(0.f, 0.f, 0.f);
       // Angles at bin edges: the second normal turned about the first by a
       // multiple of the step, in a plane that makes f1 that angle.
       for (int k = -15; k <= 15; ++k) {
@@ -112,26 +80,12 @@ TEST(PpfPairKeys, EightAtATimeEqualOneAtATime) {
           special.normals.push_back((std::cos(t + eps) * n0 + std::sin(t + eps) * b).normalized());
         }
       }
-      compared += compare_all(special, step, rng, "special, scale " + std::to_string(scale));
-      // f1 = atan2(y, x) at its bin edges: a reference at the origin with
-      // its normal leaned by a from +x toward +z and a partner on the z axis
-      // whose normal lies in the xy plane give f1 = -a (the source is the
-      // reference, the partner's normal perpendicular to the line), for a
-      // at every edge and a few floats either side of it.
-      PointSet edges;
-      for (int k = -15; k <= 15; ++k)
-        for (int u = -3; u <= 3; ++u) {
-          const float a = std::nextafter(static_cast<float>(k) * angle, u < 0 ? -10.f : 10.f) +
-                          static_cast<float>(u) * 1e-7f;
-          edges.points.emplace_back(0.f, 0.f, 0.f);
-          edges.normals.emplace_back(std::cos(a), 0.f, std::sin(a));
-        }
-      for (int k = 0; k < 8; ++k) {
-        const float t = static_cast<float>(rng.uniform(-1.5, 1.5));
-        edges.points.emplace_back(0.f, 0.f, 0.7f * scale);
-        edges.normals.emplace_back(std::cos(t), std::sin(t), 0.f);
-      }
-      compared += compare_all(edges, step, rng, "edges, scale " + std::to_string(scale));
+      compared += compare_all(special, step, rng, "special" + at_scale);
+      // f1 = atan2(y, x) at every bin edge.
+      std::vector<float> at;
+      for (int k = -15; k <= 15; ++k) at.push_back(static_cast<float>(k) * angle);
+      const PointSet edges = pair_clouds::edge_cloud(rng, scale, at);
+      compared += compare_all(edges, step, rng, "edges" + at_scale);
     }
   }
   EXPECT_GT(compared, 400000u);
