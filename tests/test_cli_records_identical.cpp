@@ -65,8 +65,10 @@
 // the stable regions' normals came from a coarse support where the cloud is
 // dense (global.cvfh_normal_max_points 64; ci: 7 CVFH, 8 CESF and 5 OUR-CVFH
 // estimates moved, 3, 4 and 4 of 10 correct as before; demo: 3 CVFH and 3
-// CESF, 1 and 2 of 4 as before). A change
-// that alters results on purpose updates those files and says why in its
+// CESF, 1 and 2 of 4 as before), and when PPF took each reference point's
+// partners from the scene at the model's sampling (ppf.scene_partner_steps
+// 2; ci: every PPF estimate moved, 8 -> 9 of 10, image 0 now correct; demo
+// has no PPF). A change that alters results on purpose updates those files and says why in its
 // commit.
 #include <gtest/gtest.h>
 

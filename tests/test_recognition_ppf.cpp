@@ -388,11 +388,13 @@ TEST(PpfSinSign, EqualsSinfTimesZ) {
 // alpha_s bin) votes, so the order counts), the pair's key looked up in the sorted table,
 // each (key, alpha_s bin) voting once per reference point (a std::set), an
 // accumulator per reference point, its best cell the most votes, the lowest
-// cell among equals.
-std::vector<ppf::PoseVote> plain_vote(const ppf::Model& m, const PointSet& scene) {
+// cell among equals. With a partner cloud pc: the partners are its points
+// (none skipped), the references still every scene point.
+std::vector<ppf::PoseVote> plain_vote(const ppf::Model& m, const PointSet& scene, const PointSet* pc = nullptr) {
   const int n_alpha = std::max(1, static_cast<int>(std::floor(2 * M_PI / m.angle_step)));
   const ppf::AlphaBins bins(m.angle_step, n_alpha);
-  const KdTree3 tree(scene.points);
+  const PointSet& second = pc ? *pc : scene;
+  const KdTree3 tree(second.points);
   std::vector<ppf::PoseVote> out;
   std::vector<int> partners;
   for (size_t r = 0; r < scene.size(); ++r) {
@@ -404,7 +406,7 @@ std::vector<ppf::PoseVote> plain_vote(const ppf::Model& m, const PointSet& scene
     for (const int pi : partners) {
       const size_t i = static_cast<size_t>(pi);
       float f[4];
-      if (i == r || !ppf::pair_feature(sr, nr, scene.points[i], scene.normals[i], f)) continue;
+      if ((!pc && i == r) || !ppf::pair_feature(sr, nr, second.points[i], second.normals[i], f)) continue;
       if (!std::isfinite(f[0]) || !std::isfinite(f[1]) || !std::isfinite(f[2]) || !std::isfinite(f[3])) continue;
       const uint64_t key = ppf::feature_key(f[0], f[1], f[2], f[3], m.angle_step, m.distance_step);
       const auto range = std::equal_range(m.table.begin(), m.table.end(), key, [](const auto& a, const auto& b) {
@@ -412,7 +414,7 @@ std::vector<ppf::PoseVote> plain_vote(const ppf::Model& m, const PointSet& scene
         else return a.key < b;
       });
       if (range.first == range.second) continue;
-      const float alpha_s = ppf::pcl_alpha(T_sg, scene.points[i]);
+      const float alpha_s = ppf::pcl_alpha(T_sg, second.points[i]);
       if (!std::isfinite(alpha_s)) continue;
       const int alpha_s_bin = static_cast<int>(std::floor((alpha_s + M_PI) / m.angle_step));
       if (!voted.insert({key, alpha_s_bin}).second) continue;
@@ -477,16 +479,37 @@ TEST(PpfVote, VoteOnceEqualsAPlainReference) {
     for (size_t i = 0; i < n; ++i) refs[i] = static_cast<int>(i);
     ppf::VoteOptions opt;
     opt.vote_once = true;
-    const std::vector<ppf::PoseVote> got = ppf::vote(m, scene, refs, opt), want = plain_vote(m, scene);
-    ASSERT_EQ(got.size(), want.size()) << deg << " deg";
-    size_t differ = 0;
-    for (size_t k = 0; k < got.size(); ++k) {
-      const bool same = got[k].votes == want[k].votes && (got[k].pose.R - want[k].pose.R).norm() < 1e-9 &&
-                        (got[k].pose.t - want[k].pose.t).norm() < 1e-9;
-      if (!same && ++differ <= 3)
-        ADD_FAILURE() << deg << " deg, reference " << k << ": " << got[k].votes << " votes, want " << want[k].votes;
+    // Partners of their own (scene_partner_steps): every third scene point,
+    // in reverse, and the scene itself passed as partners, which pairs a
+    // reference with its own point too: that pair has no feature, so the
+    // votes are those of the scene alone.
+    PointSet third;
+    for (size_t i = n; i-- > 0;)
+      if (i % 3 == 0) {
+        third.points.push_back(scene.points[i]);
+        third.normals.push_back(scene.normals[i]);
+      }
+    const std::vector<ppf::PoseVote> alone = plain_vote(m, scene);
+    const struct {
+      const char* what;
+      std::vector<ppf::PoseVote> got, want;
+    } cases[] = {{"scene", ppf::vote(m, scene, refs, opt), alone},
+                 {"every third point", ppf::vote(m, scene, refs, opt, &third), plain_vote(m, scene, &third)},
+                 {"the scene as partners", ppf::vote(m, scene, refs, opt, &scene), alone}};
+    for (const auto& c : cases) {
+      ASSERT_EQ(c.got.size(), c.want.size()) << deg << " deg, " << c.what;
+      size_t differ = 0;
+      for (size_t k = 0; k < c.got.size(); ++k) {
+        const bool same = c.got[k].votes == c.want[k].votes && (c.got[k].pose.R - c.want[k].pose.R).norm() < 1e-9 &&
+                          (c.got[k].pose.t - c.want[k].pose.t).norm() < 1e-9;
+        if (!same && ++differ <= 3)
+          ADD_FAILURE() << deg << " deg, " << c.what << ", reference " << k << ": " << c.got[k].votes
+                        << " votes, want " << c.want[k].votes;
+      }
+      EXPECT_EQ(differ, 0u) << deg << " deg, " << c.what << ", of " << c.got.size();
     }
-    EXPECT_EQ(differ, 0u) << deg << " deg, of " << got.size();
+    // Fewer partners, fewer votes: the partner cloud is used.
+    EXPECT_LT(cases[1].got[0].votes, cases[0].got[0].votes) << deg << " deg";
   }
 }
 

@@ -254,8 +254,10 @@ struct VoteOptions {
 };
 
 // One pose per reference point: the best accumulator cell of its votes.
+// Reference r is scene.points[r]; its partners are the points of
+// `partners` within the model's diameter (nullptr: of `scene`, r skipped).
 std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vector<int>& refs,
-                           const VoteOptions& opt);
+                           const VoteOptions& opt, const PointSet* partners = nullptr);
 
 // Greedy clustering, most votes first; the best max_hypotheses clusters as
 // hypotheses (mean translation, sign-aligned mean quaternion, summed votes).

@@ -135,6 +135,15 @@ class PpfMethod : public Method {
     const PointSet& paired = leaf > 0 ? sampled : scene;
     if (paired.size() < 2 || !paired.has_normals()) return out;
     const std::vector<int> refs = ppf::reference_points(paired.size(), s_.scene_reference_fraction, seed);
+    // The partners: a coarser sampling of the scene where asked.
+    const double partner_leaf = s_.scene_partner_steps * m_.distance_step;
+    PointSet partners;
+    if (partner_leaf > 0 && partner_leaf != leaf) {
+      VoxelGridOptions coarse = grid;
+      coarse.leaf_mm = partner_leaf;
+      partners = voxel_downsample(scene, coarse);
+    }
+    const PointSet* partner_cloud = partners.points.empty() ? nullptr : &partners;
     times.describe += timer.seconds();
 
     // Match: vote per reference point.
@@ -142,7 +151,7 @@ class PpfMethod : public Method {
     ppf::VoteOptions vo;
     vo.margin = static_cast<float>(s_.neighbour_margin);
     vo.vote_once = s_.vote_once;
-    std::vector<ppf::PoseVote> poses = ppf::vote(m_, paired, refs, vo);
+    std::vector<ppf::PoseVote> poses = ppf::vote(m_, paired, refs, vo, partner_cloud);
     times.match += timer.seconds();
 
     // Group: greedy pose clustering, most votes first.

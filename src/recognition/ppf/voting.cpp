@@ -282,8 +282,12 @@ void margin_pair_keys(const Vec3f& sr, const Vec3f& nr, const PointSet& scene, c
 }  // namespace
 
 std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vector<int>& refs,
-                           const VoteOptions& opt) {
-  const KdTree3 tree(scene.points);
+                           const VoteOptions& opt, const PointSet* partner_cloud) {
+  // The partners: `scene` itself (a reference skips its own index) or a
+  // cloud of their own (nothing skipped: a partner at the reference's very
+  // position has no feature).
+  const PointSet& partners = partner_cloud ? *partner_cloud : scene;
+  const KdTree3 tree(partners.points);
   const size_t n_model = m.points.size();
   const int n_alpha = std::max(1, static_cast<int>(std::floor(2 * M_PI / m.angle_step)));
   const VoteCells vote_cells(m.angle_step, n_alpha);
@@ -310,6 +314,7 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
     const Vec3f sr = scene.points[r], nr = scene.normals[r];
     if (!sr.allFinite() || !nr.allFinite()) continue;
     const Eigen::Affine3f T_sg = to_reference_frame(sr, nr);
+    const int self = partner_cloud ? -1 : r;
     // The kd-tree's order of the partners: deterministic, and with vote_once
     // it counts (the first pair of a (key, alpha_s bin) votes, with its own
     // alpha_s).
@@ -320,11 +325,12 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
     pair_keys_end.clear();
     keys.clear();
     if (opt.margin > 0) {
-      margin_pair_keys(sr, nr, scene, nn, r, step, opt.margin, pair_point, keys, pair_keys_end);
+      margin_pair_keys(sr, nr, partners, nn, self, step, opt.margin, pair_point, keys, pair_keys_end);
     } else {  // one key per pair, its own bin
       pair_point.resize(nn.size());
       keys.resize(nn.size());
-      const size_t n_pairs = pair_keys(sr, nr, scene, nn.data(), nn.size(), r, step, pair_point.data(), keys.data());
+      const size_t n_pairs =
+          pair_keys(sr, nr, partners, nn.data(), nn.size(), self, step, pair_point.data(), keys.data());
       pair_point.resize(n_pairs);
       keys.resize(n_pairs);
       pair_keys_end.resize(n_pairs);
@@ -352,7 +358,7 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
         const auto [begin, end, id] = ranges[q];
         if (begin == end) continue;
         if (!have_alpha_s) {
-          alpha_s = pcl_alpha(T_sg, scene.points[i]);
+          alpha_s = pcl_alpha(T_sg, partners.points[i]);
           if (!std::isfinite(alpha_s)) {
             q = pair_keys_end[p];
             break;
