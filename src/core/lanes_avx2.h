@@ -88,11 +88,10 @@ __attribute__((target("avx2"))) inline PairLanes pair_lanes(const float* pts, co
   return l;
 }
 
-// series_atan2(y, x) of four lanes, then the two ends of binned_atan2's
-// window about it as floats (static_cast<float>(a -+ kAtan2BinWindow)).
-// Lanes with a zero or non-finite argument are the caller's to set aside
-// (binned_atan2 takes atan2f for them).
-__attribute__((target("avx2"))) inline void series_atan2_window(__m128 yf, __m128 xf, __m128* lo, __m128* hi) {
+// series_atan2(y, x) of four lanes, in double. Lanes with a zero or
+// non-finite argument are the caller's to set aside (binned_atan2 takes
+// atan2f for them).
+__attribute__((target("avx2"))) inline __m256d series_atan2_lanes(__m128 yf, __m128 xf) {
   const __m256d y = _mm256_cvtps_pd(yf), x = _mm256_cvtps_pd(xf);
   const __m256d sign = _mm256_set1_pd(-0.0), zero = _mm256_setzero_pd();
   const __m256d ay = _mm256_andnot_pd(sign, y), ax = _mm256_andnot_pd(sign, x);
@@ -109,8 +108,13 @@ __attribute__((target("avx2"))) inline void series_atan2_window(__m128 yf, __m12
   __m256d r = _mm256_add_pd(base, _mm256_mul_pd(t, s));
   r = _mm256_blendv_pd(r, _mm256_sub_pd(_mm256_set1_pd(M_PI / 2), r), steep);
   r = _mm256_blendv_pd(r, _mm256_sub_pd(_mm256_set1_pd(M_PI), r), _mm256_cmp_pd(x, zero, _CMP_LT_OQ));
-  r = _mm256_blendv_pd(r, _mm256_xor_pd(r, sign), _mm256_cmp_pd(y, zero, _CMP_LT_OQ));
-  const __m256d window = _mm256_set1_pd(kAtan2BinWindow);
+  return _mm256_blendv_pd(r, _mm256_xor_pd(r, sign), _mm256_cmp_pd(y, zero, _CMP_LT_OQ));
+}
+
+// The two ends of binned_atan2's window about series_atan2_lanes(y, x) as
+// floats (static_cast<float>(a -+ kAtan2BinWindow)).
+__attribute__((target("avx2"))) inline void series_atan2_window(__m128 yf, __m128 xf, __m128* lo, __m128* hi) {
+  const __m256d r = series_atan2_lanes(yf, xf), window = _mm256_set1_pd(kAtan2BinWindow);
   *lo = _mm256_cvtpd_ps(_mm256_sub_pd(r, window));
   *hi = _mm256_cvtpd_ps(_mm256_add_pd(r, window));
 }

@@ -190,6 +190,19 @@ float pcl_alpha(const Eigen::Affine3f& T, const Vec3f& other);
 // The seeded subset of scene reference points (ascending indices).
 std::vector<int> reference_points(size_t n, double fraction, uint64_t seed);
 
+// alpha_s of the pairs of the reference point whose frame is T with the
+// points idx[0..n) of `pts` (pcl_alpha(T, pts.points[idx[k]])), where only
+// its bins count: value[k] the series' angle (core/atan2_bin.h) as a float,
+// within 2 * kAtan2BinWindow of pcl_alpha's; bin[k] the vote flags' bin of
+// pcl_alpha's value, floor((alpha_s + pi) / step) in double, where the
+// window leaves no doubt, else -1 (also for a zero or non-finite argument,
+// an angle within the window of +-pi, where atan2f may give +-float(pi) and
+// pcl_alpha negates it, and everywhere without AVX2): there, take
+// pcl_alpha itself. The cells of
+// an approximate value come from VoteCells::checked.
+void approx_alpha_s(const Eigen::Affine3f& T, const PointSet& pts, const int* idx, size_t n, float step,
+                    float* value, int* bin);
+
 // PCL's alpha bin value of a vote: (alpha + pi) / step in double, as float.
 inline float alpha_bin_value(float alpha, float angle_step) {
   return static_cast<float>((alpha + M_PI) / angle_step);
@@ -239,10 +252,18 @@ class VoteCells {
   void operator()(const uint32_t* ref, const float* alpha_m, size_t n, float alpha_s, uint32_t* cells) const;
   // The one-at-a-time path alone (tests: the reference of the AVX2 one).
   void plain(const uint32_t* ref, const float* alpha_m, size_t n, float alpha_s, uint32_t* cells) const;
+  // operator()'s cells from an approximate alpha_s (approx_alpha_s' value):
+  // true when they are the cells of every alpha_s within 2 *
+  // kAtan2BinWindow of it, the exact one among them (no vote's bin value
+  // within the reach of that window, plus the roundings, of a bin edge, and
+  // no vote's alpha of the wrap at +-pi);
+  // false: the cells are not to be used. Always false without AVX2.
+  bool checked(const uint32_t* ref, const float* alpha_m, size_t n, float alpha_s, uint32_t* cells) const;
 
  private:
   float step_;
   int n_alpha_;
+  double edge_margin_;  // checked's: the reach in bin values
   AlphaBins bins_;
   bool avx2_;
 };

@@ -279,6 +279,45 @@ void margin_pair_keys(const Vec3f& sr, const Vec3f& nr, const PointSet& scene, c
   }
 }
 
+// The keys of reference point (sr, nr) paired with each of `partners` but
+// `self`: per pair with a feature its point and the end of its keys in
+// `keys` (with a margin, Vidal et al.'s neighbouring bins; without, one key
+// per pair, its own bin).
+void reference_keys(const Vec3f& sr, const Vec3f& nr, const PointSet& scene, const std::vector<int>& partners,
+                    int self, const float step[4], float margin, std::vector<int>& pair_point,
+                    std::vector<uint64_t>& keys, std::vector<uint32_t>& pair_keys_end) {
+  pair_point.clear();
+  pair_keys_end.clear();
+  keys.clear();
+  if (margin > 0) {
+    margin_pair_keys(sr, nr, scene, partners, self, step, margin, pair_point, keys, pair_keys_end);
+    return;
+  }
+  pair_point.resize(partners.size());
+  keys.resize(partners.size());
+  const size_t n_pairs =
+      pair_keys(sr, nr, scene, partners.data(), partners.size(), self, step, pair_point.data(), keys.data());
+  pair_point.resize(n_pairs);
+  keys.resize(n_pairs);
+  pair_keys_end.resize(n_pairs);
+  std::iota(pair_keys_end.begin(), pair_keys_end.end(), 1u);
+}
+
+// The pose of accumulator cell `cell` (model reference point, alpha bin,
+// the bin's centre) for the scene reference frame T_sg, with its votes.
+PoseVote cell_pose(const Model& m, const Eigen::Affine3f& T_sg, uint32_t cell, uint32_t votes, int n_alpha) {
+  const size_t mr = cell / static_cast<size_t>(n_alpha);
+  const int bin = static_cast<int>(cell % static_cast<size_t>(n_alpha));
+  const float alpha = static_cast<float>((bin + 0.5) * m.angle_step - M_PI);
+  const Eigen::Affine3f T_mg = to_reference_frame(m.points[mr], m.normals[mr]);
+  const Eigen::Affine3f T = T_sg.inverse() * Eigen::AngleAxisf(alpha, Vec3f::UnitX()) * T_mg;
+  PoseVote pv;
+  pv.pose.R = T.linear().cast<double>();
+  pv.pose.t = T.translation().cast<double>();
+  pv.votes = votes;
+  return pv;
+}
+
 }  // namespace
 
 std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vector<int>& refs,
@@ -310,6 +349,9 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
   std::vector<uint32_t> pair_keys_end;            // its keys end here in keys
   std::vector<uint64_t> keys;
   std::vector<KeyIndex::Range> ranges;  // keys[q]'s range in the table and its id
+  std::vector<int> hit_point;           // the second points of the pairs whose key is in the table
+  std::vector<float> hit_alpha;         // their approx_alpha_s values
+  std::vector<int> hit_bin;             // and bins
   for (int r : refs) {
     const Vec3f sr = scene.points[r], nr = scene.normals[r];
     if (!sr.allFinite() || !nr.allFinite()) continue;
@@ -321,26 +363,23 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
     tree.radius_unsorted(sr, m.diameter, nn);
     acc.next_reference();
     flags.next_reference();
-    pair_point.clear();
-    pair_keys_end.clear();
-    keys.clear();
-    if (opt.margin > 0) {
-      margin_pair_keys(sr, nr, partners, nn, self, step, opt.margin, pair_point, keys, pair_keys_end);
-    } else {  // one key per pair, its own bin
-      pair_point.resize(nn.size());
-      keys.resize(nn.size());
-      const size_t n_pairs =
-          pair_keys(sr, nr, partners, nn.data(), nn.size(), self, step, pair_point.data(), keys.data());
-      pair_point.resize(n_pairs);
-      keys.resize(n_pairs);
-      pair_keys_end.resize(n_pairs);
-      std::iota(pair_keys_end.begin(), pair_keys_end.end(), 1u);
-    }
+    reference_keys(sr, nr, partners, nn, self, step, opt.margin, pair_point, keys, pair_keys_end);
     ranges.resize(keys.size());
     for (size_t q = 0; q < keys.size(); ++q) {
       if (q + kSlotsAhead < keys.size()) m.index.prefetch(keys[q + kSlotsAhead]);
       ranges[q] = m.index.find(keys[q]);
     }
+    // One key per pair: alpha_s of the pairs whose key is in the table, eight
+    // at a time, approximately where its bins leave no doubt (approx_alpha_s).
+    hit_point.clear();
+    if (opt.margin <= 0)
+      for (size_t p = 0; p < pair_point.size(); ++p)
+        if (ranges[p].begin != ranges[p].end) hit_point.push_back(pair_point[p]);
+    hit_alpha.resize(hit_point.size());
+    hit_bin.resize(hit_point.size());
+    approx_alpha_s(T_sg, partners, hit_point.data(), hit_point.size(), m.angle_step, hit_alpha.data(),
+                   hit_bin.data());
+    size_t hit = 0;
     size_t q = 0;
     for (size_t p = 0; p < pair_point.size(); ++p) {
       const size_t i = static_cast<size_t>(pair_point[p]);
@@ -348,7 +387,7 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
       // casts no vote, whatever its alpha_s).
       float alpha_s = 0;
       int alpha_s_bin = 0;
-      bool have_alpha_s = false;
+      bool have_alpha_s = false, approximate = false;
       for (; q < pair_keys_end[p]; ++q) {
         if (q + kRangesAhead < ranges.size()) {
           const uint32_t ahead = ranges[q + kRangesAhead].begin;
@@ -358,13 +397,20 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
         const auto [begin, end, id] = ranges[q];
         if (begin == end) continue;
         if (!have_alpha_s) {
-          alpha_s = pcl_alpha(T_sg, partners.points[i]);
-          if (!std::isfinite(alpha_s)) {
-            q = pair_keys_end[p];
-            break;
-          }
-          alpha_s_bin = static_cast<int>(std::floor((alpha_s + M_PI) / m.angle_step));
           have_alpha_s = true;
+          if (opt.margin <= 0 && hit_bin[hit] >= 0) {  // approximate: its bins are pcl_alpha's
+            alpha_s = hit_alpha[hit];
+            alpha_s_bin = hit_bin[hit++];
+            approximate = true;
+          } else {
+            hit += opt.margin <= 0;
+            alpha_s = pcl_alpha(T_sg, partners.points[i]);
+            if (!std::isfinite(alpha_s)) {
+              q = pair_keys_end[p];
+              break;
+            }
+            alpha_s_bin = static_cast<int>(std::floor((alpha_s + M_PI) / m.angle_step));
+          }
         }
         if (opt.vote_once && !flags.first(id, alpha_s_bin)) continue;
         if (opt.margin > 0) {
@@ -375,23 +421,20 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
         // alpha is.
         for (uint32_t e = begin; e < end; e += kChunk) {
           const uint32_t n = std::min(kChunk, end - e);
-          vote_cells(m.vote_ref.data() + e, m.vote_alpha.data() + e, n, alpha_s, cells);
+          const uint32_t* ref = m.vote_ref.data() + e;
+          const float* alpha_m = m.vote_alpha.data() + e;
+          if (!approximate || !vote_cells.checked(ref, alpha_m, n, alpha_s, cells)) {
+            if (approximate) {  // a vote near a bin edge: pcl_alpha decides (finite: its arguments are)
+              alpha_s = pcl_alpha(T_sg, partners.points[i]);
+              approximate = false;
+            }
+            vote_cells(ref, alpha_m, n, alpha_s, cells);
+          }
           for (uint32_t c = 0; c < n; ++c) acc.add(cells[c]);
         }
       }
     }
-    if (acc.best() == 0) continue;
-    const uint32_t best_cell = acc.best_cell();
-    const size_t mr = best_cell / static_cast<size_t>(n_alpha);
-    const int bin = static_cast<int>(best_cell % static_cast<size_t>(n_alpha));
-    const float alpha = static_cast<float>((bin + 0.5) * m.angle_step - M_PI);
-    const Eigen::Affine3f T_mg = to_reference_frame(m.points[mr], m.normals[mr]);
-    const Eigen::Affine3f T = T_sg.inverse() * Eigen::AngleAxisf(alpha, Vec3f::UnitX()) * T_mg;
-    PoseVote pv;
-    pv.pose.R = T.linear().cast<double>();
-    pv.pose.t = T.translation().cast<double>();
-    pv.votes = acc.best();
-    poses.push_back(pv);
+    if (acc.best() > 0) poses.push_back(cell_pose(m, T_sg, acc.best_cell(), acc.best(), n_alpha));
   }
   return poses;
 }
