@@ -263,7 +263,7 @@ class VoteCells {
  private:
   float step_;
   int n_alpha_;
-  double edge_margin_;  // checked's: the reach in bin values
+  float edge_margin_;  // checked's: the reach in bin values
   AlphaBins bins_;
   bool avx2_;
 };
