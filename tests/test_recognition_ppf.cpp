@@ -438,33 +438,68 @@ std::vector<ppf::PoseVote> plain_vote(const ppf::Model& m, const PointSet& scene
   return out;
 }
 
-// ppf::vote with vote_once equals plain_vote on a model whose pairs share
-// few keys: points on a plane, so every pair has the same angles and the
-// distance bin (a quarter of the diameter) alone tells keys apart, and a
-// reference point meets one key with alpha_s in every bin. At 12 degrees
-// (30 alpha bins) and at 4 degrees (90 bins, more than the 64 flags of one
-// word: bins 64 apart must not share a flag).
-TEST(PpfVote, VoteOnceEqualsAPlainReference) {
-  for (const double deg : {12.0, 4.0}) {
-    Rng rng(21);
-    ppf::Model m;
-    for (int k = 0; k < 120; ++k) {
-      m.points.emplace_back(static_cast<float>(rng.uniform(-50, 50)), static_cast<float>(rng.uniform(-50, 50)), 0.f);
-      m.normals.emplace_back(0.f, 0.f, 1.f);
+// A model of 120 points (in a 100 mm cube, random normals; or on a plane,
+// its normal +z) with every pair's feature, its table at `deg` degrees and a
+// distance step of a quarter of the diameter.
+ppf::Model vote_test_model(bool plane, double deg) {
+  Rng rng(21);
+  ppf::Model m;
+  for (int k = 0; k < 120; ++k) {
+    const float z = plane ? 0.f : static_cast<float>(rng.uniform(-50, 50));
+    m.points.emplace_back(static_cast<float>(rng.uniform(-50, 50)), static_cast<float>(rng.uniform(-50, 50)), z);
+    m.normals.push_back(plane ? Vec3f::UnitZ()
+                              : Vec3f(static_cast<float>(rng.normal()), static_cast<float>(rng.normal()),
+                                      static_cast<float>(rng.normal()))
+                                    .normalized());
+  }
+  const size_t n = m.points.size();
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j) {
+      float f[4];
+      const float nan = std::numeric_limits<float>::quiet_NaN();
+      ppf::PairFeature pf{nan, nan, nan, nan, nan};
+      if (i != j && ppf::pair_feature(m.points[i], m.normals[i], m.points[j], m.normals[j], f))
+        pf = {f[0], f[1], f[2], f[3], ppf::pcl_alpha(ppf::to_reference_frame(m.points[i], m.normals[i]), m.points[j])};
+      m.features.push_back(pf);
     }
+  m.angle_step = static_cast<float>(deg * M_PI / 180.0);
+  m.distance_step = 0.25f * 142.f;
+  ppf::build_table(m);
+  return m;
+}
+
+// The most votes a reference point of `scene` can cast with every other
+// point: the sum of its pairs' table ranges (voting counts in 16 bits up to
+// 65535 of them).
+size_t most_votes_of_a_reference(const ppf::Model& m, const PointSet& scene) {
+  size_t most = 0;
+  for (size_t r = 0; r < scene.size(); ++r) {
+    size_t sum = 0;
+    for (size_t i = 0; i < scene.size(); ++i) {
+      float f[4];
+      if (i == r || !ppf::pair_feature(scene.points[r], scene.normals[r], scene.points[i], scene.normals[i], f))
+        continue;
+      const uint64_t key = ppf::feature_key(f[0], f[1], f[2], f[3], m.angle_step, m.distance_step);
+      sum += static_cast<size_t>(
+          std::count_if(m.table.begin(), m.table.end(), [key](const auto& e) { return e.key == key; }));
+    }
+    most = std::max(most, sum);
+  }
+  return most;
+}
+
+// ppf::vote with vote_once equals plain_vote on two models. One whose pairs
+// share few keys: points on a plane, so every pair has the same angles and
+// the distance bin alone tells keys apart, and a reference point meets one
+// key with alpha_s in every bin; its references cast more votes than 16 bits
+// count. And random points, whose references cast few, so both of voting's
+// accumulators are compared. At 12 degrees (30 alpha bins) and at 4 degrees
+// (90 bins, more than the 64 flags of one word: bins 64 apart must not share
+// a flag).
+TEST(PpfVote, VoteOnceEqualsAPlainReference) {
+  for (const auto& [plane, deg] : {std::pair{true, 12.0}, {true, 4.0}, {false, 12.0}, {false, 4.0}}) {
+    ppf::Model m = vote_test_model(plane, deg);
     const size_t n = m.points.size();
-    for (size_t i = 0; i < n; ++i)
-      for (size_t j = 0; j < n; ++j) {
-        float f[4];
-        const float nan = std::numeric_limits<float>::quiet_NaN();
-        ppf::PairFeature pf{nan, nan, nan, nan, nan};
-        if (i != j && ppf::pair_feature(m.points[i], m.normals[i], m.points[j], m.normals[j], f))
-          pf = {f[0], f[1], f[2], f[3], ppf::pcl_alpha(ppf::to_reference_frame(m.points[i], m.normals[i]), m.points[j])};
-        m.features.push_back(pf);
-      }
-    m.angle_step = static_cast<float>(deg * M_PI / 180.0);
-    m.distance_step = 0.25f * 142.f;
-    ppf::build_table(m);
     ASSERT_FALSE(m.table.empty());
     m.diameter = 1000;  // every scene point a partner: no radius boundary to agree on
     // The scene: the model moved.
@@ -477,6 +512,11 @@ TEST(PpfVote, VoteOnceEqualsAPlainReference) {
     }
     std::vector<int> refs(n);
     for (size_t i = 0; i < n; ++i) refs[i] = static_cast<int>(i);
+    if (deg == 12.0) {
+      const size_t most = most_votes_of_a_reference(m, scene);
+      if (plane) EXPECT_GT(most, 65535u) << "the plane's references need 32-bit counts";
+      else EXPECT_LE(most, 65535u) << "the random points' references fit 16-bit counts";
+    }
     ppf::VoteOptions opt;
     opt.vote_once = true;
     // Partners of their own (scene_partner_steps): every third scene point,
@@ -497,16 +537,18 @@ TEST(PpfVote, VoteOnceEqualsAPlainReference) {
                  {"every third point", ppf::vote(m, scene, refs, opt, &third), plain_vote(m, scene, &third)},
                  {"the scene as partners", ppf::vote(m, scene, refs, opt, &scene), alone}};
     for (const auto& c : cases) {
-      ASSERT_EQ(c.got.size(), c.want.size()) << deg << " deg, " << c.what;
+      ASSERT_EQ(c.got.size(), c.want.size()) << (plane ? "plane, " : "random, ") << deg << " deg, " << c.what;
       size_t differ = 0;
       for (size_t k = 0; k < c.got.size(); ++k) {
         const bool same = c.got[k].votes == c.want[k].votes && (c.got[k].pose.R - c.want[k].pose.R).norm() < 1e-9 &&
                           (c.got[k].pose.t - c.want[k].pose.t).norm() < 1e-9;
         if (!same && ++differ <= 3)
-          ADD_FAILURE() << deg << " deg, " << c.what << ", reference " << k << ": " << c.got[k].votes
+          ADD_FAILURE() << (plane ? "plane, " : "random, ") << deg << " deg, " << c.what << ", reference " << k
+                        << ": " << c.got[k].votes
                         << " votes, want " << c.want[k].votes;
       }
-      EXPECT_EQ(differ, 0u) << deg << " deg, " << c.what << ", of " << c.got.size();
+      EXPECT_EQ(differ, 0u) << (plane ? "plane, " : "random, ") << deg << " deg, " << c.what << ", of "
+                            << c.got.size();
     }
     // Fewer partners, fewer votes: the partner cloud is used.
     EXPECT_LT(cases[1].got[0].votes, cases[0].got[0].votes) << deg << " deg";

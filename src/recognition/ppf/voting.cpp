@@ -9,6 +9,7 @@
 #include "core/random.h"
 #include "recognition/kdtree.h"
 #include "recognition/ppf/internal.h"
+#include "recognition/ppf/vote_state.h"
 
 namespace pb::ppf {
 
@@ -119,94 +120,12 @@ int neighbour_keys(const float f[4], const float step[4], float margin, uint64_t
 
 namespace {
 
-// Hinterstoisser et al.'s flags for one reference point: per looked-up model
-// key (its KeyIndex id) and word of 64 alpha_s bins, a bit per bin already
-// voted. Open addressing, emptied per reference by a generation count.
-class VoteFlags {
- public:
-  // True the first time (id, bin) is seen since the last next_reference().
-  bool first(uint32_t id, int bin) {
-    if (2 * (used_ + 1) > slots_.size()) grow();
-    const uint64_t key = (static_cast<uint64_t>(id) << 32) | (static_cast<uint32_t>(bin) >> 6);
-    size_t i = slot(key);
-    Slot& s = slots_[i];
-    if (s.gen != gen_) {
-      s = {key, 0, gen_};
-      ++used_;
-    }
-    const uint64_t m = uint64_t(1) << (static_cast<uint32_t>(bin) & 63);
-    if (s.mask & m) return false;
-    s.mask |= m;
-    return true;
-  }
-  void next_reference() {
-    ++gen_;
-    used_ = 0;
-  }
-
- private:
-  struct Slot {
-    uint64_t key = 0, mask = 0;
-    uint32_t gen = 0;
-  };
-  size_t slot(uint64_t key) const {
-    const uint64_t h = (key ^ (key >> 32)) * 0x9e3779b97f4a7c15ull;  // the id is in the high half
-    size_t i = static_cast<size_t>(h >> 20) & (slots_.size() - 1);
-    while (slots_[i].gen == gen_ && slots_[i].key != key) i = (i + 1) & (slots_.size() - 1);
-    return i;
-  }
-  void grow() {
-    std::vector<Slot> old;
-    old.swap(slots_);
-    slots_.assign(std::max<size_t>(1024, 2 * old.size()), Slot{});
-    for (const Slot& s : old)
-      if (s.gen == gen_) slots_[slot(s.key)] = s;
-  }
-  std::vector<Slot> slots_;
-  uint32_t gen_ = 1;
-  size_t used_ = 0;
-};
-
-}  // namespace
-
-namespace {
-
-// Accumulator cells stamped with the reference point that voted for them
-// (its generation in the high 32 bits, the count in the low 32): a new
-// reference starts from zero without clearing, and a vote needs no branch.
-// The best cell is kept as votes arrive: the most votes, the lowest cell
-// among equals (the first maximum in cell order, as a scan of the
-// accumulator finds it, since counts only grow), as one maximum of
-// (count, ~cell) packed in 64 bits.
-class Accumulator {
- public:
-  explicit Accumulator(size_t cells) : cells_(cells, 0) {}
-  void next_reference() {
-    ++gen_;
-    stamp_ = static_cast<uint64_t>(gen_) << 32;
-    best_ = 0;
-  }
-  void add(uint32_t cell) {
-    const uint64_t v = cells_[cell];
-    const uint64_t nv = (v >> 32) == gen_ ? v + 1 : stamp_ + 1;
-    cells_[cell] = nv;
-    best_ = std::max(best_, (nv << 32) | static_cast<uint32_t>(~cell));
-  }
-  uint32_t best() const { return static_cast<uint32_t>(best_ >> 32); }  // 0: no vote since next_reference()
-  uint32_t best_cell() const { return ~static_cast<uint32_t>(best_); }
-
- private:
-  std::vector<uint64_t> cells_;
-  uint32_t gen_ = 0;
-  uint64_t stamp_ = 0;
-  uint64_t best_ = 0;  // (count << 32) | ~cell of the best cell
-};
-
 // The votes of one scene pair's model pairs [begin, end) with neighbouring
 // alpha bins (margin > 0): PCL's bin value, its fraction decides the
 // neighbour.
+template <class Acc>
 void vote_with_margin(const Model& m, uint32_t begin, uint32_t end, float alpha_s, int n_alpha, float margin,
-                      Accumulator& acc) {
+                      Acc& acc) {
   for (uint32_t e = begin; e < end; ++e) {
     const float alpha = wrapped_alpha(m.vote_alpha[e], alpha_s);
     if (!std::isfinite(alpha)) continue;
@@ -318,6 +237,87 @@ PoseVote cell_pose(const Model& m, const Eigen::Affine3f& T_sg, uint32_t cell, u
   return pv;
 }
 
+// One reference point's pairs: the second point of each, the end of its
+// keys in `keys`, each key's range in the table (and its id), and for the
+// pairs whose key is in the table (one key per pair) approx_alpha_s' values
+// and bins.
+struct ReferencePairs {
+  std::vector<int> pair_point;
+  std::vector<uint32_t> pair_keys_end;
+  std::vector<uint64_t> keys;
+  std::vector<KeyIndex::Range> ranges;
+  std::vector<int> hit_point;
+  std::vector<float> hit_alpha;
+  std::vector<int> hit_bin;
+};
+
+// One reference point's pairs (rp, in order) vote into acc: alpha_s once a
+// pair's key is in the table (a pair whose keys all miss casts no vote,
+// whatever its alpha_s; approx_alpha_s' value where it gave a bin), the
+// flags, then the cells of the model pairs of its key.
+template <class Acc>
+void cast_votes(const Model& m, const VoteOptions& opt, const ReferencePairs& rp, const Eigen::Affine3f& T_sg,
+                const PointSet& partners, const VoteCells& vote_cells, int n_alpha, VoteFlags& flags, Acc& acc) {
+  constexpr size_t kRangesAhead = 8;  // each range's first entries prefetched this many keys ahead
+  constexpr uint32_t kChunk = 256;    // cells computed at a time
+  uint32_t cells[kChunk];
+  const uint32_t* const vote_ref = m.vote_ref.data();
+  const float* const vote_alpha = m.vote_alpha.data();
+  const KeyIndex::Range* const ranges = rp.ranges.data();
+  const size_t n_ranges = rp.ranges.size(), n_pairs = rp.pair_point.size();
+  const bool margin = opt.margin > 0, vote_once = opt.vote_once;
+  size_t hit = 0, q = 0;
+  for (size_t p = 0; p < n_pairs; ++p) {
+    const size_t i = static_cast<size_t>(rp.pair_point[p]);
+    float alpha_s = 0;
+    int alpha_s_bin = 0;
+    bool have_alpha_s = false, approximate = false;
+    for (; q < rp.pair_keys_end[p]; ++q) {
+      if (q + kRangesAhead < n_ranges) {
+        const uint32_t ahead = ranges[q + kRangesAhead].begin;
+        __builtin_prefetch(vote_ref + ahead);
+        __builtin_prefetch(vote_alpha + ahead);
+      }
+      const auto [begin, end, id] = ranges[q];
+      if (begin == end) continue;
+      if (!have_alpha_s) {
+        have_alpha_s = true;
+        if (!margin && rp.hit_bin[hit] >= 0) {  // approximate: its bins are pcl_alpha's
+          alpha_s = rp.hit_alpha[hit];
+          alpha_s_bin = rp.hit_bin[hit++];
+          approximate = true;
+        } else {
+          hit += !margin;
+          alpha_s = pcl_alpha(T_sg, partners.points[i]);
+          if (!std::isfinite(alpha_s)) {
+            q = rp.pair_keys_end[p];
+            break;
+          }
+          alpha_s_bin = static_cast<int>(std::floor((alpha_s + M_PI) / m.angle_step));
+        }
+      }
+      if (vote_once && !flags.first(id, alpha_s_bin)) continue;
+      if (margin) {
+        vote_with_margin(m, begin, end, alpha_s, n_alpha, opt.margin, acc);
+        continue;
+      }
+      // alpha_m and alpha_s are finite (the table holds finite ones), so
+      // alpha is.
+      for (uint32_t e = begin; e < end; e += kChunk) {
+        const uint32_t n = std::min(kChunk, end - e);
+        if (!approximate || !vote_cells.checked(vote_ref + e, vote_alpha + e, n, alpha_s, cells)) {
+          if (approximate) {  // a vote near a bin edge: pcl_alpha decides (finite: its arguments are)
+            alpha_s = pcl_alpha(T_sg, partners.points[i]);
+            approximate = false;
+          }
+          vote_cells(vote_ref + e, vote_alpha + e, n, alpha_s, cells);
+        }
+        for (uint32_t c = 0; c < n; ++c) acc.add(cells[c]);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vector<int>& refs,
@@ -331,8 +331,7 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
   const int n_alpha = std::max(1, static_cast<int>(std::floor(2 * M_PI / m.angle_step)));
   const VoteCells vote_cells(m.angle_step, n_alpha);
   Accumulator acc(n_model * static_cast<size_t>(n_alpha));
-  constexpr uint32_t kChunk = 256;  // cells computed at a time
-  uint32_t cells[kChunk];
+  SmallAccumulator small(n_model * static_cast<size_t>(n_alpha));
   std::vector<PoseVote> poses;
   std::vector<int> nn;
   VoteFlags flags;
@@ -341,17 +340,11 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
   // asked for ahead of its use (on a real frame the key index and the
   // table's ranges are beyond the caches): the keys of every pair, their
   // ranges in the index (its slots prefetched kSlotsAhead keys ahead), then
-  // the votes (each range's first entries prefetched kRangesAhead keys
-  // ahead). Pairs and keys keep their order, so the votes and the flags are
-  // those of one pass.
-  constexpr size_t kSlotsAhead = 16, kRangesAhead = 8;
-  std::vector<int> pair_point;                    // the pair's second point
-  std::vector<uint32_t> pair_keys_end;            // its keys end here in keys
-  std::vector<uint64_t> keys;
-  std::vector<KeyIndex::Range> ranges;  // keys[q]'s range in the table and its id
-  std::vector<int> hit_point;           // the second points of the pairs whose key is in the table
-  std::vector<float> hit_alpha;         // their approx_alpha_s values
-  std::vector<int> hit_bin;             // and bins
+  // the votes (cast_votes; each range's first entries prefetched ahead).
+  // Pairs and keys keep their order, so the votes and the flags are those
+  // of one pass.
+  constexpr size_t kSlotsAhead = 16;
+  ReferencePairs rp;
   for (int r : refs) {
     const Vec3f sr = scene.points[r], nr = scene.normals[r];
     if (!sr.allFinite() || !nr.allFinite()) continue;
@@ -361,80 +354,39 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
     // it counts (the first pair of a (key, alpha_s bin) votes, with its own
     // alpha_s).
     tree.radius_unsorted(sr, m.diameter, nn);
-    acc.next_reference();
     flags.next_reference();
-    reference_keys(sr, nr, partners, nn, self, step, opt.margin, pair_point, keys, pair_keys_end);
-    ranges.resize(keys.size());
+    reference_keys(sr, nr, partners, nn, self, step, opt.margin, rp.pair_point, rp.keys, rp.pair_keys_end);
+    const std::vector<uint64_t>& keys = rp.keys;
+    rp.ranges.resize(keys.size());
     for (size_t q = 0; q < keys.size(); ++q) {
       if (q + kSlotsAhead < keys.size()) m.index.prefetch(keys[q + kSlotsAhead]);
-      ranges[q] = m.index.find(keys[q]);
+      rp.ranges[q] = m.index.find(keys[q]);
     }
     // One key per pair: alpha_s of the pairs whose key is in the table, eight
-    // at a time, approximately where its bins leave no doubt (approx_alpha_s).
-    hit_point.clear();
+    // at a time, approximately where its bins leave no doubt (approx_alpha_s),
+    // and the most votes the reference can cast, the sum of their ranges.
+    rp.hit_point.clear();
+    uint64_t votes_bound = 0;
     if (opt.margin <= 0)
-      for (size_t p = 0; p < pair_point.size(); ++p)
-        if (ranges[p].begin != ranges[p].end) hit_point.push_back(pair_point[p]);
-    hit_alpha.resize(hit_point.size());
-    hit_bin.resize(hit_point.size());
-    approx_alpha_s(T_sg, partners, hit_point.data(), hit_point.size(), m.angle_step, hit_alpha.data(),
-                   hit_bin.data());
-    size_t hit = 0;
-    size_t q = 0;
-    for (size_t p = 0; p < pair_point.size(); ++p) {
-      const size_t i = static_cast<size_t>(pair_point[p]);
-      // alpha_s once a key is in the table (a pair whose keys all miss
-      // casts no vote, whatever its alpha_s).
-      float alpha_s = 0;
-      int alpha_s_bin = 0;
-      bool have_alpha_s = false, approximate = false;
-      for (; q < pair_keys_end[p]; ++q) {
-        if (q + kRangesAhead < ranges.size()) {
-          const uint32_t ahead = ranges[q + kRangesAhead].begin;
-          __builtin_prefetch(m.vote_ref.data() + ahead);
-          __builtin_prefetch(m.vote_alpha.data() + ahead);
+      for (size_t p = 0; p < rp.pair_point.size(); ++p)
+        if (rp.ranges[p].begin != rp.ranges[p].end) {
+          rp.hit_point.push_back(rp.pair_point[p]);
+          votes_bound += rp.ranges[p].end - rp.ranges[p].begin;
         }
-        const auto [begin, end, id] = ranges[q];
-        if (begin == end) continue;
-        if (!have_alpha_s) {
-          have_alpha_s = true;
-          if (opt.margin <= 0 && hit_bin[hit] >= 0) {  // approximate: its bins are pcl_alpha's
-            alpha_s = hit_alpha[hit];
-            alpha_s_bin = hit_bin[hit++];
-            approximate = true;
-          } else {
-            hit += opt.margin <= 0;
-            alpha_s = pcl_alpha(T_sg, partners.points[i]);
-            if (!std::isfinite(alpha_s)) {
-              q = pair_keys_end[p];
-              break;
-            }
-            alpha_s_bin = static_cast<int>(std::floor((alpha_s + M_PI) / m.angle_step));
-          }
-        }
-        if (opt.vote_once && !flags.first(id, alpha_s_bin)) continue;
-        if (opt.margin > 0) {
-          vote_with_margin(m, begin, end, alpha_s, n_alpha, opt.margin, acc);
-          continue;
-        }
-        // alpha_m and alpha_s are finite (the table holds finite ones), so
-        // alpha is.
-        for (uint32_t e = begin; e < end; e += kChunk) {
-          const uint32_t n = std::min(kChunk, end - e);
-          const uint32_t* ref = m.vote_ref.data() + e;
-          const float* alpha_m = m.vote_alpha.data() + e;
-          if (!approximate || !vote_cells.checked(ref, alpha_m, n, alpha_s, cells)) {
-            if (approximate) {  // a vote near a bin edge: pcl_alpha decides (finite: its arguments are)
-              alpha_s = pcl_alpha(T_sg, partners.points[i]);
-              approximate = false;
-            }
-            vote_cells(ref, alpha_m, n, alpha_s, cells);
-          }
-          for (uint32_t c = 0; c < n; ++c) acc.add(cells[c]);
-        }
-      }
+    rp.hit_alpha.resize(rp.hit_point.size());
+    rp.hit_bin.resize(rp.hit_point.size());
+    approx_alpha_s(T_sg, partners, rp.hit_point.data(), rp.hit_point.size(), m.angle_step, rp.hit_alpha.data(),
+                   rp.hit_bin.data());
+    // Its votes: counted in 16 bits where they cannot overflow them.
+    if (opt.margin <= 0 && votes_bound <= SmallAccumulator::kMaxVotes) {
+      small.next_reference();
+      cast_votes(m, opt, rp, T_sg, partners, vote_cells, n_alpha, flags, small);
+      if (small.best() > 0) poses.push_back(cell_pose(m, T_sg, small.best_cell(), small.best(), n_alpha));
+    } else {
+      acc.next_reference();
+      cast_votes(m, opt, rp, T_sg, partners, vote_cells, n_alpha, flags, acc);
+      if (acc.best() > 0) poses.push_back(cell_pose(m, T_sg, acc.best_cell(), acc.best(), n_alpha));
     }
-    if (acc.best() > 0) poses.push_back(cell_pose(m, T_sg, acc.best_cell(), acc.best(), n_alpha));
   }
   return poses;
 }
