@@ -54,8 +54,9 @@ struct PpfSettings {
                                           // sampling; the references still from
                                           // scene_sampling_steps. On the real LM-O frame 2 against
                                           // 0: 31 against 35 of 80 found (McNemar p = 0.34), the
-                                          // voting 2.4x faster (results/ppf/README.md); 0 = the
-                                          // references' sampling (Drost et al.)
+                                          // median time per object 477 -> 234 ms
+                                          // (results/ppf/README.md); 0 = the references' sampling
+                                          // (Drost et al.)
   double position_cluster_mm = 30.0;      // pose clustering: translation threshold
   double rotation_cluster_deg = 30.0;     // pose clustering: rotation threshold
   int max_hypotheses = 5;                 // clustered poses passed on
