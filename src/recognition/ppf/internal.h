@@ -198,8 +198,8 @@ std::vector<int> reference_points(size_t n, double fraction, uint64_t seed);
 // window leaves no doubt, else -1 (also for a zero or non-finite argument,
 // an angle within the window of +-pi, where atan2f may give +-float(pi) and
 // pcl_alpha negates it, and everywhere without AVX2): there, take
-// pcl_alpha itself. The cells of
-// an approximate value come from VoteCells::checked.
+// pcl_alpha itself. The cells of an approximate value come from
+// VoteCells::checked.
 void approx_alpha_s(const Eigen::Affine3f& T, const PointSet& pts, const int* idx, size_t n, float step,
                     float* value, int* bin);
 

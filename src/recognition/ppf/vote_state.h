@@ -56,61 +56,72 @@ class VoteFlags {
   size_t used_ = 0;
 };
 
+// The best cell of one reference point's votes, kept as they arrive: the
+// most votes, the lowest cell among equals (the first maximum in cell
+// order, as a scan of the accumulator finds it, since counts only grow), as
+// one maximum of (count, ~cell) packed in 64 bits.
+class BestCell {
+ public:
+  void reset() { packed_ = 0; }
+  // Cell `cell` now has `count` votes (count's low 32 bits).
+  void offer(uint64_t count, uint32_t cell) {
+    packed_ = std::max(packed_, (count << 32) | static_cast<uint32_t>(~cell));
+  }
+  uint32_t votes() const { return static_cast<uint32_t>(packed_ >> 32); }  // 0: no vote since reset()
+  uint32_t cell() const { return ~static_cast<uint32_t>(packed_); }
+
+ private:
+  uint64_t packed_ = 0;
+};
+
 // Accumulator cells stamped with the reference point that voted for them
 // (its generation in the high 32 bits, the count in the low 32): a new
 // reference starts from zero without clearing, and a vote needs no branch.
-// The best cell is kept as votes arrive: the most votes, the lowest cell
-// among equals (the first maximum in cell order, as a scan of the
-// accumulator finds it, since counts only grow), as one maximum of
-// (count, ~cell) packed in 64 bits.
 class Accumulator {
  public:
   explicit Accumulator(size_t cells) : cells_(cells, 0) {}
   void next_reference() {
     ++gen_;
     stamp_ = static_cast<uint64_t>(gen_) << 32;
-    best_ = 0;
+    best_.reset();
   }
   void add(uint32_t cell) {
     const uint64_t v = cells_[cell];
     const uint64_t nv = (v >> 32) == gen_ ? v + 1 : stamp_ + 1;
     cells_[cell] = nv;
-    best_ = std::max(best_, (nv << 32) | static_cast<uint32_t>(~cell));
+    best_.offer(nv, cell);
   }
-  uint32_t best() const { return static_cast<uint32_t>(best_ >> 32); }  // 0: no vote since next_reference()
-  uint32_t best_cell() const { return ~static_cast<uint32_t>(best_); }
+  const BestCell& best() const { return best_; }
 
  private:
   std::vector<uint64_t> cells_;
   uint32_t gen_ = 0;
   uint64_t stamp_ = 0;
-  uint64_t best_ = 0;  // (count << 32) | ~cell of the best cell
+  BestCell best_;
 };
 
 // Accumulator's counts in 16 bits, for a reference point that casts at most
 // kMaxVotes votes (the caller's bound: the sum of its pairs' table ranges),
 // so no count can overflow: 2 bytes a cell, so that a model's cells stay in
-// the first-level cache, cleared after each reference that voted. The same
-// best cell as Accumulator's.
+// the first-level cache, cleared after each reference that voted.
 class SmallAccumulator {
  public:
   static constexpr uint64_t kMaxVotes = 65535;
   explicit SmallAccumulator(size_t cells) : cells_(cells, 0) {}
   void next_reference() {
-    if (best_ != 0) std::fill(cells_.begin(), cells_.end(), uint16_t(0));
-    best_ = 0;
+    if (best_.votes() != 0) std::fill(cells_.begin(), cells_.end(), uint16_t(0));
+    best_.reset();
   }
   void add(uint32_t cell) {
     const uint16_t nv = static_cast<uint16_t>(cells_[cell] + 1);
     cells_[cell] = nv;
-    best_ = std::max(best_, (static_cast<uint64_t>(nv) << 32) | static_cast<uint32_t>(~cell));
+    best_.offer(nv, cell);
   }
-  uint32_t best() const { return static_cast<uint32_t>(best_ >> 32); }  // 0: no vote since next_reference()
-  uint32_t best_cell() const { return ~static_cast<uint32_t>(best_); }
+  const BestCell& best() const { return best_; }
 
  private:
   std::vector<uint16_t> cells_;
-  uint64_t best_ = 0;  // (count << 32) | ~cell of the best cell
+  BestCell best_;
 };
 
 }  // namespace pb::ppf

@@ -222,9 +222,10 @@ void reference_keys(const Vec3f& sr, const Vec3f& nr, const PointSet& scene, con
   std::iota(pair_keys_end.begin(), pair_keys_end.end(), 1u);
 }
 
-// The pose of accumulator cell `cell` (model reference point, alpha bin,
+// The pose of the best accumulator cell (model reference point, alpha bin,
 // the bin's centre) for the scene reference frame T_sg, with its votes.
-PoseVote cell_pose(const Model& m, const Eigen::Affine3f& T_sg, uint32_t cell, uint32_t votes, int n_alpha) {
+PoseVote cell_pose(const Model& m, const Eigen::Affine3f& T_sg, const BestCell& best, int n_alpha) {
+  const uint32_t cell = best.cell();
   const size_t mr = cell / static_cast<size_t>(n_alpha);
   const int bin = static_cast<int>(cell % static_cast<size_t>(n_alpha));
   const float alpha = static_cast<float>((bin + 0.5) * m.angle_step - M_PI);
@@ -233,7 +234,7 @@ PoseVote cell_pose(const Model& m, const Eigen::Affine3f& T_sg, uint32_t cell, u
   PoseVote pv;
   pv.pose.R = T.linear().cast<double>();
   pv.pose.t = T.translation().cast<double>();
-  pv.votes = votes;
+  pv.votes = best.votes();
   return pv;
 }
 
@@ -381,11 +382,11 @@ std::vector<PoseVote> vote(const Model& m, const PointSet& scene, const std::vec
     if (opt.margin <= 0 && votes_bound <= SmallAccumulator::kMaxVotes) {
       small.next_reference();
       cast_votes(m, opt, rp, T_sg, partners, vote_cells, n_alpha, flags, small);
-      if (small.best() > 0) poses.push_back(cell_pose(m, T_sg, small.best_cell(), small.best(), n_alpha));
+      if (small.best().votes() > 0) poses.push_back(cell_pose(m, T_sg, small.best(), n_alpha));
     } else {
       acc.next_reference();
       cast_votes(m, opt, rp, T_sg, partners, vote_cells, n_alpha, flags, acc);
-      if (acc.best() > 0) poses.push_back(cell_pose(m, T_sg, acc.best_cell(), acc.best(), n_alpha));
+      if (acc.best().votes() > 0) poses.push_back(cell_pose(m, T_sg, acc.best(), n_alpha));
     }
   }
   return poses;
