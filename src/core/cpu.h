@@ -17,4 +17,17 @@ inline bool cpu_has_avx2() {
 #endif
 }
 
+// True where the CPU has AVX2 and fused multiply-add (x86 only).
+inline bool cpu_has_fma() {
+#if defined(__x86_64__) || defined(__i386__)
+  static const bool yes = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") != 0 && __builtin_cpu_supports("fma") != 0;
+  }();
+  return yes;
+#else
+  return false;
+#endif
+}
+
 }  // namespace pb

@@ -146,7 +146,9 @@ class DescriptorIndex {
 
  private:
   void build_projection();
-  void bounds(const float* queries, int n, float* lbs) const;  // lower_bounds into lbs
+  // lower_bounds into lbs; true when it also wrote each query's smallest
+  // bound into mins (n floats; nullptr: not wanted)
+  bool bounds(const float* queries, int n, float* lbs, float* mins) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -39,12 +39,21 @@ inline float sq_dist(const float* a, const float* b, size_t dim) {
 // sq_dist where the build is not for x86): the same bits.
 float sq_dist_avx2(const float* a, const float* b, size_t dim);
 
-// The lower bounds |Pq|^2 + |Pd|^2 - 2 Pq.Pd of one query (projection zq, its
-// squared norm zn) to every row into lbs, from the rows' projections stored
-// axis by axis (zt, kProjDimShort x rows) and their squared norms (psq). Only
-// where the CPU has AVX2. Its rounding differs from Eigen's product; FPFH's
-// exact search allows for it.
-void short_bounds_avx2(const float* zq, float zn, const float* zt, const float* psq, size_t rows, float* lbs);
+// The lower bounds |Pq|^2 + |Pd|^2 - 2 Pq.Pd of nq queries (projections zq,
+// nq x kProjDimShort; squared norms zn) to every row, into lbs (nq x rows),
+// and each query's smallest bound into mins, from the rows' projections
+// stored axis by axis (zt, kProjDimShort x rows) and their squared norms
+// (psq). Only where the CPU has AVX2 and FMA (cpu_has_fma). Fused
+// multiply-adds: another rounding than the plain product, which FPFH's exact
+// search allows for.
+void short_bounds_fma(const float* zq, const float* zn, int nq, const float* zt, const float* psq, size_t rows,
+                      float* lbs, float* mins);
+
+// The scans of one query's bounds v[0..n) in the exact search, eight at a
+// time (only where the CPU has AVX2): the first index r with v[r] == m, and
+// the first r in [from, n) with v[r] <= bar (NaN never); n when none.
+size_t first_equal_avx2(const float* v, size_t n, float m);
+size_t next_at_most_avx2(const float* v, size_t from, size_t n, float bar);
 
 // The lower bounds of long rows, for the `nq` queries of a block (projections
 // zq, nq x pd, pd <= kProjDim; squared norms zn) to every row, written to lbs
