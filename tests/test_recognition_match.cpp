@@ -227,12 +227,12 @@ TEST(DescriptorIndex, SmallestAtMostEqualsListingThenNthElement) {
 }
 
 // FPFH-sized rows (33: the lower bound from 12 principal axes), with the
-// bounds from Eigen's product and, where the CPU has AVX2, from the AVX2
-// kernel (3030 rows: the kernel's tail too): the blocked search equals the
-// exact scan bit for bit, duplicate rows (ties: the lower row) included, and
-// the search bounded by the threshold gives what an unbounded k-nearest
-// search gives once the rows at or above the threshold are dropped, for
-// several k and thresholds.
+// bounds from Eigen's product and, where the CPU has AVX2 and FMA, from the
+// fused kernel (3030 rows: the kernel's tail too; blocks of any size): the
+// blocked search equals the exact scan bit for bit, duplicate rows (ties:
+// the lower row) included, and the search bounded by the threshold gives
+// what an unbounded k-nearest search gives once the rows at or above the
+// threshold are dropped, for several k and thresholds.
 TEST(DescriptorIndex, FpfhSizedBlockedSearchEqualsExactScanUnderEveryThreshold) {
   constexpr int kFpfh = 33;
   pb::Rng rng(11);
@@ -282,6 +282,20 @@ TEST(DescriptorIndex, FpfhSizedBlockedSearchEqualsExactScanUnderEveryThreshold) 
     }
     EXPECT_GT(found, 500u);    // not all empty
     EXPECT_GT(dropped, 500u);  // and the threshold binds
+    // Blocks that are not a multiple of the kernel's four queries (its
+    // one-query tail), at any offset: each query still gets the exact scan's
+    // answer.
+    for (const int block : {1, 3, 5, 7}) {
+      for (int first = 0; first + block <= 40; first += block) {
+        std::vector<std::vector<std::pair<int, float>>> got(static_cast<size_t>(block));
+        index.knn_block(queries.data() + static_cast<size_t>(first) * kFpfh, block, 3, 1500.f, got.data());
+        for (int i = 0; i < block; ++i) {
+          std::vector<std::pair<int, float>> exact;
+          index.knn(queries.data() + static_cast<size_t>(first + i) * kFpfh, 3, 1500.f, exact);
+          ASSERT_EQ(got[static_cast<size_t>(i)], exact) << "block " << block << ", query " << first + i;
+        }
+      }
+    }
   }
 }
 
