@@ -4,19 +4,19 @@
 // Every descriptor is also projected on the first principal axes of the
 // indexed rows (an orthonormal basis P, so |P q - P d| <= |q - d| for every
 // pair). The bounds |Pq|^2 + |Pd|^2 - 2 Pq.Pd of the queries to every row
-// come, for long rows, from long_bounds (AVX2 where the CPU has
-// it, the same bits), for short rows from Eigen's blocked product or, with
-// AVX2 and FMA, from short_bounds_fma, over the projections stored axis by
-// axis (match_kernels.h). Rows are then measured exactly in the order of their
-// bounds until the bound exceeds the k-th best exact distance (or the
-// threshold), with a margin for the bounds' rounding. Every row that can be
-// among the k nearest is measured exactly and offered in ascending row order,
-// so the result is the exact scan's, bit for bit. Approximate on request
-// (max_checks > 0): at most that many rows, those of the lowest bounds, are
-// measured exactly per query; the answer is still exact whenever the early
-// exit comes first (measured recall: LocalSettings' match_max_checks).
-// Searches are const and thread-safe, and deterministic (no randomized
-// trees).
+// come, for long rows, from long_bounds (AVX2 where the CPU has it, the same
+// bits), for short rows from Eigen's blocked product or, with AVX2 and FMA,
+// from short_bounds_fma, over the projections stored axis by axis
+// (match_kernels.h). The rows are then scanned in ascending order, and a row
+// is measured exactly when its bound is within a margin (for the bounds'
+// rounding) of the k-th best exact distance so far or the threshold: every
+// row that can be among the k nearest is measured and offered in ascending
+// row order, so the result is the exact scan's, bit for bit. Approximate on
+// request (max_checks > 0): at most that many rows, those of the lowest
+// bounds, are measured exactly per query, in the order of their bounds; the
+// answer is still exact whenever the early exit comes first (measured
+// recall: LocalSettings' match_max_checks). Searches are const and
+// thread-safe, and deterministic (no randomized trees).
 //
 // Why no kd-tree: for SHOT one visits nearly every leaf (measured: no faster
 // than a linear scan). FPFH used FLANN's single kd-tree (the index
