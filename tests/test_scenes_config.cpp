@@ -185,6 +185,12 @@ warehouse: {wall_yaw_deg: 0, floor_thickness_mm: 50}
   error_of("scenario: table\nocclusion: {box_colour: red}\n", "occlusion.box_colour");
   error_of("scenario: table\nocclusion: {footprint_sides: 2}\n", "occlusion.footprint_sides");
   error_of("scenario: table\ndistractors: {placement_tries: 0}\n", "distractors.placement_tries");
+  EXPECT_EQ(t.distractors.spread_max_radii, 0);  // no cap
+  EXPECT_EQ(parse("scenario: table\ndistractors: {spread_min_radii: 2, spread_max_radii: 2.5}\n")
+                .distractors.spread_max_radii,
+            2.5);
+  error_of("scenario: table\ndistractors: {spread_max_radii: 2}\n", "distractors.spread_max_radii");  // < 3
+  error_of("scenario: table\ndistractors: {spread_max_radii: -1}\n", "distractors.spread_max_radii");
   error_of("scenario: table\nwarehouse: {wall_yaw_deg: 95}\n", "warehouse.wall_yaw_deg");
 }
 
@@ -198,4 +204,7 @@ TEST(SceneConfig, LayoutDetailsInJsonOnlyWhenChanged) {
   EXPECT_NE(changed.find("\"box_probability\": 0.5"), std::string::npos) << changed;
   EXPECT_NE(changed.find("\"near_mm\": 60"), std::string::npos) << changed;
   EXPECT_EQ(changed.find("\"far_mm\""), std::string::npos) << changed;
+  EXPECT_EQ(def.find("spread_max_radii"), std::string::npos) << def;
+  const std::string capped = scene_settings_json(parse("scenario: table\ndistractors: {spread_max_radii: 4}\n"));
+  EXPECT_NE(capped.find("\"spread_max_radii\": 4"), std::string::npos) << capped;
 }

@@ -327,6 +327,43 @@ TEST(SceneGenerator, WarehouseObjectsAreLarge) {
   EXPECT_LE(img.info.gt.size(), 3u);
 }
 
+// distractors.spread_max_radii caps the disc the other objects stand in:
+// each one's origin lies within that many target footprint radii of the
+// target's on the ground (the footprint radius is at most the target mesh's
+// radius about its origin). On the table the disc is otherwise as wide as
+// the view, several target radii: without the cap (the same seed) some
+// object stands farther.
+TEST(SceneGenerator, SpreadCapKeepsOtherObjectsNearTheTarget) {
+  const std::string from = "distractors: {pool: [milk_carton, boletus, box_small, cylinder], count: [3, 8]}";
+  const auto farthest = [&](const std::string& distractors) {
+    std::string yaml = kTable;
+    yaml.replace(yaml.find(from), from.size(), distractors);
+    SceneGenerator gen(settings_from(yaml));
+    double radius = 0;  // of the target mesh about its origin
+    for (const auto& v : gen.model("ls5").mesh.vertices) radius = std::max(radius, v.cast<double>().norm());
+    double most = 0;  // the farthest other object, in target radii
+    int others = 0;
+    for (int im = 0; im < 3; ++im) {
+      const GeneratedImage img = gen.generate(im);
+      const Vec3 t0 = (img.T_world_cam * img.info.gt[0].T_cam_model).t;
+      for (size_t k = 1; k < img.info.gt.size(); ++k) {
+        const Vec3 tk = (img.T_world_cam * img.info.gt[k].T_cam_model).t;
+        most = std::max(most, (tk - t0).head<2>().norm() / radius);
+        ++others;
+      }
+    }
+    EXPECT_GE(others, 4) << distractors;
+    return most;
+  };
+  const std::string pool = "distractors: {pool: [boletus, box_small, cylinder], count: [2, 3], spread_min_radii: 2.5";
+  const double capped = farthest(pool + ", spread_max_radii: 3}");
+  const double free = farthest(pool + "}");
+  std::cout << "[ spread   ] farthest other object: " << capped << " target radii capped at 3, " << free
+            << " without the cap\n";
+  EXPECT_LE(capped, 3 + 1e-9);
+  EXPECT_GT(free, 3);
+}
+
 TEST(SceneGenerator, ImpossibleOcclusionIsAnInputError) {
   SceneSettings s = settings_from(kTable);
   s.occlusion.enabled = true;

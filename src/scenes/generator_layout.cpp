@@ -179,7 +179,8 @@ bool SceneGenerator::Impl::place_occluder(Rng& rng, Layout& L, std::string& why)
 // at the target's distance) with their origin inside the image.
 bool SceneGenerator::Impl::place_distractors(Rng& rng, Layout& L, std::string& why) const {
   const DistractorSettings& ds = s.distractors;
-  const double spread = std::max(ds.spread_min_radii * L.r_t, L.dist * std::tan(half_fov_min()));
+  double spread = std::max(ds.spread_min_radii * L.r_t, L.dist * std::tan(half_fov_min()));
+  if (ds.spread_max_radii > 0) spread = std::min(spread, ds.spread_max_radii * L.r_t);
   const int n_other = pool.empty() ? 0 : rng.uniform_int(ds.min_count, ds.max_count);
   const double m = ds.image_margin;
   for (int k = 0; k < n_other; ++k) {

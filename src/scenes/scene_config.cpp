@@ -98,7 +98,8 @@ void parse_camera(const YamlNode& c, SceneCameraSettings& cam) {
 }
 
 void parse_distractors(const YamlNode& d, DistractorSettings& ds) {
-  d.check_keys({"pool", "count", "upright_probability", "placement_tries", "spread_min_radii", "image_margin"});
+  d.check_keys({"pool", "count", "upright_probability", "placement_tries", "spread_min_radii", "spread_max_radii",
+                "image_margin"});
   if (d.has("pool")) ds.pool = d.get<std::vector<std::string>>("pool");
   if (d.has("count")) {
     ValueRange r{double(ds.min_count), double(ds.max_count)};
@@ -110,6 +111,10 @@ void parse_distractors(const YamlNode& d, DistractorSettings& ds) {
   ds.upright_probability = read_probability(d, "upright_probability", ds.upright_probability);
   ds.placement_tries = read_int_at_least(d, "placement_tries", ds.placement_tries, 1);
   ds.spread_min_radii = d.get_nonnegative("spread_min_radii", ds.spread_min_radii);
+  ds.spread_max_radii = d.get_nonnegative("spread_max_radii", ds.spread_max_radii);
+  if (ds.spread_max_radii > 0 && ds.spread_max_radii < ds.spread_min_radii)
+    d[d.has("spread_max_radii") ? "spread_max_radii" : "spread_min_radii"].fail(
+        "need spread_max_radii 0 (no cap) or at least spread_min_radii");
   ds.image_margin = read_at_most(d, "image_margin", ds.image_margin, 0.0, 10.0);
 }
 
@@ -265,7 +270,7 @@ ordered_json layout_details(const SceneSettings& s) {
   j["camera"] = {{"near_mm", c.near_mm}, {"far_mm", c.far_mm}, {"clearance_mm", c.clearance_mm},
                  {"depth_clearance_mm", c.depth_clearance_mm}};
   j["distractors"] = {{"placement_tries", d.placement_tries}, {"spread_min_radii", d.spread_min_radii},
-                      {"image_margin", d.image_margin}};
+                      {"spread_max_radii", d.spread_max_radii}, {"image_margin", d.image_margin}};
   if (o.enabled)
     j["occlusion"] = {
         {"box_probability", o.box_probability},   {"box_width", range_json(o.box_width)},

@@ -31,7 +31,7 @@
 // Layout details (optional, rarely changed; the defaults are the values the
 // generator always used, see the field comments below):
 //   camera: {near_mm, far_mm, clearance_mm, depth_clearance_mm}
-//   distractors: {placement_tries, spread_min_radii, image_margin}
+//   distractors: {placement_tries, spread_min_radii, spread_max_radii, image_margin}
 //   occlusion: {box_probability, box_width, box_depth_mm, cylinder_radius,
 //               cylinder_min_radius_mm, lateral_offset, extra_distance,
 //               height_factor, height_margin_mm, camera_headroom_mm,
@@ -95,10 +95,12 @@ struct DistractorSettings {
   double upright_probability = 0.5;
   // Layout details. The scatter disc around the target is as wide as the
   // view at the target's distance, but at least spread_min_radii target
-  // footprint radii; an object's origin must project inside the image
+  // footprint radii (and at most spread_max_radii, when that is not 0: other
+  // objects crowded around the target); an object's origin must project inside the image
   // enlarged by image_margin (fraction of its width / height) on each side.
   int placement_tries = 60;         // random positions tried per object before the layout is given up
   double spread_min_radii = 3.0;    // minimum scatter disc radius, in target footprint radii
+  double spread_max_radii = 0.0;    // maximum one, in target footprint radii; 0: none (as wide as the view)
   double image_margin = 0.05;       // fraction of the image size, each side
 };
 
