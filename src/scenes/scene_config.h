@@ -95,9 +95,10 @@ struct DistractorSettings {
   double upright_probability = 0.5;
   // Layout details. The scatter disc around the target is as wide as the
   // view at the target's distance, but at least spread_min_radii target
-  // footprint radii (and at most spread_max_radii, when that is not 0: other
-  // objects crowded around the target); an object's origin must project inside the image
-  // enlarged by image_margin (fraction of its width / height) on each side.
+  // footprint radii (and at most spread_max_radii, when that is not 0: the
+  // other objects crowded around the target); an object's origin must
+  // project inside the image enlarged by image_margin (fraction of its
+  // width / height) on each side.
   int placement_tries = 60;         // random positions tried per object before the layout is given up
   double spread_min_radii = 3.0;    // minimum scatter disc radius, in target footprint radii
   double spread_max_radii = 0.0;    // maximum one, in target footprint radii; 0: none (as wide as the view)
