@@ -272,7 +272,7 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
   // read for every query of the block (groups of four took 15% longer).
   const int group = m.dim > kShortRows ? n : 4;
   const std::unique_ptr<float[]> all(new float[static_cast<size_t>(group) * m.rows]);  // every one written
-  std::vector<float> mins(static_cast<size_t>(group));
+  std::vector<float> mins(m.dim > kShortRows ? 0 : static_cast<size_t>(group));  // only short rows get them
   bool have_mins = false;
   const auto dist = m.avx2_bounds ? sq_dist_avx2 : sq_dist;  // the same bits
   std::vector<std::pair<float, int>> cand;
