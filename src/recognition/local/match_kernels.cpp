@@ -129,15 +129,43 @@ __attribute__((target("avx2"))) size_t next_at_most_avx2(const float* v, size_t 
   return n;
 }
 
-// The lower bounds of long rows (SHOT's 32 axes), eight rows at a time: the
-// same values as long_bounds (below), bit for bit (each lane does the same
-// float operations in the same order; no fused multiply-add). Rows in tiles
-// that stay in the L1 cache; four queries share each load of a tile's
-// projections.
+// The lower bounds of long rows (SHOT's 32 axes) for four queries over R
+// groups of eight rows (rows r, r + 8, ...): each lane does the same float
+// operations in the same order as long_bounds (below; no fused
+// multiply-add), so the same bits. Two groups share each load of a query's
+// broadcast coordinate: with one group the kernel waits on its loads.
+namespace {
+template <int R>
+__attribute__((target("avx2"))) inline void long_bounds_rows(const __m256* qb, const float* zn, size_t P,
+                                                             const float* zt, const float* psq, size_t rows,
+                                                             size_t r, float* lbs) {
+  __m256 d[R][4];
+  for (int g = 0; g < R; ++g) {
+    const __m256 z = _mm256_loadu_ps(zt + r + 8 * g);
+    for (int j = 0; j < 4; ++j) d[g][j] = _mm256_mul_ps(qb[j], z);
+  }
+  for (size_t a = 1; a < P; ++a) {
+    const __m256* b = qb + 4 * a;
+    for (int g = 0; g < R; ++g) {
+      const __m256 z = _mm256_loadu_ps(zt + a * rows + r + 8 * g);
+      for (int j = 0; j < 4; ++j) d[g][j] = _mm256_add_ps(d[g][j], _mm256_mul_ps(b[j], z));
+    }
+  }
+  const __m256 two = _mm256_set1_ps(2.f);
+  for (int g = 0; g < R; ++g) {
+    const __m256 p = _mm256_loadu_ps(psq + r + 8 * g);
+    for (int j = 0; j < 4; ++j)
+      _mm256_storeu_ps(lbs + static_cast<size_t>(j) * rows + r + 8 * g,
+                       _mm256_sub_ps(_mm256_add_ps(_mm256_set1_ps(zn[j]), p), _mm256_mul_ps(two, d[g][j])));
+  }
+}
+}  // namespace
+
+// Rows in tiles that stay in the L1 cache; four queries share each load of
+// a tile's projections.
 __attribute__((target("avx2"))) void long_bounds_avx2(const float* zq, const float* zn, int nq, int pd,
                                                       const float* zt, const float* psq, size_t rows, float* lbs) {
   constexpr size_t kTile = 256;  // rows: 32 axes x 256 rows x 4 bytes = 32 KB
-  const __m256 two = _mm256_set1_ps(2.f);
   __m256 qb[4 * kProjDim];  // pd <= kProjDim
   for (size_t t0 = 0; t0 < rows; t0 += kTile) {
     const size_t t1 = std::min(rows, t0 + kTile);
@@ -148,25 +176,10 @@ __attribute__((target("avx2"))) void long_bounds_avx2(const float* zq, const flo
       // axis, query by query): the products read them from memory.
       for (size_t a = 0; a < P; ++a)
         for (size_t j = 0; j < 4; ++j) qb[4 * a + j] = _mm256_set1_ps(q[j * P + a]);
+      float* out = lbs + static_cast<size_t>(i) * rows;
       size_t r = t0;
-      for (; r + 8 <= t1; r += 8) {
-        __m256 z = _mm256_loadu_ps(zt + r);
-        __m256 d0 = _mm256_mul_ps(qb[0], z), d1 = _mm256_mul_ps(qb[1], z), d2 = _mm256_mul_ps(qb[2], z),
-               d3 = _mm256_mul_ps(qb[3], z);
-        for (size_t a = 1; a < P; ++a) {
-          z = _mm256_loadu_ps(zt + a * rows + r);
-          const __m256* b = qb + 4 * a;
-          d0 = _mm256_add_ps(d0, _mm256_mul_ps(b[0], z));
-          d1 = _mm256_add_ps(d1, _mm256_mul_ps(b[1], z));
-          d2 = _mm256_add_ps(d2, _mm256_mul_ps(b[2], z));
-          d3 = _mm256_add_ps(d3, _mm256_mul_ps(b[3], z));
-        }
-        const __m256 p = _mm256_loadu_ps(psq + r);
-        const __m256 d[4] = {d0, d1, d2, d3};
-        for (int j = 0; j < 4; ++j)
-          _mm256_storeu_ps(lbs + static_cast<size_t>(i + j) * rows + r,
-                           _mm256_sub_ps(_mm256_add_ps(_mm256_set1_ps(zn[i + j]), p), _mm256_mul_ps(two, d[j])));
-      }
+      for (; r + 16 <= t1; r += 16) long_bounds_rows<2>(qb, zn + i, P, zt, psq, rows, r, out);
+      for (; r + 8 <= t1; r += 8) long_bounds_rows<1>(qb, zn + i, P, zt, psq, rows, r, out);
       for (; r < t1; ++r)
         for (int j = 0; j < 4; ++j) {
           const float* qj = q + static_cast<size_t>(j) * P;
