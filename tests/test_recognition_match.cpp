@@ -198,7 +198,8 @@ TEST(DescriptorIndex, ShotSizedBoundsHaveTheSameBitsOnEveryPath) {
 // The capped search's candidates: the cap smallest (value, index) pairs
 // under the limit, the same set as listing every pair under it and keeping
 // the cap smallest with nth_element (the way before), with ties, NaN and
-// lengths that are not a multiple of four.
+// lengths that are not a multiple of four or eight, on both paths (SSE, and
+// AVX2 where the CPU has it).
 TEST(DescriptorIndex, SmallestAtMostEqualsListingThenNthElement) {
   pb::Rng rng(5);
   for (int trial = 0; trial < 200; ++trial) {
@@ -218,11 +219,15 @@ TEST(DescriptorIndex, SmallestAtMostEqualsListingThenNthElement) {
       std::nth_element(want.begin(), want.begin() + static_cast<long>(cap), want.end());
       want.resize(cap);
     }
-    std::vector<std::pair<float, int>> got;
-    pb::local::smallest_at_most(v.data(), n, limit, cap, got);
     std::sort(want.begin(), want.end());
-    std::sort(got.begin(), got.end());
-    ASSERT_EQ(got, want) << "trial " << trial << ": n " << n << " cap " << cap << " limit " << limit;
+    for (const bool avx2 : {false, true}) {
+      if (avx2 && !pb::cpu_has_avx2()) continue;
+      std::vector<std::pair<float, int>> got;
+      pb::local::smallest_at_most(v.data(), n, limit, cap, got, avx2);
+      std::sort(got.begin(), got.end());
+      ASSERT_EQ(got, want) << "trial " << trial << ": n " << n << " cap " << cap << " limit " << limit << " avx2 "
+                           << avx2;
+    }
   }
 }
 

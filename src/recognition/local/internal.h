@@ -156,7 +156,8 @@ class DescriptorIndex {
 // The `cap` smallest (v[r], r) pairs (value, then index) of v[0..n) among
 // those with v[r] <= limit (NaN never), in any order: the candidates of the
 // capped search (DescriptorIndex::knn_block's max_checks).
-void smallest_at_most(const float* v, size_t n, float limit, size_t cap, std::vector<std::pair<float, int>>& out);
+void smallest_at_most(const float* v, size_t n, float limit, size_t cap, std::vector<std::pair<float, int>>& out,
+                      bool avx2 = false);
 
 // A correspondence between a model keypoint (of one training view) and a
 // scene keypoint, with its descriptor distance.
