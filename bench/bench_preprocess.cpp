@@ -53,7 +53,7 @@ const Frame& frame(int which) {
 PointSet cut(const Frame& f) {
   const OrganizedCloud c = OrganizedCloud::from_depth(f.depth, f.K);
   PointSet ps;
-  ps.source_width = c.width;  // the pixels index an image this wide (the grid's column guesses)
+  ps.source_width = c.width;  // the pixels index an image this wide
   ps.source_height = c.height;
   for (size_t i = 0; i < c.points.size(); ++i) {
     const Vec3f& p = c.points[i];

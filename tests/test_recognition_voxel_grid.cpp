@@ -275,8 +275,8 @@ TEST(VoxelGrid, FourPointKernelsEqualTheOnePointLoops) {
 
 // A rendered table frame, range-cut as the scene preprocessing cuts it
 // (pixels in image order): every pixel's point at the scene's voxel sizes;
-// with the image's width given (the grid's guesses from the pixel above)
-// and without, and with pixels out of image order (the guesses stop).
+// with the image's width given and without, with pixels out of image order
+// and with pixels unknown (-1), which each cell's nearest pixel must handle.
 TEST(VoxelGrid, EqualsThePlainReferenceOnATableFrame) {
   const pb::Mesh mesh = pbtest::make_l_block();
   const pbtest::TableScene scene = pbtest::render_table_scene(mesh);
