@@ -98,6 +98,8 @@ TEST(SceneConfig, Errors) {
   error_of("scenario: table\ncamera: {distance_mm: [1500, 600]}\n", "camera.distance_mm");
   error_of("scenario: table\ncamera: {zoom: 2}\n", "camera.zoom");
   error_of("scenario: table\ntable: {size_mm: -4}\n", "table.size_mm");
+  error_of("scenario: table\ntable: {floor_drop_mm: 10}\n", "table.floor_drop_mm");  // inside the table top
+  error_of("scenario: table\ntable: {wall_distance_mm: [-5, 100]}\n", "table.wall_distance_mm");
   error_of("scenario: warehouse\nwarehouse: {object_size_mm: [-1, 2]}\ndistractors: {pool: [pallet]}\n",
            "warehouse.object_size_mm");
   error_of("scenario: table\nocclusion: [0.4, 1.5]\n", "occlusion");

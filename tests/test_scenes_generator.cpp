@@ -432,3 +432,49 @@ TEST(SceneGenerator, WarehouseWithoutWallHasOnlyTheFloor) {
   ASSERT_EQ(a.info.gt.size(), b.info.gt.size());
   EXPECT_EQ(a.info.gt[0].obj_id, b.info.gt[0].obj_id);
 }
+
+// A room around the table (table.floor_drop_mm, table.wall_distance_mm): the
+// points of the noise-free depth, in the scene's world frame (z up, the
+// table top at z = 0), reach down to the floor beyond the table's edges but
+// not below it, and back to the wall behind the table but not beyond it;
+// without the room nothing lies below the table top.
+TEST(SceneGenerator, TableRoomHasAFloorBelowAndAWallBehind) {
+  const auto world_points = [](const std::string& table, std::vector<Vec3>& out, Eigen::Vector2d& g) {
+    std::string yaml = kTable;
+    yaml += "camera: {distance_mm: 2000, elevation_deg: 30}\nocclusion: none\n" + table;
+    yaml.replace(yaml.find("occlusion: {visib_fract: [0.4, 0.9], probability: 0.5}\n"), 55, "");
+    SceneGenerator gen(settings_from(yaml));
+    const GeneratedImage img = gen.generate(0);
+    const OrganizedCloud c = OrganizedCloud::from_depth(img.depth_clean, img.info.K);
+    for (const Vec3f& p : c.points)
+      if (p.allFinite()) out.push_back(img.T_world_cam * p.cast<double>());
+    g = img.T_world_cam.t.head<2>().normalized();  // from the target (the origin) toward the camera
+  };
+  std::vector<Vec3> room, bare;
+  Eigen::Vector2d g, g_bare;
+  world_points("table: {size_mm: 1200, floor_drop_mm: 750, wall_distance_mm: 300}\n", room, g);
+  world_points("table: {size_mm: 1200}\n", bare, g_bare);
+  ASSERT_GT(room.size(), 1000u);
+  ASSERT_GT(bare.size(), 1000u);
+  double far = 0;  // the table's farthest corner from the origin, away from the camera
+  for (const double x : {-600.0, 600.0})
+    for (const double y : {-600.0, 600.0}) far = std::max(far, -g.dot(Eigen::Vector2d(x, y)));
+  const double wall = far + 300;  // the wall's face, along -g
+  int on_floor = 0, on_wall = 0;
+  double lowest = 0, deepest = 0;
+  for (const Vec3& p : room) {
+    lowest = std::min(lowest, p.z());
+    deepest = std::max(deepest, -g.dot(p.head<2>()));
+    if (std::abs(p.z() + 750) < 5 && (std::abs(p.x()) > 610 || std::abs(p.y()) > 610)) ++on_floor;
+    if (std::abs(-g.dot(p.head<2>()) - wall) < 5 && p.z() > 0) ++on_wall;
+  }
+  std::cout << "[ room     ] " << on_floor << " floor and " << on_wall << " wall pixels of " << room.size()
+            << "; lowest z " << lowest << " mm, deepest " << deepest << " mm (wall at " << wall << ")\n";
+  EXPECT_GT(on_floor, 100);
+  EXPECT_GT(on_wall, 100);
+  EXPECT_GT(lowest, -750 - 1);
+  EXPECT_LT(deepest, wall + 1);
+  double bare_lowest = 0;
+  for (const Vec3& p : bare) bare_lowest = std::min(bare_lowest, p.z());
+  EXPECT_GT(bare_lowest, -40 - 1);  // the table top's thickness at most
+}

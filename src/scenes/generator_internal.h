@@ -131,6 +131,7 @@ struct SceneGenerator::Impl : scene_detail::GeneratorState {
   void place_target(Rng& rng, Layout& L) const;
   bool place_camera(Rng& rng, Layout& L, GeneratedImage& img, std::string& why) const;
   void place_background(Rng& rng, Layout& L) const;
+  Placed wall_at(const Layout& L, double bottom) const;
   bool place_occluder(Rng& rng, Layout& L, std::string& why) const;
   bool place_distractors(Rng& rng, Layout& L, std::string& why) const;
   // Whether ground point q lies on the table (at least table_margin inside

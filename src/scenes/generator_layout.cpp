@@ -67,16 +67,46 @@ bool SceneGenerator::Impl::place_camera(Rng& rng, Layout& L, GeneratedImage& img
   return true;
 }
 
-// 3. Table under everything; warehouse: a floor and (warehouse.wall) a wall
-// behind the target as seen from the camera.
+// A wall facing the camera (normal L.wall_n, horizontal) whose face passes
+// through L.wall_point, from height `bottom` up.
+Placed SceneGenerator::Impl::wall_at(const Layout& L, double bottom) const {
+  const WarehouseSettings& w = s.warehouse;
+  Placed wall;
+  wall.mesh = &wall_mesh;
+  const double yaw = std::atan2(L.wall_n.y(), L.wall_n.x()) - M_PI / 2;  // box y axis along wall_n
+  wall.T_world_model.R = axis_angle(Vec3::UnitZ(), yaw);
+  const Vec2 c = L.wall_point - L.wall_n * (0.5 * w.wall_thickness_mm);
+  wall.T_world_model.t = Vec3(c.x(), c.y(), bottom + 0.5 * w.wall_height_mm);
+  return wall;
+}
+
+// 3. Table under everything, and (table.floor_drop_mm, wall_distance_mm) a
+// room around it: a floor below and a wall behind the table as seen from
+// the camera; warehouse: a floor and (warehouse.wall) a wall behind the
+// target. Only a room's wall draws from the stream (default sets keep their
+// images).
 void SceneGenerator::Impl::place_background(Rng& rng, Layout& L) const {
   L.wall_point = Vec2::Zero();
   L.wall_n = L.g;
   if (!warehouse()) {
+    const TableSettings& t = s.table;
     Placed table;
     table.mesh = &table_mesh;
-    table.T_world_model.t = Vec3(0, 0, -0.5 * s.table.thickness_mm);
+    table.T_world_model.t = Vec3(0, 0, -0.5 * t.thickness_mm);
     L.bg.push_back(table);
+    if (t.floor_drop_mm > 0) {
+      Placed floor;
+      floor.mesh = &floor_mesh;
+      floor.T_world_model.t = Vec3(0, 0, -t.floor_drop_mm - 0.5 * s.warehouse.floor_thickness_mm);
+      L.bg.push_back(floor);
+    }
+    if (t.wall_distance_mm.hi > 0) {
+      double far = 0;  // the table's farthest corner from the target, away from the camera
+      for (const double x : {-0.5, 0.5})
+        for (const double y : {-0.5, 0.5}) far = std::max(far, -L.g.dot(Vec2(x, y) * t.size_mm));
+      L.wall_point = -L.g * (far + rng.uniform(t.wall_distance_mm.lo, t.wall_distance_mm.hi));
+      L.bg.push_back(wall_at(L, -t.floor_drop_mm));
+    }
     return;
   }
   const WarehouseSettings& w = s.warehouse;
@@ -89,13 +119,7 @@ void SceneGenerator::Impl::place_background(Rng& rng, Layout& L) const {
   floor.T_world_model.t = Vec3(0, 0, -0.5 * w.floor_thickness_mm);
   L.bg.push_back(floor);
   if (!w.wall) return;  // the floor alone (on_ground_area: no wall bounds it)
-  Placed wall;
-  wall.mesh = &wall_mesh;
-  const double yaw = std::atan2(L.wall_n.y(), L.wall_n.x()) - M_PI / 2;  // box y axis along wall_n
-  wall.T_world_model.R = axis_angle(Vec3::UnitZ(), yaw);
-  const Vec2 c = L.wall_point - L.wall_n * (0.5 * w.wall_thickness_mm);
-  wall.T_world_model.t = Vec3(c.x(), c.y(), 0.5 * w.wall_height_mm);
-  L.bg.push_back(wall);
+  L.bg.push_back(wall_at(L, 0.0));
 }
 
 bool SceneGenerator::Impl::on_ground_area(const Layout& L, const Vec2& q, double table_margin) const {
@@ -144,7 +168,8 @@ bool SceneGenerator::Impl::place_occluder(Rng& rng, Layout& L, std::string& why)
     local = {{-oc.w / 2, -oc.d / 2}, {oc.w / 2, -oc.d / 2}, {oc.w / 2, oc.d / 2}, {-oc.w / 2, oc.d / 2}};
   } else {
     const int n = o.footprint_sides;
-    for (int k = 0; k < n; ++k) local.emplace_back(oc.r * std::cos(2 * M_PI * k / n), oc.r * std::sin(2 * M_PI * k / n));
+    for (int k = 0; k < n; ++k)
+      local.emplace_back(oc.r * std::cos(2 * M_PI * k / n), oc.r * std::sin(2 * M_PI * k / n));
   }
   oc.placed.footprint = transform_footprint(local, yaw, c);
   oc.placed.T_world_model.R = axis_angle(Vec3::UnitZ(), yaw);

@@ -160,10 +160,14 @@ void parse_occlusion(const YamlNode& root, OcclusionSettings& oc) {
 }
 
 void parse_table(const YamlNode& t, TableSettings& ts) {
-  t.check_keys({"size_mm", "thickness_mm", "gap_mm"});
+  t.check_keys({"size_mm", "thickness_mm", "gap_mm", "floor_drop_mm", "wall_distance_mm"});
   ts.size_mm = t.get_positive("size_mm", ts.size_mm);
   ts.thickness_mm = t.get_positive("thickness_mm", ts.thickness_mm);
   ts.gap_mm = t.get_nonnegative("gap_mm", ts.gap_mm);
+  ts.floor_drop_mm = t.get_nonnegative("floor_drop_mm", ts.floor_drop_mm);
+  if (ts.floor_drop_mm > 0 && ts.floor_drop_mm < ts.thickness_mm)
+    t["floor_drop_mm"].fail("must be 0 (no floor) or at least the table's thickness_mm (" + num(ts.thickness_mm) + ")");
+  read_range(t, "wall_distance_mm", ts.wall_distance_mm, false);
 }
 
 void parse_warehouse(const YamlNode& w, WarehouseSettings& ws) {
@@ -281,6 +285,8 @@ ordered_json layout_details(const SceneSettings& s) {
         {"min_height_mm", o.min_height_mm},       {"token_height", o.token_height},
         {"search_iterations", o.search_iterations}, {"search_tolerance", o.search_tolerance},
         {"footprint_sides", o.footprint_sides},   {"cylinder_segments", o.cylinder_segments}};
+  if (s.scenario == Scenario::table)
+    j["table"] = {{"floor_drop_mm", s.table.floor_drop_mm}, {"wall_distance_mm", range_json(s.table.wall_distance_mm)}};
   if (s.scenario == Scenario::warehouse)
     j["warehouse"] = {{"wall_yaw_deg", w.wall_yaw_deg}, {"wall_thickness_mm", w.wall_thickness_mm},
                       {"wall_length_mm", w.wall_length_mm}, {"floor_size_mm", w.floor_size_mm},

@@ -39,6 +39,7 @@
 //               search_tolerance, footprint_sides, cylinder_segments}
 //   warehouse: {wall_yaw_deg, wall_thickness_mm, wall_length_mm,
 //               floor_size_mm, floor_thickness_mm}
+//   table: {floor_drop_mm, wall_distance_mm}   # a room around the table
 // posebench_scene.json lists a layout detail only when it differs from its
 // default (so scene sets made with the defaults keep their bytes).
 #pragma once
@@ -142,6 +143,13 @@ struct TableSettings {
   double size_mm = 4000;      // edge of the square table top (a plane in practice)
   double thickness_mm = 40;   // table top thickness
   double gap_mm = 10;         // minimum distance between object footprints
+  // A room around the table (layout details; by default none: the table
+  // top fills the view and nothing else is in range). The floor slab and
+  // the wall are the warehouse's (warehouse.floor_* and wall_* details).
+  double floor_drop_mm = 0;            // > 0: a floor this far below the table top, mm
+  ValueRange wall_distance_mm{0, 0};   // > 0: a wall behind the table as seen from the camera,
+                                       // this far beyond the table's farthest corner (drawn
+                                       // per image), from the floor (or the table top) up, mm
 };
 
 struct WarehouseSettings {
