@@ -14,6 +14,7 @@
 #include "cli/command.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/memory.h"
 
 namespace pb::cli {
 
@@ -55,6 +56,10 @@ static void usage() {
 }
 
 int main(int argc, char** argv) {
+  // Every command times recognition as the runner's workers do (`recognize`
+  // over a folder of frames calls it once per frame): freed buffers stay
+  // with the process.
+  pb::keep_freed_memory();
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
     usage();
     return argc < 2 ? pb::kExitInputError : 0;

@@ -1,7 +1,6 @@
 #include "runner/pool.h"
 
 #include <fcntl.h>
-#include <malloc.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
@@ -29,13 +28,6 @@ const bool kMemoryLimitApplies = true;
 #else
 const bool kMemoryLimitApplies = true;
 #endif
-
-void keep_freed_memory() {
-#ifdef __GLIBC__
-  mallopt(M_MMAP_THRESHOLD, 64 << 20);
-  mallopt(M_TRIM_THRESHOLD, 1 << 30);
-#endif
-}
 
 namespace {
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/memory.h"
 #include "eval/record.h"
 
 namespace pb {
@@ -24,20 +25,7 @@ int omp_threads_per_worker(int jobs, int host_cores);
 // the memory limit is not applied (the runner says so).
 extern const bool kMemoryLimitApplies;
 
-// Called once by each worker: a trial's freed buffers stay with the process
-// for the next trial. A worker runs one trial after another, and a trial's
-// large buffers (the 640x480 cloud, the voxel grid's keys, the normals) are
-// freed at its end; glibc gives them back to the kernel (blocks from 128 KiB
-// to a few MiB come from mmap, and the heap's free top beyond about twice
-// the largest such block is trimmed), so the next trial faulted every page
-// in again. What ran before then decided a method's time: PPF alone on the
-// table frames spent 13.9 ms in preprocessing, 9.0 ms after CVFH had grown
-// the heap (results/bench/README.md, twenty-fourth round). Kept as
-// latency-sensitive programs do: blocks under 64 MiB from the heap, and up to
-// 1 GiB of freed heap not returned. It changes when memory goes back, never a
-// result; a worker's resident size stays near its peak. glibc only (a no-op
-// elsewhere and under AddressSanitizer, which has its own allocator).
-void keep_freed_memory();
+// keep_freed_memory() (core/memory.h): called once by each worker.
 
 struct PoolOptions {
   std::string binary;    // the posebench executable
