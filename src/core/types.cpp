@@ -2,6 +2,11 @@
 
 #include <cmath>
 #include <limits>
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
+
+#include "core/cpu.h"
 
 namespace pb {
 
@@ -128,18 +133,65 @@ void Mesh::append(const Mesh& o) {
     vertex_normals.clear();
 }
 
+namespace {
+
+// Pixels [from, width) of row v of from_depth: pixel u's point
+// K.backproject(u, v, z) in float, or NaN where z is not a measurement (0,
+// negative, NaN or infinite); z and out index the row.
+void backproject_row(const float* z, int from, int width, int v, const Intrinsics& K, Vec3f* out) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int u = from; u < width; ++u)
+    out[u] = z[u] > 0.f && std::isfinite(z[u]) ? K.backproject(u, v, z[u]).cast<float>() : Vec3f(nan, nan, nan);
+}
+
+#if defined(__x86_64__) || defined(__i386__)
+// The same row four pixels at a time: each lane does backproject's double
+// operations in its order, (u - cx) * z / fx and (v - cy) * z / fy, each
+// correctly rounded as the scalar ones, then the same rounding to float.
+// The divisions are most of the cost, four to an instruction here.
+__attribute__((target("avx2"))) void backproject_row_avx2(const float* z, int width, int v, const Intrinsics& K,
+                                                          Vec3f* out) {
+  const __m256d cx = _mm256_set1_pd(K.cx), fx = _mm256_set1_pd(K.fx), fy = _mm256_set1_pd(K.fy);
+  const __m256d vy = _mm256_set1_pd(static_cast<double>(v) - K.cy);
+  const __m128 zero = _mm_setzero_ps(), inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+  const __m128 nan = _mm_set1_ps(std::numeric_limits<float>::quiet_NaN());
+  int u = 0;
+  for (; u + 4 <= width; u += 4) {
+    const __m128 zf = _mm_loadu_ps(z + u);
+    const __m128 ok = _mm_and_ps(_mm_cmpgt_ps(zf, zero), _mm_cmplt_ps(zf, inf));  // z > 0, finite
+    const __m256d zd = _mm256_cvtps_pd(zf);
+    const __m256d ud = _mm256_set_pd(u + 3, u + 2, u + 1, u);
+    const __m128 x = _mm256_cvtpd_ps(_mm256_div_pd(_mm256_mul_pd(_mm256_sub_pd(ud, cx), zd), fx));
+    const __m128 y = _mm256_cvtpd_ps(_mm256_div_pd(_mm256_mul_pd(vy, zd), fy));
+    alignas(16) float xs[4], ys[4], zs[4];
+    _mm_store_ps(xs, _mm_blendv_ps(nan, x, ok));
+    _mm_store_ps(ys, _mm_blendv_ps(nan, y, ok));
+    _mm_store_ps(zs, _mm_blendv_ps(nan, zf, ok));
+    for (int k = 0; k < 4; ++k) out[u + k] = Vec3f(xs[k], ys[k], zs[k]);
+  }
+  backproject_row(z, u, width, v, K, out);
+}
+#endif
+
+}  // namespace
+
 OrganizedCloud OrganizedCloud::from_depth(const DepthImage& depth, const Intrinsics& K) {
   OrganizedCloud c;
   c.width = depth.width;
   c.height = depth.height;
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  c.points.assign(static_cast<size_t>(c.width) * c.height, Vec3f(nan, nan, nan));
-  for (int v = 0; v < depth.height; ++v)
-    for (int u = 0; u < depth.width; ++u) {
-      const float z = depth.at(u, v);
-      if (z > 0.f && std::isfinite(z))
-        c.points[static_cast<size_t>(v) * c.width + u] = K.backproject(u, v, z).cast<float>();
+  c.points.resize(static_cast<size_t>(c.width) * c.height);  // every one written
+  const bool avx2 = cpu_has_avx2();
+  for (int v = 0; v < depth.height; ++v) {
+    const float* z = depth.z.data() + static_cast<size_t>(v) * depth.width;
+    Vec3f* out = c.points.data() + static_cast<size_t>(v) * c.width;
+#if defined(__x86_64__) || defined(__i386__)
+    if (avx2) {
+      backproject_row_avx2(z, depth.width, v, K, out);
+      continue;
     }
+#endif
+    backproject_row(z, 0, depth.width, v, K, out);
+  }
   return c;
 }
 
