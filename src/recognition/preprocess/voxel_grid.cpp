@@ -104,6 +104,11 @@ Cells group_by(size_t n, KeyOf key_of, Skip skip, std::vector<K>& keys) {
   Cells c;
   c.cell_of.assign(n, -1);
   KeyTable<K> slot(n / 8 + 16);
+  // At most one cell per point: written by index, cut to size at the end.
+  keys.resize(n);
+  c.first.resize(n);
+  c.count.assign(n, 0);
+  int cells = 0;
   K last{};
   int last_slot = -1;
   for (size_t i = 0; i < n; ++i) {
@@ -112,11 +117,11 @@ Cells group_by(size_t n, KeyOf key_of, Skip skip, std::vector<K>& keys) {
     int s = last_slot;
     if (s < 0 || !(k == last)) {
       bool fresh = false;
-      s = slot.find_or_insert(k, static_cast<int>(keys.size()), &fresh);
+      s = slot.find_or_insert(k, cells, &fresh);
       if (fresh) {
-        keys.push_back(k);
-        c.first.push_back(static_cast<int>(i));
-        c.count.push_back(0);
+        keys[static_cast<size_t>(cells)] = k;
+        c.first[static_cast<size_t>(cells)] = static_cast<int>(i);
+        ++cells;
       }
       last = k;
       last_slot = s;
@@ -124,6 +129,9 @@ Cells group_by(size_t n, KeyOf key_of, Skip skip, std::vector<K>& keys) {
     ++c.count[static_cast<size_t>(s)];
     c.cell_of[i] = s;
   }
+  keys.resize(static_cast<size_t>(cells));
+  c.first.resize(static_cast<size_t>(cells));
+  c.count.resize(static_cast<size_t>(cells));
   return c;
 }
 
