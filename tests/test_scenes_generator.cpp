@@ -441,8 +441,9 @@ TEST(SceneGenerator, WarehouseWithoutWallHasOnlyTheFloor) {
 TEST(SceneGenerator, TableRoomHasAFloorBelowAndAWallBehind) {
   const auto world_points = [](const std::string& table, std::vector<Vec3>& out, Eigen::Vector2d& g) {
     std::string yaml = kTable;
-    yaml += "camera: {distance_mm: 2000, elevation_deg: 30}\nocclusion: none\n" + table;
-    yaml.replace(yaml.find("occlusion: {visib_fract: [0.4, 0.9], probability: 0.5}\n"), 55, "");
+    const std::string occluded = "occlusion: {visib_fract: [0.4, 0.9], probability: 0.5}\n";
+    yaml.replace(yaml.find(occluded), occluded.size(), "occlusion: none\n");
+    yaml += "camera: {distance_mm: 2000, elevation_deg: 30}\n" + table;
     SceneGenerator gen(settings_from(yaml));
     const GeneratedImage img = gen.generate(0);
     const OrganizedCloud c = OrganizedCloud::from_depth(img.depth_clean, img.info.K);
