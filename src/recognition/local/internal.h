@@ -155,7 +155,8 @@ class DescriptorIndex {
 
 // The `cap` smallest (v[r], r) pairs (value, then index) of v[0..n) among
 // those with v[r] <= limit (NaN never), in any order: the candidates of the
-// capped search (DescriptorIndex::knn_block's max_checks).
+// capped search (DescriptorIndex::knn_block's max_checks). avx2: scan with
+// the AVX2 kernel, only where the CPU has it (cpu_has_avx2()); the same set.
 void smallest_at_most(const float* v, size_t n, float limit, size_t cap, std::vector<std::pair<float, int>>& out,
                       bool avx2 = false);
 
