@@ -190,8 +190,8 @@ inline void offer(std::vector<std::pair<int, float>>& out, size_t kk, int row, f
 // smallest and the bar falls to the largest value kept (a later pair equal
 // to it is still appended: the last nth_element decides by index). The bar
 // is compared eight values at a time by AVX2 (avx2: the CPU has it), else
-// four at a time by SSE. (A max-heap of the cap best, updated per pair, took
-// five times as long on the warehouse's SHOT rows.)
+// four at a time by SSE (next_at_most). (A max-heap of the cap best,
+// updated per pair, took five times as long on the warehouse's SHOT rows.)
 void smallest_at_most(const float* v, size_t n, float limit, size_t cap, std::vector<std::pair<float, int>>& out,
                       bool avx2) {
   out.clear();
@@ -202,26 +202,13 @@ void smallest_at_most(const float* v, size_t n, float limit, size_t cap, std::ve
     out.resize(cap);
     bar = out[cap - 1].first;  // the largest kept (nth_element puts it at cap - 1)
   };
-  const auto offer_row = [&](size_t r) {
-    if (!(v[r] <= bar)) return;  // NaN too
+  // The rows under the bar, in ascending order, found as the exact search's
+  // second pass finds them.
+  const auto next = avx2 ? next_at_most_avx2 : next_at_most;
+  for (size_t r = next(v, 0, n, bar); r < n; r = next(v, r + 1, n, bar)) {
     out.emplace_back(v[r], static_cast<int>(r));
     if (out.size() == 2 * cap) keep_smallest();
-  };
-  size_t r = 0;
-  if (avx2) {
-    while ((r = next_at_most_avx2(v, r, n, bar)) < n) offer_row(r++);
-    if (out.size() > cap) keep_smallest();
-    return;
   }
-#ifdef __SSE2__
-  for (; r + 4 <= n; r += 4) {
-    const int mask = _mm_movemask_ps(_mm_cmple_ps(_mm_loadu_ps(v + r), _mm_set1_ps(bar)));
-    if (mask == 0) continue;
-    for (int k = 0; k < 4; ++k)
-      if (mask & (1 << k)) offer_row(r + static_cast<size_t>(k));
-  }
-#endif
-  for (; r < n; ++r) offer_row(r);
   if (out.size() > cap) keep_smallest();
 }
 
