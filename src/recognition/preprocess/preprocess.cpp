@@ -291,34 +291,6 @@ std::vector<char> veil_pixels(const OrganizedCloud& cloud, double angle_deg) {
 
 namespace {
 
-// The valid pixels within [min_z, max_z], except those flagged in `drop`
-// (empty: none).
-PointSet range_cut(const OrganizedCloud& cloud, double min_z, double max_z, const std::vector<char>& drop = {}) {
-  PointSet ps;
-  ps.source_width = cloud.width;
-  ps.source_height = cloud.height;
-  const size_t n = cloud.points.size();
-  ps.points.resize(n);
-  ps.pixel.resize(n);
-  // Every pixel written, the count advanced only for those kept (no branch).
-  size_t m = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const Vec3f& p = cloud.points[i];
-    const bool keep = std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z()) && !(p.z() < min_z) &&
-                      !(p.z() > max_z) && (drop.empty() || !drop[i]);
-    ps.points[m] = p;
-    ps.pixel[m] = static_cast<int>(i);
-    m += keep ? 1 : 0;
-  }
-  ps.points.resize(m);
-  ps.pixel.resize(m);
-  return ps;
-}
-
-}  // namespace
-
-namespace {
-
 // The dominant planes removed from `ps`, one after the other (max_planes,
 // min_plane_fraction of the points it had first), each RANSAC'd with its
 // own seed and widened by the image's depth noise (plane_noise_factor).
@@ -370,7 +342,7 @@ void remove_planes(PointSet& ps, const OrganizedCloud& cloud, const PreprocessSe
 }  // namespace
 
 PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings& s, uint64_t seed) {
-  PointSet ps = range_cut(cloud, s.min_range_mm, s.max_range_mm,
+  PointSet ps = detail::range_cut(cloud, s.min_range_mm, s.max_range_mm,
                           s.veil_angle_deg > 0 ? detail::veil_pixels(cloud, s.veil_angle_deg) : std::vector<char>{});
   // Before the grid: the range-cut points, the widening's median over
   // about plane_sample_points of the plane's (all with 0).
@@ -385,7 +357,7 @@ PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings&
 PointSet preprocess_view(const OrganizedCloud& cloud, const PreprocessSettings& s, uint64_t /*seed*/) {
   // The model is alone in its view, rendered at the distance the view
   // settings chose: no range cut, no plane.
-  PointSet ps = range_cut(cloud, 0.0, std::numeric_limits<double>::infinity());
+  PointSet ps = detail::range_cut(cloud, 0.0, std::numeric_limits<double>::infinity());
   ps = voxel_downsample(ps, {s.voxel_mm});
   radius_normals(ps, s.normal_radius_mm, s.normal_max_points, s.normal_support_leaf_mm());
   return ps;
