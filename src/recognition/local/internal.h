@@ -3,7 +3,8 @@
 // file, so the PCL compile cost is spread over several small units:
 //   keypoints.cpp  keypoints (the shared voxel grid, PCL-free)
 //   fpfh.cpp       FPFH (our own, on KdTree3; fpfh_pcl.cpp: PCL's, the reference)
-//   shot.cpp       SHOT (our own, on KdTree3; shot_pcl.cpp: PCL's, the reference)
+//   shot.cpp       SHOT (our own, on KdTree3; shot_pcl.cpp: PCL's, the reference;
+//                  shot_votes.cpp: its histogram's votes)
 //   match.cpp      descriptor search: a scan with a projected lower bound
 //                  (exact for FPFH, SHOT capped by match_max_checks)
 //   board.cpp      BOARD reference frames (our own; board_pcl.cpp: PCL's, the reference)

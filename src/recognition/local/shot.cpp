@@ -17,7 +17,8 @@
 // the same order of additions per bin); remaining differences are at
 // rounding level (three-coordinate dot products, sqrt in double, ties in
 // distance ordered by index), checked by tests/test_recognition_local_shot.cpp.
-// Each row depends on its own neighbourhood only: the same result for any
+// The histogram's votes are shot_votes.cpp's (four at a time with AVX2, the
+// same bits). Each row depends on its own neighbourhood only: the same result for any
 // thread count.
 #ifdef _OPENMP
 #include <omp.h>
@@ -30,23 +31,16 @@
 #include <limits>
 
 #include "recognition/local/internal.h"
+#include "recognition/local/shot_votes.h"
 #include "recognition/scatter.h"
 
 namespace pb::local {
 
 namespace {
 
-constexpr int kCosBins = 10;                // cosine bins per volume (one more slot: cos = 1)
-constexpr int kSlots = kCosBins + 1;        // floats per volume
-constexpr int kVolumes = kShotDim / kSlots;  // 32
-constexpr double kPi = M_PI;
-constexpr double kRad45 = kPi / 4, kRad90 = kPi / 2, kRad135 = 3 * kPi / 4, kRad7_8 = 7 * kPi / 8;
-
 using Neighbours = std::vector<std::pair<float, int>>;  // (squared distance, cloud index), by distance
 
-struct Frame {
-  Vec3f x, y, z;
-};
+using Frame = ShotFrame;
 
 // `count` offsets pointing along `axis` (dot >= 0), as a majority sign: the
 // axis is flipped when fewer than half point along it; on a tie the five
@@ -94,106 +88,22 @@ bool reference_frame(const Vec3f& q, const std::vector<Vec3f>& pts, const Neighb
   return true;
 }
 
-// The volume (0..31) of offset (x, y, z) at `distance`: azimuth sector in
-// bits 2-4, upper half in bit 0, outer shell in bit 1 (PCL's numbering).
-int volume_of(double x, double y, double z, double distance, double half_radius) {
-  const int upper_y = (y > 0) || (y == 0.0 && x < 0);
-  const int right_x = (x > 0) || (x == 0.0 && y > 0);
-  int v = ((upper_y << 3) + ((right_x ? !upper_y : upper_y) << 2)) << 1;
-  if (x * y > 0 || x == 0.0)
-    v += std::abs(x) >= std::abs(y) ? 0 : 4;
-  else
-    v += std::abs(x) > std::abs(y) ? 4 : 0;
-  v += z > 0 ? 1 : 0;
-  v += distance > half_radius ? 2 : 0;
-  return v;
-}
-
-// Adds one neighbour's vote (offset d, its normal's cosine bin position
-// `bin_pos`) to the histogram h, in PCL's order of additions.
-void add_vote(const Vec3f& d, const Frame& f, double distance, double bin_pos, double radius, float* h) {
-  const double r14 = radius / 4, r12 = radius / 2, r34 = radius * 3 / 4;
-  double x = d.dot(f.x), y = d.dot(f.y), z = d.dot(f.z);
-  if (std::abs(y) < 1e-30) y = 0;
-  if (std::abs(x) < 1e-30) x = 0;
-  if (std::abs(z) < 1e-30) z = 0;
-  const int vol = volume_of(x, y, z, distance, r12);
-  const int step = static_cast<int>(std::floor(bin_pos + 0.5));
-  const int base = vol * kSlots;
-  // Cosine: the adjacent bin (circular over the 10 bins) gets the fraction.
-  const double frac = bin_pos - step;
-  double own = 1 - std::abs(frac);
-  if (frac > 0)
-    h[base + (step + 1) % kCosBins] += static_cast<float>(frac);
-  else
-    h[base + (step - 1 + kCosBins) % kCosBins] += -static_cast<float>(frac);
-  // Radial: between the shells' middles the inner / outer shell shares.
-  if (distance > r12) {
-    const double t = (distance - r34) / r12;
-    if (distance > r34) {
-      own += 1 - t;
-    } else {
-      own += 1 + t;
-      h[(vol - 2) * kSlots + step] -= static_cast<float>(t);
-    }
-  } else {
-    const double t = (distance - r14) / r12;
-    if (distance < r14) {
-      own += 1 + t;
-    } else {
-      own += 1 - t;
-      h[(vol + 2) * kSlots + step] += static_cast<float>(t);
-    }
-  }
-  // Elevation: between the halves' middles (45 and 135 degrees).
-  const double incl = std::acos(std::clamp(z / distance, -1.0, 1.0));
-  if (incl > kRad90 || (std::abs(incl - kRad90) < 1e-30 && z <= 0)) {
-    const double t = (incl - kRad135) / kRad90;
-    if (incl > kRad135) {
-      own += 1 - t;
-    } else {
-      own += 1 + t;
-      h[(vol + 1) * kSlots + step] -= static_cast<float>(t);
-    }
-  } else {
-    const double t = (incl - kRad45) / kRad90;
-    if (incl < kRad45) {
-      own += 1 + t;
-    } else {
-      own += 1 - t;
-      h[(vol - 1) * kSlots + step] += static_cast<float>(t);
-    }
-  }
-  // Azimuth: the neighbouring sector on the side of the offset.
-  if (y != 0.0 || x != 0.0) {
-    const double az = std::atan2(y, x);
-    const int sector = vol >> 2;
-    const double t = std::clamp((az - (-kRad7_8 + kRad45 * sector)) / kRad45, -0.5, 0.5);
-    if (t > 0) {
-      own += 1 - t;
-      h[((vol + 4) % kVolumes) * kSlots + step] += static_cast<float>(t);
-    } else {
-      own += 1 + t;
-      h[((vol - 4 + kVolumes) % kVolumes) * kSlots + step] -= static_cast<float>(t);
-    }
-  }
-  h[base + step] += static_cast<float>(own);
-}
-
 // The descriptor of keypoint q in frame f into `row` (kShotDim floats);
 // false when it has none (fewer than 5 neighbours, an empty histogram).
 bool describe(const Vec3f& q, const Frame& f, const PointSet& cloud, const Neighbours& nn, double radius,
-              float* row) {
+              float* row, ShotVotes& votes) {
   if (nn.size() < 5) return false;
-  std::fill(row, row + kShotDim, 0.0f);
+  votes.clear();
   for (const auto& [d2, i] : nn) {
     const Vec3f& n = cloud.normals[static_cast<size_t>(i)];
     if (!n.allFinite()) continue;
     const double distance = std::sqrt(static_cast<double>(d2));
     if (std::abs(distance) < 1e-15) continue;
-    const double c = std::clamp(static_cast<double>(n.dot(f.z)), -1.0, 1.0);
-    add_vote(cloud.points[static_cast<size_t>(i)] - q, f, distance, ((1.0 + c) * kCosBins) / 2, radius, row);
+    votes.push(cloud.points[static_cast<size_t>(i)] - q, n.dot(f.z), distance);
   }
+  std::array<float, kShotDim + 1> h{};  // and add_shot_votes' spare slot
+  add_shot_votes(votes, f, radius, h.data());
+  std::copy(h.begin(), h.begin() + kShotDim, row);
   double norm = 0;
   for (int j = 0; j < kShotDim; ++j) norm += row[j] * row[j];
   if (!(norm > 0)) return false;
@@ -216,6 +126,7 @@ std::vector<float> compute_shot(const PointSet& cloud, const std::vector<int>& k
   {
     Neighbours nn;
     std::vector<Vec3> off;
+    ShotVotes votes;
 #pragma omp for schedule(dynamic, 16)
     for (long k = 0; k < nk; ++k) {
       const int p = keypoints[static_cast<size_t>(k)];
@@ -230,7 +141,7 @@ std::vector<float> compute_shot(const PointSet& cloud, const std::vector<int>& k
       // sample in order of distance.
       const bool framed = reference_frame(q, pts, nn, radius_mm, &f, off);
       keep_evenly(nn, max_support);
-      if (!framed || !describe(q, f, cloud, nn, radius_mm, row))
+      if (!framed || !describe(q, f, cloud, nn, radius_mm, row, votes))
         std::fill(row, row + kShotDim, std::numeric_limits<float>::quiet_NaN());
     }
   }
