@@ -30,8 +30,14 @@
 #include <cstdlib>
 #include <limits>
 
+#include "core/cpu.h"
 #include "recognition/local/internal.h"
 #include "recognition/scatter.h"
+
+#if defined(__x86_64__) || defined(__i386__)
+#include "core/lanes_avx2.h"
+#define PB_BOARD_X86 1
+#endif
 
 namespace pb::local {
 
@@ -55,6 +61,75 @@ Vec3f tangent_direction(const Vec3f& axis, const Vec3f& origin, const Vec3f& p) 
 float angle_about(const Vec3f& a, const Vec3f& b, const Vec3f& axis) {
   const float angle = std::acos(std::clamp(a.dot(b), -1.0f, 1.0f));
   return a.cross(b).dot(axis) < 0.f ? kTwoPi - angle : angle;
+}
+
+// The margin's values for the points idx[0..n): c[k], the cosine of point
+// k's normal to z, and angle[k], its direction's angle about z from x0
+// (angle_about of tangent_direction from q). One point at a time.
+void margin_values_scalar(const PointSet& cloud, const int* idx, size_t n, const Vec3f& q, const Vec3f& z,
+                          const Vec3f& x0, float* c, float* angle) {
+  for (size_t k = 0; k < n; ++k) {
+    const size_t i = static_cast<size_t>(idx[k]);
+    c[k] = z.dot(cloud.normals[i]);
+    angle[k] = angle_about(x0, tangent_direction(z, q, cloud.points[i]), z);
+  }
+}
+
+#ifdef PB_BOARD_X86
+// Eigen's float dot product of 3-vectors, a0 b0 + (a1 b1 + a2 b2), per lane.
+__attribute__((target("avx2"))) inline __m256 dot8(const Lanes3& a, const Lanes3& b) {
+  return _mm256_add_ps(_mm256_mul_ps(a.x, b.x), _mm256_add_ps(_mm256_mul_ps(a.y, b.y), _mm256_mul_ps(a.z, b.z)));
+}
+
+// The same values eight points at a time: each lane the one-point code's
+// float operations in its order (Eigen's dot products and normalized(), a
+// division by the root of the squared norm), acosf per lane.
+__attribute__((target("avx2"))) void margin_values_avx2(const PointSet& cloud, const int* idx, size_t n,
+                                                        const Vec3f& q, const Vec3f& z, const Vec3f& x0, float* c,
+                                                        float* angle) {
+  const Lanes3 zl = broadcast3(z), ql = broadcast3(q), xl = broadcast3(x0);
+  const float* pts = cloud.points.front().data();
+  const float* nrm = cloud.normals.front().data();
+  const __m256 zero = _mm256_setzero_ps(), lo = _mm256_set1_ps(-1.0f), hi = _mm256_set1_ps(1.0f);
+  int lane[8];
+  alignas(32) float cs[8], dots[8], acos8[8], negative[8];
+  for (size_t k = 0; k < n; k += 8) {
+    const size_t count = block_of_eight(idx, k, n, lane);
+    const __m256i at = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(lane));
+    const Lanes3 p = gather3(pts, at);
+    _mm256_store_ps(cs, dot8(zl, gather3(nrm, at)));
+    // tangent_direction: p - (z . (p - q)) z, minus q, normalized.
+    const __m256 s = dot8(zl, minus(p, ql));
+    const Lanes3 proj{_mm256_sub_ps(p.x, _mm256_mul_ps(s, zl.x)), _mm256_sub_ps(p.y, _mm256_mul_ps(s, zl.y)),
+                      _mm256_sub_ps(p.z, _mm256_mul_ps(s, zl.z))};
+    const Lanes3 u = minus(proj, ql);
+    const __m256 sq = dot8(u, u);
+    const __m256 root = _mm256_sqrt_ps(sq), positive = _mm256_cmp_ps(sq, zero, _CMP_GT_OQ);
+    const Lanes3 t = select(positive,
+                            Lanes3{_mm256_div_ps(u.x, root), _mm256_div_ps(u.y, root), _mm256_div_ps(u.z, root)}, u);
+    // angle_about: acos of the clamped dot, turned where (x0 x t) . z < 0.
+    const __m256 d = dot8(xl, t);
+    const __m256 clamped =
+        _mm256_blendv_ps(_mm256_blendv_ps(d, hi, _mm256_cmp_ps(hi, d, _CMP_LT_OQ)), lo, _mm256_cmp_ps(d, lo, _CMP_LT_OQ));
+    _mm256_store_ps(dots, clamped);
+    _mm256_store_ps(negative, _mm256_cmp_ps(dot8(cross(xl, t), zl), zero, _CMP_LT_OQ));
+    for (size_t j = 0; j < count; ++j) acos8[j] = std::acos(dots[j]);
+    for (size_t j = 0; j < count; ++j) {
+      c[k + j] = cs[j];
+      angle[k + j] = negative[j] != 0.f ? kTwoPi - acos8[j] : acos8[j];
+    }
+  }
+}
+#endif
+
+// The margin's values (margin_values_scalar), eight at a time where the CPU
+// has AVX2 (the same bits; test LocalBoard.FramesBitForBitAsFingerprinted).
+void margin_values(const PointSet& cloud, const int* idx, size_t n, const Vec3f& q, const Vec3f& z,
+                   const Vec3f& x0, float* c, float* angle) {
+#ifdef PB_BOARD_X86
+  if (cpu_has_avx2()) return margin_values_avx2(cloud, idx, n, q, z, x0, c, angle);
+#endif
+  margin_values_scalar(cloud, idx, n, q, z, x0, c, angle);
 }
 
 // A unit axis orthogonal to z: deterministic, or std::rand()'s as PCL draws
@@ -133,7 +208,9 @@ bool widest_hole(const Sectors& s, float min_cos, float* angle) {
 }
 
 // The frame of keypoint q (rows x, y, z into row[9]); false when it has none.
-bool board_frame(const Vec3f& q, const PointSet& cloud, const Neighbours& nn, BoardStartAxis how, float* row) {
+// margin, cosines, angles: scratch.
+bool board_frame(const Vec3f& q, const PointSet& cloud, const Neighbours& nn, BoardStartAxis how, float* row,
+                 std::vector<int>& margin, std::vector<float>& cosines, std::vector<float>& angles) {
   if (nn.size() < 6) return false;
   // z: the plane through the neighbours, oriented by their normals.
   Vec3f centroid = Vec3f::Zero();
@@ -152,14 +229,18 @@ bool board_frame(const Vec3f& q, const PointSet& cloud, const Neighbours& nn, Bo
   float min_cos = std::numeric_limits<float>::max();
   int steepest = -1;
   Sectors sectors;
-  for (const auto& [d2, i] : nn) {
-    if (d2 <= 0.0f) continue;  // the keypoint itself (margin distance 0: every other point)
-    const float c = z.dot(cloud.normals[static_cast<size_t>(i)]);
-    if (c < min_cos) {
-      min_cos = c;
-      steepest = i;
+  margin.clear();
+  for (const auto& [d2, i] : nn)
+    if (d2 > 0.0f) margin.push_back(i);  // not the keypoint itself (margin distance 0: every other point)
+  cosines.resize(margin.size());
+  angles.resize(margin.size());
+  margin_values(cloud, margin.data(), margin.size(), q, z, x0, cosines.data(), angles.data());
+  for (size_t k = 0; k < margin.size(); ++k) {
+    if (cosines[k] < min_cos) {
+      min_cos = cosines[k];
+      steepest = margin[k];
     }
-    sectors.add(angle_about(x0, tangent_direction(z, q, cloud.points[static_cast<size_t>(i)]), z), c);
+    sectors.add(angles[k], cosines[k]);
   }
   Vec3f x;
   float hole = 0;
@@ -203,6 +284,8 @@ std::vector<float> compute_board_lrf(const PointSet& cloud, const std::vector<in
   const CloudNeighbours tree(cloud.points);
   const float r2 = static_cast<float>(radius_mm * radius_mm);
   Neighbours nn;
+  std::vector<int> margin;
+  std::vector<float> cosines, angles;
   float row[kLrfDim];
   for (size_t k = 0; k < keypoints.size(); ++k) {
     const int p = keypoints[k];
@@ -210,7 +293,7 @@ std::vector<float> compute_board_lrf(const PointSet& cloud, const std::vector<in
       continue;
     const Vec3f& q = cloud.points[static_cast<size_t>(p)];
     tree.within(q, r2, nn, false);  // tree order: nothing below needs distance order
-    if (board_frame(q, cloud, nn, start, row) && usable_frame(row))
+    if (board_frame(q, cloud, nn, start, row, margin, cosines, angles) && usable_frame(row))
       std::copy(row, row + kLrfDim, out.begin() + static_cast<long>(k) * kLrfDim);
   }
   return out;
