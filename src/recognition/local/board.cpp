@@ -109,8 +109,8 @@ __attribute__((target("avx2"))) void margin_values_avx2(const PointSet& cloud, c
                             Lanes3{_mm256_div_ps(u.x, root), _mm256_div_ps(u.y, root), _mm256_div_ps(u.z, root)}, u);
     // angle_about: acos of the clamped dot, turned where (x0 x t) . z < 0.
     const __m256 d = dot8(xl, t);
-    const __m256 clamped =
-        _mm256_blendv_ps(_mm256_blendv_ps(d, hi, _mm256_cmp_ps(hi, d, _CMP_LT_OQ)), lo, _mm256_cmp_ps(d, lo, _CMP_LT_OQ));
+    const __m256 below_hi = _mm256_blendv_ps(d, hi, _mm256_cmp_ps(hi, d, _CMP_LT_OQ));
+    const __m256 clamped = _mm256_blendv_ps(below_hi, lo, _mm256_cmp_ps(d, lo, _CMP_LT_OQ));
     _mm256_store_ps(dots, clamped);
     _mm256_store_ps(negative, _mm256_cmp_ps(dot8(cross(xl, t), zl), zero, _CMP_LT_OQ));
     for (size_t j = 0; j < count; ++j) acos8[j] = std::acos(dots[j]);
