@@ -1,9 +1,11 @@
 // The range cut (recognition/preprocess/internal.h): the vector path keeps
 // the pixels the one-pixel loop keeps, and both keep what the definition
-// says, on bounds that are not floats, non-finite coordinates, dropped
-// pixels and clouds whose size is no multiple of eight.
+// says and give the kept points' box, on bounds that are not floats,
+// non-finite coordinates, dropped pixels and clouds whose size is no
+// multiple of eight.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -57,8 +59,19 @@ TEST(RangeCut, VectorAndScalarKeepTheSamePixels) {
       const std::vector<char> d = with_drop ? drop : std::vector<char>{};
       const std::vector<int> want = kept(c, lo, hi, d);
       for (const auto isa : {pb::detail::RangeCutIsa::best, pb::detail::RangeCutIsa::scalar}) {
-        const PointSet ps = pb::detail::range_cut(c, lo, hi, d, isa);
+        float box[6];
+        const PointSet ps = pb::detail::range_cut(c, lo, hi, d, isa, box);
         ASSERT_EQ(ps.pixel, want) << "n " << n << " drop " << with_drop;
+        // The box of the kept points (lo > hi when there is none).
+        for (int a = 0; a < 3; ++a) {
+          float l = std::numeric_limits<float>::infinity(), h = -l;
+          for (const int px : want) {
+            l = std::min(l, c.points[static_cast<size_t>(px)][a]);
+            h = std::max(h, c.points[static_cast<size_t>(px)][a]);
+          }
+          EXPECT_EQ(box[a], l) << "n " << n << " axis " << a;
+          EXPECT_EQ(box[3 + a], h) << "n " << n << " axis " << a;
+        }
         ASSERT_EQ(ps.points.size(), want.size());
         for (size_t k = 0; k < want.size(); ++k)
           ASSERT_EQ(ps.points[k], c.points[static_cast<size_t>(want[k])]) << "n " << n << " point " << k;

@@ -76,10 +76,12 @@ std::vector<char> veil_pixels(const OrganizedCloud& cloud, double angle_deg);
 // (mm), except those flagged in `drop` (empty: none; else one flag per
 // pixel), in pixel order with their pixel indices. `best` takes eight
 // pixels at a time with AVX2 where the CPU has it; `scalar` one at a time:
-// the same points (test RangeCut.VectorAndScalarKeepTheSamePixels).
+// the same points (test RangeCut.VectorAndScalarKeepTheSamePixels). box
+// (when not null, 6 floats): the kept points' box, lo x y z then hi x y z
+// (lo > hi when none is kept), for the voxel grid (VoxelGridOptions::box).
 enum class RangeCutIsa { best, scalar };
 PointSet range_cut(const OrganizedCloud& cloud, double min_z, double max_z, const std::vector<char>& drop = {},
-                   RangeCutIsa isa = RangeCutIsa::best);
+                   RangeCutIsa isa = RangeCutIsa::best, float* box = nullptr);
 
 // Keeps the points whose flag is set (all per-point arrays).
 PointSet select(const PointSet& in, const std::vector<char>& keep);

@@ -342,13 +342,21 @@ void remove_planes(PointSet& ps, const OrganizedCloud& cloud, const PreprocessSe
 }  // namespace
 
 PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings& s, uint64_t seed) {
+  float box[6];  // the range cut's points' box, which the grid needs first
   PointSet ps = detail::range_cut(cloud, s.min_range_mm, s.max_range_mm,
-                          s.veil_angle_deg > 0 ? detail::veil_pixels(cloud, s.veil_angle_deg) : std::vector<char>{});
+                                  s.veil_angle_deg > 0 ? detail::veil_pixels(cloud, s.veil_angle_deg)
+                                                       : std::vector<char>{},
+                                  detail::RangeCutIsa::best, box);
+  VoxelGridOptions grid{s.voxel_mm};
+  grid.box = box;
   // Before the grid: the range-cut points, the widening's median over
-  // about plane_sample_points of the plane's (all with 0).
-  if (s.remove_plane && s.planes_before_grid)
+  // about plane_sample_points of the plane's (all with 0). The box is then
+  // the grid's to find.
+  if (s.remove_plane && s.planes_before_grid) {
     remove_planes(ps, cloud, s, seed, static_cast<size_t>(s.plane_sample_points));
-  ps = voxel_downsample(ps, {s.voxel_mm});
+    grid.box = nullptr;
+  }
+  ps = voxel_downsample(ps, grid);
   if (s.remove_plane && !s.planes_before_grid) remove_planes(ps, cloud, s, seed);
   radius_normals(ps, s.normal_radius_mm, s.normal_max_points, s.normal_support_leaf_mm());
   return ps;
@@ -357,8 +365,12 @@ PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings&
 PointSet preprocess_view(const OrganizedCloud& cloud, const PreprocessSettings& s, uint64_t /*seed*/) {
   // The model is alone in its view, rendered at the distance the view
   // settings chose: no range cut, no plane.
-  PointSet ps = detail::range_cut(cloud, 0.0, std::numeric_limits<double>::infinity());
-  ps = voxel_downsample(ps, {s.voxel_mm});
+  float box[6];
+  PointSet ps =
+      detail::range_cut(cloud, 0.0, std::numeric_limits<double>::infinity(), {}, detail::RangeCutIsa::best, box);
+  VoxelGridOptions grid{s.voxel_mm};
+  grid.box = box;
+  ps = voxel_downsample(ps, grid);
   radius_normals(ps, s.normal_radius_mm, s.normal_max_points, s.normal_support_leaf_mm());
   return ps;
 }

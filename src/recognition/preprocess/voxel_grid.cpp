@@ -227,7 +227,12 @@ Cells group(const std::vector<Vec3f>& pts, const VoxelGridOptions& opt) {
   auto cell = [&](float v) { return detail::floor_to_int(divide ? v / opt.leaf_mm : v * inv); };
   const int ax[3] = {zyx ? 2 : 0, 1, zyx ? 0 : 2};  // priority order of the axes
   float mn[3], mx[3];  // the box of the finite points
-  if (!detail::finite_box(pts.data(), n, mn, mx)) return Cells{std::vector<int>(n, -1), {}, {}, {}};
+  if (opt.box) {
+    std::copy(opt.box, opt.box + 3, mn);
+    std::copy(opt.box + 3, opt.box + 6, mx);
+  }
+  if (opt.box ? !(mn[0] <= mx[0]) : !detail::finite_box(pts.data(), n, mn, mx))
+    return Cells{std::vector<int>(n, -1), {}, {}, {}};
   detail::PackedGrid g;
   g.leaf = opt.leaf_mm;
   g.divide = divide;

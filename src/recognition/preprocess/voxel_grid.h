@@ -34,6 +34,10 @@ struct VoxelGridOptions {
   // centroid and mean normal), the cell's clusters in creation order. Keeps
   // both sides of an edge that a plain grid would average away. 0 = off.
   double normal_cluster_deg = 0;
+  // The box of the input's finite points (lo x y z, hi x y z; lo > hi if
+  // there is none) when the caller has it (the range cut's), else nullptr:
+  // the grid computes it. The cells are sized from it.
+  const float* box = nullptr;
 };
 
 // Centroid per occupied cell. leaf <= 0 or an empty cloud: the input as is.
