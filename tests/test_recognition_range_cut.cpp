@@ -95,6 +95,10 @@ TEST(RangeCut, InfiniteAndHugeBoundsKeepEveryFinitePixel) {
   const PointSet ps = pb::detail::range_cut(c, 0.0, 1e38);
   ASSERT_EQ(ps.size(), 15u);
   for (const int px : ps.pixel) EXPECT_NE(px, 3);
+  // Bounds beyond the floats: a minimum above every float keeps nothing, a
+  // maximum below every float keeps nothing.
+  EXPECT_EQ(pb::detail::range_cut(c, 1e300, std::numeric_limits<double>::infinity()).size(), 0u);
+  EXPECT_EQ(pb::detail::range_cut(c, -std::numeric_limits<double>::infinity(), -1e300).size(), 0u);
 }
 
 }  // namespace

@@ -57,14 +57,20 @@ size_t cut_scalar(const OrganizedCloud& cloud, double min_z, double max_z, const
 // The float bounds that decide z < min_z and z > max_z for every float z as
 // the doubles do: z < min_z exactly when z < the smallest float >= min_z,
 // and z > max_z exactly when z > the largest float <= max_z.
+// A finite double beyond the floats' range is not converted (undefined):
+// it gives the float range's end or an infinity, which compare the same.
+constexpr double kFloatMax = std::numeric_limits<float>::max();
+constexpr float kInf = std::numeric_limits<float>::infinity();
 float float_at_least(double v) {
+  if (std::isfinite(v) && std::abs(v) > kFloatMax) return v > 0 ? kInf : -std::numeric_limits<float>::max();
   float f = static_cast<float>(v);  // nearest
-  if (static_cast<double>(f) < v) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+  if (static_cast<double>(f) < v) f = std::nextafter(f, kInf);
   return f;
 }
 float float_at_most(double v) {
+  if (std::isfinite(v) && std::abs(v) > kFloatMax) return v > 0 ? std::numeric_limits<float>::max() : -kInf;
   float f = static_cast<float>(v);
-  if (static_cast<double>(f) > v) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+  if (static_cast<double>(f) > v) f = std::nextafter(f, -kInf);
   return f;
 }
 
