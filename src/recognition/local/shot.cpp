@@ -18,8 +18,8 @@
 // rounding level (three-coordinate dot products, sqrt in double, ties in
 // distance ordered by index), checked by tests/test_recognition_local_shot.cpp.
 // The histogram's votes are shot_votes.cpp's (four at a time with AVX2, the
-// same bits). Each row depends on its own neighbourhood only: the same result for any
-// thread count.
+// same bits). Each row depends on its own neighbourhood only: the same
+// result for any thread count.
 #ifdef _OPENMP
 #include <omp.h>
 #endif
