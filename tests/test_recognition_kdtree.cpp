@@ -203,7 +203,8 @@ TEST(KdTree3, RadiusRemainingIsRadiusUnsortedWithoutTheRemovedPoints) {
 
 // within: strictly below the bound (a point exactly at it is left out, as
 // FLANN's radius search), sorted by (distance, index) with duplicates
-// (equal distances) in index order; unsorted: the same set.
+// (equal distances) in index order; unsorted: the same set; scanned
+// (within_scanned): the same list.
 TEST(KdTree3, WithinIsStrictAndSortedByDistanceThenIndex) {
   std::vector<Vec3f> pts = random_cloud(3000, 11, 100.f);
   for (int i = 0; i < 40; ++i) pts.push_back(pts[static_cast<size_t>(i) * 7]);  // exact duplicates
@@ -223,6 +224,8 @@ TEST(KdTree3, WithinIsStrictAndSortedByDistanceThenIndex) {
       std::vector<std::pair<float, int>> got;
       tree.within(q, max2, got);
       EXPECT_EQ(got, want);
+      tree.within_scanned(q, max2, got);
+      EXPECT_EQ(got, want) << "scanned";
       tree.within(q, max2, got, false);
       std::sort(got.begin(), got.end());
       EXPECT_EQ(got, want);
@@ -231,6 +234,8 @@ TEST(KdTree3, WithinIsStrictAndSortedByDistanceThenIndex) {
   std::vector<std::pair<float, int>> at_bound;
   tree.within(Vec3f(0, 0, 0), 25.f, at_bound);
   for (const auto& e : at_bound) EXPECT_NE(e.second, static_cast<int>(pts.size()) - 1) << "25 is not below 25";
+  tree.within_scanned(Vec3f(0, 0, 0), 25.f, at_bound);
+  for (const auto& e : at_bound) EXPECT_NE(e.second, static_cast<int>(pts.size()) - 1) << "scanned: 25 is not below 25";
 }
 
 // Long neighbourhoods (thousands of points: the bucket-sorted path, buckets
@@ -253,6 +258,8 @@ TEST(KdTree3, LongNeighbourhoodsAreSortedByDistanceThenIndex) {
       std::vector<std::pair<float, int>> got;
       tree.within(q, max2, got);
       EXPECT_EQ(got, want);
+      tree.within_scanned(q, max2, got);
+      EXPECT_EQ(got, want) << "scanned";
     }
   }
 }

@@ -39,6 +39,11 @@ inline size_t block_of_eight(const int* idx, size_t k, size_t n, int lane[8]) {
   return count;
 }
 
+// Eigen's dot product of 3-vectors (Vector3f), x x' + (y y' + z z').
+__attribute__((target("avx2"))) inline __m256 dot(const Lanes3& a, const Lanes3& b) {
+  return _mm256_add_ps(_mm256_mul_ps(a.x, b.x), _mm256_add_ps(_mm256_mul_ps(a.y, b.y), _mm256_mul_ps(a.z, b.z)));
+}
+
 // Eigen's cross product of 3-vectors, coefficient by coefficient.
 __attribute__((target("avx2"))) inline Lanes3 cross(const Lanes3& a, const Lanes3& b) {
   return {_mm256_sub_ps(_mm256_mul_ps(a.y, b.z), _mm256_mul_ps(a.z, b.y)),

@@ -242,6 +242,24 @@ void KdTree3::within(const Vec3f& q, float max_sq_dist, std::vector<std::pair<fl
     if (d < max_sq_dist) keys.push_back(entry_key(d, i));
   };
   visit_radius(0, q, max_sq_dist, add);
+  sorted_entries(keys, out);
+}
+
+void KdTree3::within_scanned(const Vec3f& q, float max_sq_dist, std::vector<std::pair<float, int>>& out) const {
+  out.clear();
+  if (nodes_.empty() || !q.allFinite() || !(max_sq_dist > 0)) return;
+  thread_local std::vector<uint64_t> keys;
+  keys.clear();
+  // The root's range is every point: scanned as a leaf, in tree order (the
+  // sort makes the order the tree's search's).
+  scan_leaf(nodes_[0], q, max_sq_dist, [&](float d, int pos) {
+    if (d < max_sq_dist) keys.push_back(entry_key(d, order_[static_cast<size_t>(pos)]));
+    return false;
+  });
+  sorted_entries(keys, out);
+}
+
+void KdTree3::sorted_entries(std::vector<uint64_t>& keys, std::vector<std::pair<float, int>>& out) {
   sort_keys(keys);
   out.reserve(keys.size());
   for (uint64_t k : keys) out.push_back(entry_of(k));

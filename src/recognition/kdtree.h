@@ -42,6 +42,10 @@ class KdTree3 {
   // FLANN's radius search), as (squared distance, index), sorted unless
   // `sorted` is false (then in tree order).
   void within(const Vec3f& q, float max_sq_dist, std::vector<std::pair<float, int>>& out, bool sorted = true) const;
+  // The sorted list of within(q, max_sq_dist, out), found by scanning every
+  // point (the leaves' distances, the same sort) instead of the tree: the
+  // same list, cheaper where a query lists a large part of a small cloud.
+  void within_scanned(const Vec3f& q, float max_sq_dist, std::vector<std::pair<float, int>>& out) const;
   // The same set in tree order (no sort: for sums over the neighbourhood).
   void radius_unsorted(const Vec3f& q, float r, std::vector<int>& out) const;
   // The points a search still reports (region growing: those no region has
@@ -151,6 +155,8 @@ class KdTree3 {
   // scan; then so does scan_leaf (kdtree_leaf.h).
   template <class F>
   bool scan_leaf(const Node& n, const Vec3f& q, const float& bound, F&& f) const;
+  // within()'s keys (entry_key) sorted into out, as (distance, index).
+  static void sorted_entries(std::vector<uint64_t>& keys, std::vector<std::pair<float, int>>& out);
   // Calls f(squared distance, input index) for every point within sqrt(r2)
   // of the subtrees for which skip(node) is false (kdtree_leaf.h).
   struct NoSkip {

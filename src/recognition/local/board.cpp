@@ -76,11 +76,6 @@ void margin_values_scalar(const PointSet& cloud, const int* idx, size_t n, const
 }
 
 #ifdef PB_BOARD_X86
-// Eigen's float dot product of 3-vectors, a0 b0 + (a1 b1 + a2 b2), per lane.
-__attribute__((target("avx2"))) inline __m256 dot8(const Lanes3& a, const Lanes3& b) {
-  return _mm256_add_ps(_mm256_mul_ps(a.x, b.x), _mm256_add_ps(_mm256_mul_ps(a.y, b.y), _mm256_mul_ps(a.z, b.z)));
-}
-
 // The same values eight points at a time: each lane the one-point code's
 // float operations in its order (Eigen's dot products and normalized(), a
 // division by the root of the squared norm), acosf per lane.
@@ -97,22 +92,22 @@ __attribute__((target("avx2"))) void margin_values_avx2(const PointSet& cloud, c
     const size_t count = block_of_eight(idx, k, n, lane);
     const __m256i at = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(lane));
     const Lanes3 p = gather3(pts, at);
-    _mm256_store_ps(cs, dot8(zl, gather3(nrm, at)));
+    _mm256_store_ps(cs, dot(zl, gather3(nrm, at)));
     // tangent_direction: p - (z . (p - q)) z, minus q, normalized.
-    const __m256 s = dot8(zl, minus(p, ql));
+    const __m256 s = dot(zl, minus(p, ql));
     const Lanes3 proj{_mm256_sub_ps(p.x, _mm256_mul_ps(s, zl.x)), _mm256_sub_ps(p.y, _mm256_mul_ps(s, zl.y)),
                       _mm256_sub_ps(p.z, _mm256_mul_ps(s, zl.z))};
     const Lanes3 u = minus(proj, ql);
-    const __m256 sq = dot8(u, u);
+    const __m256 sq = dot(u, u);
     const __m256 root = _mm256_sqrt_ps(sq), positive = _mm256_cmp_ps(sq, zero, _CMP_GT_OQ);
     const Lanes3 t = select(positive,
                             Lanes3{_mm256_div_ps(u.x, root), _mm256_div_ps(u.y, root), _mm256_div_ps(u.z, root)}, u);
     // angle_about: acos of the clamped dot, turned where (x0 x t) . z < 0.
-    const __m256 d = dot8(xl, t);
+    const __m256 d = dot(xl, t);
     const __m256 below_hi = _mm256_blendv_ps(d, hi, _mm256_cmp_ps(hi, d, _CMP_LT_OQ));
     const __m256 clamped = _mm256_blendv_ps(below_hi, lo, _mm256_cmp_ps(d, lo, _CMP_LT_OQ));
     _mm256_store_ps(dots, clamped);
-    _mm256_store_ps(negative, _mm256_cmp_ps(dot8(cross(xl, t), zl), zero, _CMP_LT_OQ));
+    _mm256_store_ps(negative, _mm256_cmp_ps(dot(cross(xl, t), zl), zero, _CMP_LT_OQ));
     for (size_t j = 0; j < count; ++j) acos8[j] = std::acos(dots[j]);
     for (size_t j = 0; j < count; ++j) {
       c[k + j] = cs[j];

@@ -25,11 +25,6 @@ namespace {
 
 static_assert(sizeof(Vec3f) == 3 * sizeof(float), "the AVX2 path gathers from Vec3f arrays of stride 3 floats");
 
-// Eigen's dot product of 3-vectors: x x' + (y y' + z z').
-__attribute__((target("avx2"))) inline __m256 dot(const Lanes3& a, const Lanes3& b) {
-  return _mm256_add_ps(_mm256_mul_ps(a.x, b.x), _mm256_add_ps(_mm256_mul_ps(a.y, b.y), _mm256_mul_ps(a.z, b.z)));
-}
-
 // clamped_bin(scaled, bins) (recognition/darboux.h) of four doubles: 0
 // unless scaled >= 0, else floor(scaled) at most bins - 1.
 __attribute__((target("avx2"))) inline __m128i clamped_bins(__m256d scaled, int bins) {

@@ -109,12 +109,8 @@ class CloudNeighbours {
                 int max_points = 0) const;
 
  private:
-  // The sorted list of a small cloud from a scan of every point (the same
-  // distances as the tree's leaves, the same sort: the same list).
-  void scan_within(const Vec3f& q, float r2, std::vector<std::pair<float, int>>& out) const;
   std::vector<int> cloud_index_;  // tree input index -> cloud index
   KdTree3 tree_;
-  std::vector<float> xs_, ys_, zs_;  // the tree's points by coordinate, for scan_within (small clouds only)
 };
 
 // Nearest neighbour search over descriptors (squared L2 distances): exact
