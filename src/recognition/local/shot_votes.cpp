@@ -5,10 +5,13 @@
 #include <cmath>
 
 #include "core/cpu.h"
+#include "core/trig.h"
 #include "recognition/local/internal.h"
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
+
+#include "core/trig_avx2.h"
 #define PB_SHOT_VOTES_X86 1
 #endif
 
@@ -113,7 +116,7 @@ void vote_scalar(const ShotVotes& v, size_t i, const ShotFrame& f, double radius
   const double tr = (distance - (outer ? r34 : r14)) / r12;
   const Split rs = split(outer, tr, outer ? distance > r34 : distance < r14);
   own += rs.own;
-  const double incl = std::acos(std::clamp(z / distance, -1.0, 1.0));
+  const double incl = series_acos(std::clamp(z / distance, -1.0, 1.0));
   const bool lower = incl > kRad90 || (std::abs(incl - kRad90) < 1e-30 && z <= 0);
   const double te = (incl - (lower ? kRad135 : kRad45)) / kRad90;
   const Split es = split(lower, te, lower ? incl > kRad135 : incl < kRad45);
@@ -121,7 +124,7 @@ void vote_scalar(const ShotVotes& v, size_t i, const ShotFrame& f, double radius
   const bool has_az = y != 0.0 || x != 0.0;
   double t_az = 0;
   if (has_az) {
-    const double az = std::atan2(y, x);
+    const double az = series_atan2_double(y, x);
     t_az = std::clamp((az - (-kRad7_8 + kRad45 * (vol >> 2))) / kRad45, -0.5, 0.5);
     own += t_az > 0 ? 1 - t_az : 1 + t_az;
   }
@@ -180,8 +183,8 @@ __attribute__((target("avx2"))) inline __m128 negate_where(__m128 v, int m) {
   return _mm_xor_ps(v, _mm_and_ps(_mm_set1_ps(-0.0f), fbits(m)));
 }
 
-// Votes i .. i + 3: the arithmetic in lanes, acos and atan2 per lane, the
-// additions vote by vote.
+// Votes i .. i + 3: the arithmetic in lanes (series_acos and
+// series_atan2_double too, core/trig_avx2.h), the additions vote by vote.
 __attribute__((target("avx2"))) void votes4(const ShotVotes& v, size_t i, const ShotFrame& f, double radius,
                                             float* h) {
   const double r14 = radius / 4, r12 = radius / 2, r34 = radius * 3 / 4;
@@ -213,11 +216,8 @@ __attribute__((target("avx2"))) void votes4(const ShotVotes& v, size_t i, const 
       _mm256_set1_pd(r12));
   const int past_r = (mask(_mm256_cmp_pd(distance, _mm256_set1_pd(r34), _CMP_GT_OQ)) & outer) |
                      (mask(_mm256_cmp_pd(distance, _mm256_set1_pd(r14), _CMP_LT_OQ)) & ~outer);
-  // Elevation: acos per lane.
-  alignas(32) double zr[4], incl[4];
-  _mm256_store_pd(zr, clamp4(_mm256_div_pd(z, distance), -1.0, 1.0));
-  for (int l = 0; l < 4; ++l) incl[l] = std::acos(zr[l]);
-  const __m256d in = _mm256_load_pd(incl);
+  // Elevation.
+  const __m256d in = series_acos4(clamp4(_mm256_div_pd(z, distance), -1.0, 1.0));
   const __m256d near90 = _mm256_cmp_pd(_mm256_andnot_pd(sign, _mm256_sub_pd(in, _mm256_set1_pd(kRad90))),
                                        _mm256_set1_pd(1e-30), _CMP_LT_OQ);
   const __m256d lower_m = _mm256_or_pd(_mm256_cmp_pd(in, _mm256_set1_pd(kRad90), _CMP_GT_OQ),
@@ -228,21 +228,18 @@ __attribute__((target("avx2"))) void votes4(const ShotVotes& v, size_t i, const 
       _mm256_set1_pd(kRad90));
   const int past_e = (mask(_mm256_cmp_pd(in, _mm256_set1_pd(kRad135), _CMP_GT_OQ)) & lower) |
                      (mask(_mm256_cmp_pd(in, _mm256_set1_pd(kRad45), _CMP_LT_OQ)) & ~lower);
-  // The volumes, then the azimuth's t: atan2 per lane where x or y is not 0.
+  // The volumes, then the azimuth's t where x or y is not 0.
   alignas(16) int vol[4];
   for (int l = 0; l < 4; ++l)
     vol[l] = volume_of({lane(y_pos, l), lane(y_zero, l), lane(x_pos, l), lane(x_zero, l), lane(x_neg, l),
                         lane(xy_pos, l), lane(ax_ge, l), lane(ax_gt, l), lane(z_pos, l), lane(outer, l)});
   const __m256d has_az_m = _mm256_or_pd(_mm256_cmp_pd(y, zero, _CMP_NEQ_UQ), _mm256_cmp_pd(x, zero, _CMP_NEQ_UQ));
   const int has_az = mask(has_az_m);
-  alignas(32) double xs[4], ys[4], az[4];
-  _mm256_store_pd(xs, x);
-  _mm256_store_pd(ys, y);
-  for (int l = 0; l < 4; ++l) az[l] = lane(has_az, l) ? std::atan2(ys[l], xs[l]) : 0.0;
+  const __m256d az = _mm256_and_pd(series_atan2_double4(y, x), has_az_m);
   const __m256d sector = _mm256_cvtepi32_pd(_mm_srai_epi32(_mm_load_si128(reinterpret_cast<__m128i*>(vol)), 2));
   const __m256d centre = _mm256_add_pd(_mm256_set1_pd(-kRad7_8), _mm256_mul_pd(_mm256_set1_pd(kRad45), sector));
   const __m256d ta =
-      clamp4(_mm256_div_pd(_mm256_sub_pd(_mm256_load_pd(az), centre), _mm256_set1_pd(kRad45)), -0.5, 0.5);
+      clamp4(_mm256_div_pd(_mm256_sub_pd(az, centre), _mm256_set1_pd(kRad45)), -0.5, 0.5);
   // The own bin's total, in PCL's order: 1 - |frac|, the radial share, the
   // elevation's, the azimuth's. A split's own share is 1 - t on the outer
   // side past the far middle and on the inner side before the near one

@@ -3,9 +3,10 @@
 // PCL's SHOTEstimation does it. One vote at a time, or four at a time with
 // AVX2 where the CPU has it: the lanes do the same double and float
 // operations in the same order (the file is built without fused
-// multiply-adds) and call libm's acos and atan2 per lane, then add to the
-// histogram vote by vote, so both give the same bits. Internal to the local
-// pipeline; PCL-free.
+// multiply-adds), then add to the histogram vote by vote, so both give the
+// same bits. The angles come from core/trig.h's series (within 4 ulp of
+// the true angle; libm's acos and atan2 until session 43), the same bits on
+// every machine. Internal to the local pipeline; PCL-free.
 #pragma once
 
 #include <cstddef>
