@@ -45,8 +45,9 @@ inline double series_acos(double x) {
   return x < 0 ? M_PI - 2 * half : 2 * half;
 }
 
-// atan2(y, x) for x and y not both zero: the octant's angle atan_unit of
-// min / max, then reflected as the signs and the larger coordinate say.
+// atan2(y, x) for finite x and y, not both zero (y = -0 counts as +0): the
+// octant's angle atan_unit of min / max, then reflected as the signs and the
+// larger coordinate say.
 inline double series_atan2_double(double y, double x) {
   const double ay = std::fabs(y), ax = std::fabs(x);
   const bool steep = ay > ax;
