@@ -15,8 +15,9 @@
 //     shell, elevation and azimuth sector; scaled to unit L2 norm.
 // PCL's arithmetic is followed step by step (double where PCL uses double,
 // the same order of additions per bin); remaining differences are at
-// rounding level (three-coordinate dot products, sqrt in double, ties in
-// distance ordered by index), checked by tests/test_recognition_local_shot.cpp.
+// rounding level (three-coordinate dot products, sqrt in double, acos and
+// atan2 from core/trig.h's series, ties in distance ordered by index),
+// checked by tests/test_recognition_local_shot.cpp.
 // The histogram's votes are shot_votes.cpp's (four at a time with AVX2, the
 // same bits). Each row depends on its own neighbourhood only: the same
 // result for any thread count.
