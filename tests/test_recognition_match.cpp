@@ -17,6 +17,7 @@
 #include "core/cpu.h"
 #include "core/random.h"
 #include "recognition/local/internal.h"
+#include "recognition/local/match_kernels.h"
 
 namespace {
 
@@ -190,6 +191,43 @@ TEST(DescriptorIndex, ShotSizedBoundsHaveTheSameBitsOnEveryPath) {
                     exact + 1e-4f * (qn + 1.f))
               << "rows " << rows << " query " << i << " row " << r;
         }
+      }
+    }
+  }
+}
+
+// The AVX2 bounds kernel's smallest bound per query (what knn_block's first
+// pass looks for, found as the bounds are written) is the smallest of the
+// bounds it writes, for row counts off its eight lanes and 256-row tiles
+// and blocks off its four queries.
+TEST(DescriptorIndex, LongBoundsKernelGivesEachQuerysSmallestBound) {
+  if (!pb::cpu_has_avx2()) GTEST_SKIP() << "no AVX2 on this CPU";
+  pb::Rng rng(41);
+  constexpr int kAxes = pb::local::kProjDim;
+  for (const size_t rows : {size_t{1}, size_t{13}, size_t{256}, size_t{2075}}) {
+    std::vector<float> zt(rows * kAxes), psq(rows);
+    for (size_t r = 0; r < rows; ++r)
+      for (int a = 0; a < kAxes; ++a) {
+        const float v = static_cast<float>(rng.normal(0, 0.3));
+        zt[static_cast<size_t>(a) * rows + r] = v;
+        psq[r] += v * v;
+      }
+    for (const int nq : {1, 4, 7, 37}) {
+      std::vector<float> zq(static_cast<size_t>(nq) * kAxes), zn(static_cast<size_t>(nq));
+      for (int i = 0; i < nq; ++i)
+        for (int a = 0; a < kAxes; ++a) {
+          const float v = static_cast<float>(rng.normal(0, 0.3));
+          zq[static_cast<size_t>(i) * kAxes + static_cast<size_t>(a)] = v;
+          zn[static_cast<size_t>(i)] += v * v;
+        }
+      std::vector<float> lbs(static_cast<size_t>(nq) * rows), mins(static_cast<size_t>(nq));
+      pb::local::long_bounds_avx2(zq.data(), zn.data(), nq, kAxes, zt.data(), psq.data(), rows, lbs.data(),
+                                  mins.data());
+      for (int i = 0; i < nq; ++i) {
+        const auto first = lbs.begin() + static_cast<long>(static_cast<size_t>(i) * rows);
+        const float want = *std::min_element(first, first + static_cast<long>(rows));
+        ASSERT_EQ(std::memcmp(&mins[static_cast<size_t>(i)], &want, sizeof want), 0)
+            << "rows " << rows << " queries " << nq << ": query " << i;
       }
     }
   }

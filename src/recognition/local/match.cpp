@@ -54,6 +54,7 @@ using RowMat = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMa
 struct DescriptorIndex::Impl {
   std::vector<float> data;
   float max_sq_norm = 0;       // of the rows (the bound's rounding margin)
+  bool finite = true;          // every row's squared norm is finite (so is every value)
   int dim = 0;
   size_t rows = 0;
   int proj_dim = 0;
@@ -78,6 +79,7 @@ void DescriptorIndex::build(const std::vector<float>& data, int dim) {
     float s = 0;
     for (int j = 0; j < dim; ++j) s += d[j] * d[j];
     impl_->max_sq_norm = std::max(impl_->max_sq_norm, s);
+    impl_->finite = impl_->finite && std::isfinite(s);
   }
   build_projection();
 }
@@ -231,9 +233,17 @@ bool DescriptorIndex::bounds(const float* queries, int n, float* lbs, float* min
   // the AVX2 + FMA kernel (with each query's smallest bound), or Eigen's
   // n x rows product of the projections, then the bounds in place (short
   // rows are searched exactly: their rounding does not matter).
-  if (m.dim > kShortRows) {
-    (m.avx2_bounds ? long_bounds_avx2 : long_bounds)(Zq.data(), zn.data(), n, m.proj_dim, m.proj_t.data(),
-                                                     m.proj_sq.data(), m.rows, lbs);
+  if (m.dim > kShortRows && m.avx2_bounds) {
+    // Each query's smallest bound too, where every bound is finite (rows and
+    // projections of squared norm under 1e30: no sum can overflow, no NaN),
+    // so that the first row equal to it is first_argmin's row.
+    const bool finite_bounds = m.finite && m.max_sq_norm < 1e30f &&
+                               std::all_of(zn.begin(), zn.end(), [](float v) { return v < 1e30f; });
+    long_bounds_avx2(Zq.data(), zn.data(), n, m.proj_dim, m.proj_t.data(), m.proj_sq.data(), m.rows, lbs,
+                     mins && finite_bounds ? mins : nullptr);
+    return mins && finite_bounds;
+  } else if (m.dim > kShortRows) {
+    long_bounds(Zq.data(), zn.data(), n, m.proj_dim, m.proj_t.data(), m.proj_sq.data(), m.rows, lbs);
   } else if (m.avx2_bounds && m.proj_dim == kProjDimShort && cpu_has_fma()) {
     std::vector<float> own(mins ? 0 : static_cast<size_t>(n));
     short_bounds_fma(Zq.data(), zn.data(), n, m.proj_t.data(), m.proj_sq.data(), m.rows, lbs,
@@ -273,7 +283,7 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
   // read for every query of the block (groups of four took 15% longer).
   const int group = m.dim > kShortRows ? n : 4;
   const std::unique_ptr<float[]> all(new float[static_cast<size_t>(group) * m.rows]);  // every one written
-  std::vector<float> mins(m.dim > kShortRows ? 0 : static_cast<size_t>(group));  // only short rows get them
+  std::vector<float> mins(static_cast<size_t>(group));
   bool have_mins = false;
   const auto dist = m.avx2_bounds ? sq_dist_avx2 : sq_dist;  // the same bits
   std::vector<std::pair<float, int>> cand;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
 #endif
@@ -138,7 +139,7 @@ namespace {
 template <int R>
 __attribute__((target("avx2"))) inline void long_bounds_rows(const __m256* qb, const float* zn, size_t P,
                                                              const float* zt, const float* psq, size_t rows,
-                                                             size_t r, float* lbs) {
+                                                             size_t r, float* lbs, float* lane_min) {
   __m256 d[R][4];
   for (int g = 0; g < R; ++g) {
     const __m256 z = _mm256_loadu_ps(zt + r + 8 * g);
@@ -154,9 +155,11 @@ __attribute__((target("avx2"))) inline void long_bounds_rows(const __m256* qb, c
   const __m256 two = _mm256_set1_ps(2.f);
   for (int g = 0; g < R; ++g) {
     const __m256 p = _mm256_loadu_ps(psq + r + 8 * g);
-    for (int j = 0; j < 4; ++j)
-      _mm256_storeu_ps(lbs + static_cast<size_t>(j) * rows + r + 8 * g,
-                       _mm256_sub_ps(_mm256_add_ps(_mm256_set1_ps(zn[j]), p), _mm256_mul_ps(two, d[g][j])));
+    for (int j = 0; j < 4; ++j) {
+      const __m256 b = _mm256_sub_ps(_mm256_add_ps(_mm256_set1_ps(zn[j]), p), _mm256_mul_ps(two, d[g][j]));
+      _mm256_storeu_ps(lbs + static_cast<size_t>(j) * rows + r + 8 * g, b);
+      if (lane_min) _mm256_storeu_ps(lane_min + 8 * j, _mm256_min_ps(b, _mm256_loadu_ps(lane_min + 8 * j)));
+    }
   }
 }
 }  // namespace
@@ -164,9 +167,13 @@ __attribute__((target("avx2"))) inline void long_bounds_rows(const __m256* qb, c
 // Rows in tiles that stay in the L1 cache; four queries share each load of
 // a tile's projections.
 __attribute__((target("avx2"))) void long_bounds_avx2(const float* zq, const float* zn, int nq, int pd,
-                                                      const float* zt, const float* psq, size_t rows, float* lbs) {
+                                                      const float* zt, const float* psq, size_t rows, float* lbs,
+                                                      float* mins) {
   constexpr size_t kTile = 256;  // rows: 32 axes x 256 rows x 4 bytes = 32 KB
   __m256 qb[4 * kProjDim];  // pd <= kProjDim
+  // Each query's smallest bound so far, per lane (a minimum is exact in any
+  // order); the rows of the scalar tail go to lane 0.
+  std::vector<float> lane_min(mins ? 8 * static_cast<size_t>(nq) : 0, std::numeric_limits<float>::infinity());
   for (size_t t0 = 0; t0 < rows; t0 += kTile) {
     const size_t t1 = std::min(rows, t0 + kTile);
     for (int i = 0; i + 4 <= nq; i += 4) {
@@ -177,15 +184,18 @@ __attribute__((target("avx2"))) void long_bounds_avx2(const float* zq, const flo
       for (size_t a = 0; a < P; ++a)
         for (size_t j = 0; j < 4; ++j) qb[4 * a + j] = _mm256_set1_ps(q[j * P + a]);
       float* out = lbs + static_cast<size_t>(i) * rows;
+      float* lm = mins ? lane_min.data() + 8 * static_cast<size_t>(i) : nullptr;
       size_t r = t0;
-      for (; r + 16 <= t1; r += 16) long_bounds_rows<2>(qb, zn + i, P, zt, psq, rows, r, out);
-      for (; r + 8 <= t1; r += 8) long_bounds_rows<1>(qb, zn + i, P, zt, psq, rows, r, out);
+      for (; r + 16 <= t1; r += 16) long_bounds_rows<2>(qb, zn + i, P, zt, psq, rows, r, out, lm);
+      for (; r + 8 <= t1; r += 8) long_bounds_rows<1>(qb, zn + i, P, zt, psq, rows, r, out, lm);
       for (; r < t1; ++r)
         for (int j = 0; j < 4; ++j) {
           const float* qj = q + static_cast<size_t>(j) * P;
           float d = qj[0] * zt[r];
           for (size_t a = 1; a < P; ++a) d = d + qj[a] * zt[a * rows + r];
-          lbs[static_cast<size_t>(i + j) * rows + r] = (zn[i + j] + psq[r]) - 2.f * d;
+          const float b = (zn[i + j] + psq[r]) - 2.f * d;
+          lbs[static_cast<size_t>(i + j) * rows + r] = b;
+          if (lm) lm[8 * j] = std::min(b, lm[8 * j]);
         }
     }
   }
@@ -195,12 +205,23 @@ __attribute__((target("avx2"))) void long_bounds_avx2(const float* zq, const flo
   if (grouped < nq)
     long_bounds(zq + static_cast<size_t>(grouped) * pd, zn + grouped, nq - grouped, pd, zt, psq, rows,
                 lbs + static_cast<size_t>(grouped) * rows);
+  if (!mins) return;
+  for (int i = 0; i < nq; ++i) {
+    float m = std::numeric_limits<float>::infinity();
+    if (i < grouped) {
+      for (int l = 0; l < 8; ++l) m = std::min(lane_min[8 * static_cast<size_t>(i) + static_cast<size_t>(l)], m);
+    } else {
+      const float* b = lbs + static_cast<size_t>(i) * rows;
+      for (size_t r = 0; r < rows; ++r) m = std::min(b[r], m);
+    }
+    mins[i] = m;
+  }
 }
 #else
 void short_bounds_fma(const float*, const float*, int, const float*, const float*, size_t, float*, float*) {}
 size_t first_equal_avx2(const float*, size_t n, float) { return n; }
 size_t next_at_most_avx2(const float*, size_t, size_t n, float) { return n; }
-void long_bounds_avx2(const float*, const float*, int, int, const float*, const float*, size_t, float*) {}
+void long_bounds_avx2(const float*, const float*, int, int, const float*, const float*, size_t, float*, float*) {}
 #endif
 
 void long_bounds(const float* zq, const float* zn, int nq, int pd, const float* zt, const float* psq, size_t rows,

@@ -65,7 +65,9 @@ size_t next_at_most_avx2(const float* v, size_t from, size_t n, float bar);
 // sums the rows left over from its 12-row panels in another order.)
 void long_bounds(const float* zq, const float* zn, int nq, int pd, const float* zt, const float* psq, size_t rows,
                  float* lbs);
+// mins (not null): each query's smallest bound (every bound finite: the
+// caller's to check) into mins[0..nq), found as the bounds are written.
 void long_bounds_avx2(const float* zq, const float* zn, int nq, int pd, const float* zt, const float* psq,
-                      size_t rows, float* lbs);
+                      size_t rows, float* lbs, float* mins = nullptr);
 
 }  // namespace pb::local
