@@ -229,14 +229,15 @@ bool DescriptorIndex::bounds(const float* queries, int n, float* lbs, float* min
   const RowMat Zq = Q * B.transpose();  // n x proj_dim
   std::vector<float> zn(static_cast<size_t>(n));
   for (int i = 0; i < n; ++i) zn[static_cast<size_t>(i)] = Zq.row(i).squaredNorm();
-  // Long rows: long_bounds, or its AVX2 kernel (the same bits). Short rows:
-  // the AVX2 + FMA kernel (with each query's smallest bound), or Eigen's
-  // n x rows product of the projections, then the bounds in place (short
-  // rows are searched exactly: their rounding does not matter).
+  // Long rows: long_bounds, or its AVX2 kernel (the same bits, and each
+  // query's smallest bound where every bound is finite). Short rows: the
+  // AVX2 + FMA kernel (with each query's smallest bound), or Eigen's n x
+  // rows product of the projections, then the bounds in place (short rows
+  // are searched exactly: their rounding does not matter).
   if (m.dim > kShortRows && m.avx2_bounds) {
-    // Each query's smallest bound too, where every bound is finite (rows and
-    // projections of squared norm under 1e30: no sum can overflow, no NaN),
-    // so that the first row equal to it is first_argmin's row.
+    // Rows and projections of squared norm under 1e30: no sum overflows and
+    // no bound is NaN, so the first row equal to the smallest bound is
+    // first_argmin's row.
     const bool finite_bounds = m.finite && m.max_sq_norm < 1e30f &&
                                std::all_of(zn.begin(), zn.end(), [](float v) { return v < 1e30f; });
     long_bounds_avx2(Zq.data(), zn.data(), n, m.proj_dim, m.proj_t.data(), m.proj_sq.data(), m.rows, lbs,
