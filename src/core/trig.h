@@ -5,6 +5,8 @@
 // warehouse SHOT frame (session 43's perf record). These give the same bits
 // on every machine (no fused multiply-add: build callers with
 // -ffp-contract=off), and core/trig_avx2.h gives them for four lanes.
+// (core/atan2_bin.h's series_atan2 is the coarser sibling, within 2e-8,
+// for code that only bins the angle and lets atan2f decide near an edge.)
 //
 // atan t for t in [0, 1]: with c the nearest quarter, atan t = atan c +
 // atan u, u = (t - c) / (1 + t c), |u| <= 1/8 (t - c is exact: c / 2 <= t
