@@ -141,6 +141,12 @@ class DescriptorIndex {
   // long ones (SHOT's), from a plain loop with the same bits; the answers
   // are the same either way (tests run both).
   void set_avx2_bounds(bool on);
+  // Whether long rows (SHOT's), when there are at least 4096, are searched
+  // by their clusters (match_clusters.h: bounds only for the rows that can
+  // matter; default) or by every row's bound; the same answers either way
+  // (tests run both). has_clusters: whether the index has them.
+  void set_clusters(bool on);
+  bool has_clusters() const;
   // The lower bounds knn_block ranks the rows by, for `n` queries (n x rows,
   // row-major): for tests, which check that every path gives the same bits.
   std::vector<float> lower_bounds(const float* queries, int n) const;

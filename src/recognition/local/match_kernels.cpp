@@ -8,8 +8,59 @@
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
 #endif
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 namespace pb::local {
+
+// The first index of the smallest of v[0..n) (n > 0; as the scan `if (v[r] <
+// v[arg]) arg = r`, for finite values). Four lanes of SSE minima find the
+// value (a minimum is exact in any order), a scan its first index.
+size_t first_argmin(const float* v, size_t n) {
+  float m = std::numeric_limits<float>::infinity();
+  size_t r = 0;
+#ifdef __SSE2__
+  __m128 m0 = _mm_set1_ps(m), m1 = m0;
+  for (; r + 8 <= n; r += 8) {
+    m0 = _mm_min_ps(m0, _mm_loadu_ps(v + r));
+    m1 = _mm_min_ps(m1, _mm_loadu_ps(v + r + 4));
+  }
+  alignas(16) float lanes[4];
+  _mm_store_ps(lanes, _mm_min_ps(m0, m1));
+  for (const float l : lanes) m = std::min(m, l);
+#endif
+  for (; r < n; ++r) m = std::min(m, v[r]);
+  size_t i = 0;
+#ifdef __SSE2__
+  const __m128 m4 = _mm_set1_ps(m);
+  for (; i + 4 <= n; i += 4)
+    if (_mm_movemask_ps(_mm_cmpeq_ps(_mm_loadu_ps(v + i), m4)) != 0) break;  // the first equal is in v[i..i+4)
+#endif
+  for (; i < n; ++i)
+    if (v[i] == m) return i;
+  size_t arg = 0;  // no finite value equals the minimum (NaN or infinity): the plain scan
+  for (size_t i = 1; i < n; ++i)
+    if (v[i] < v[arg]) arg = i;
+  return arg;
+}
+
+// The first r in [from, n) with v[r] <= bar (NaN never), or n; SSE: four
+// values compared at once, most groups have none.
+size_t next_at_most(const float* v, size_t from, size_t n, float bar) {
+  size_t r = from;
+#ifdef __SSE2__
+  const __m128 b4 = _mm_set1_ps(bar);
+  for (; r + 4 <= n; r += 4) {
+    const int mask = _mm_movemask_ps(_mm_cmple_ps(_mm_loadu_ps(v + r), b4));
+    if (mask != 0) return r + static_cast<size_t>(__builtin_ctz(static_cast<unsigned>(mask)));
+  }
+#endif
+  for (; r < n; ++r)
+    if (v[r] <= bar) return r;
+  return n;
+}
+
 
 #if defined(__x86_64__) || defined(__i386__)
 // sq_dist with the eight partial sums in one AVX2 register: each lane does
@@ -217,7 +268,56 @@ __attribute__((target("avx2"))) void long_bounds_avx2(const float* zq, const flo
     mins[i] = m;
   }
 }
+
+namespace {
+// A block's bounds (zn + psq) - 2 d from its sums d over the axes.
+__attribute__((target("avx2"))) inline void finish_block(__m256 d, float zn, const float* psq, float* out) {
+  const __m256 b =
+      _mm256_sub_ps(_mm256_add_ps(_mm256_set1_ps(zn), _mm256_loadu_ps(psq)), _mm256_mul_ps(_mm256_set1_ps(2.f), d));
+  _mm256_storeu_ps(out, b);
+}
+}  // namespace
+
+// Four blocks at a time (four independent sums over the axes: one sum waits
+// on its adds), then the rest one at a time; every lane as long_bounds.
+__attribute__((target("avx2"))) void long_bounds_blocks_avx2(const float* zq, float zn, int pd, const float* blocks,
+                                                             const float* psq, const uint32_t* ids, size_t n,
+                                                             float* out) {
+  const size_t P = static_cast<size_t>(pd), B = 8 * P;
+  size_t i = 0;
+  for (; i + 4 <= n; i += 4) {
+    const float* z0 = blocks + ids[i] * B;
+    const float* z1 = blocks + ids[i + 1] * B;
+    const float* z2 = blocks + ids[i + 2] * B;
+    const float* z3 = blocks + ids[i + 3] * B;
+    __m256 q = _mm256_set1_ps(zq[0]);
+    __m256 d0 = _mm256_mul_ps(q, _mm256_loadu_ps(z0)), d1 = _mm256_mul_ps(q, _mm256_loadu_ps(z1));
+    __m256 d2 = _mm256_mul_ps(q, _mm256_loadu_ps(z2)), d3 = _mm256_mul_ps(q, _mm256_loadu_ps(z3));
+    for (size_t a = 1; a < P; ++a) {
+      q = _mm256_set1_ps(zq[a]);
+      d0 = _mm256_add_ps(d0, _mm256_mul_ps(q, _mm256_loadu_ps(z0 + 8 * a)));
+      d1 = _mm256_add_ps(d1, _mm256_mul_ps(q, _mm256_loadu_ps(z1 + 8 * a)));
+      d2 = _mm256_add_ps(d2, _mm256_mul_ps(q, _mm256_loadu_ps(z2 + 8 * a)));
+      d3 = _mm256_add_ps(d3, _mm256_mul_ps(q, _mm256_loadu_ps(z3 + 8 * a)));
+    }
+    finish_block(d0, zn, psq + 8 * static_cast<size_t>(ids[i]), out + 8 * i);
+    finish_block(d1, zn, psq + 8 * static_cast<size_t>(ids[i + 1]), out + 8 * (i + 1));
+    finish_block(d2, zn, psq + 8 * static_cast<size_t>(ids[i + 2]), out + 8 * (i + 2));
+    finish_block(d3, zn, psq + 8 * static_cast<size_t>(ids[i + 3]), out + 8 * (i + 3));
+  }
+  for (; i < n; ++i) {
+    const float* z = blocks + ids[i] * B;
+    __m256 d = _mm256_mul_ps(_mm256_set1_ps(zq[0]), _mm256_loadu_ps(z));
+    for (size_t a = 1; a < P; ++a)
+      d = _mm256_add_ps(d, _mm256_mul_ps(_mm256_set1_ps(zq[a]), _mm256_loadu_ps(z + 8 * a)));
+    finish_block(d, zn, psq + 8 * static_cast<size_t>(ids[i]), out + 8 * i);
+  }
+}
 #else
+void long_bounds_blocks_avx2(const float* zq, float zn, int pd, const float* blocks, const float* psq,
+                             const uint32_t* ids, size_t n, float* out) {
+  long_bounds_blocks(zq, zn, pd, blocks, psq, ids, n, out);
+}
 void short_bounds_fma(const float*, const float*, int, const float*, const float*, size_t, float*, float*) {}
 size_t first_equal_avx2(const float*, size_t n, float) { return n; }
 size_t next_at_most_avx2(const float*, size_t, size_t n, float) { return n; }
@@ -237,6 +337,18 @@ void long_bounds(const float* zq, const float* zn, int nq, int pd, const float* 
     }
     for (size_t r = 0; r < rows; ++r) out[r] = (zn[i] + psq[r]) - 2.f * out[r];
   }
+}
+
+void long_bounds_blocks(const float* zq, float zn, int pd, const float* blocks, const float* psq,
+                        const uint32_t* ids, size_t n, float* out) {
+  const size_t B = 8 * static_cast<size_t>(pd);
+  for (size_t i = 0; i < n; ++i)
+    for (size_t l = 0; l < 8; ++l) {
+      const float* z = blocks + ids[i] * B + l;
+      float d = zq[0] * z[0];
+      for (int a = 1; a < pd; ++a) d = d + zq[a] * z[8 * static_cast<size_t>(a)];
+      out[8 * i + l] = (zn + psq[8 * static_cast<size_t>(ids[i]) + l]) - 2.f * d;
+    }
 }
 
 }  // namespace pb::local

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 
 namespace pb::local {
 
@@ -49,6 +50,12 @@ float sq_dist_avx2(const float* a, const float* b, size_t dim);
 void short_bounds_fma(const float* zq, const float* zn, int nq, const float* zt, const float* psq, size_t rows,
                       float* lbs, float* mins);
 
+// The first index of the smallest of v[0..n) (n > 0; as the scan `if (v[r] <
+// v[arg]) arg = r`, for finite values), and the first r in [from, n) with
+// v[r] <= bar (NaN never), or n: with SSE where the build has it.
+size_t first_argmin(const float* v, size_t n);
+size_t next_at_most(const float* v, size_t from, size_t n, float bar);
+
 // The scans of one query's bounds v[0..n) in the exact search, eight at a
 // time (only where the CPU has AVX2): the first index r with v[r] == m, and
 // the first r in [from, n) with v[r] <= bar (NaN never); n when none.
@@ -69,5 +76,16 @@ void long_bounds(const float* zq, const float* zn, int nq, int pd, const float* 
 // caller's to check) into mins[0..nq), found as the bounds are written.
 void long_bounds_avx2(const float* zq, const float* zn, int nq, int pd, const float* zt, const float* psq,
                       size_t rows, float* lbs, float* mins = nullptr);
+
+// long_bounds' bounds of one query (projection zq, pd values; squared norm zn)
+// for blocks of eight positions, each block's projections stored together
+// (blocks: per block pd x 8 values, axis by axis; squared norms psq by
+// position): block ids[i] goes to out[8 i .. 8 i + 8). Each bound is
+// long_bounds' bits for that position's row (the same operations in the same
+// order); the AVX2 version (only where the CPU has it) gives the same bits.
+void long_bounds_blocks(const float* zq, float zn, int pd, const float* blocks, const float* psq,
+                        const uint32_t* ids, size_t n, float* out);
+void long_bounds_blocks_avx2(const float* zq, float zn, int pd, const float* blocks, const float* psq,
+                             const uint32_t* ids, size_t n, float* out);
 
 }  // namespace pb::local
