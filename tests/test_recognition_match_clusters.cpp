@@ -168,24 +168,71 @@ TEST(RowClusters, SearchGivesTheSameAnswersWithAndWithoutClusters) {
   const int n = static_cast<int>(queries.size() / kDim);
   using Result = std::vector<std::vector<std::pair<int, float>>>;
   size_t found = 0;
+  // Blocks of 32 queries, as the pipeline's; with clusters throughout (a
+  // share over 1), every row's bound from the first query (0), and as by
+  // default.
+  const auto search = [&](int k, float thr, int checks, Result& out) {
+    for (int first = 0; first < n; first += 32)
+      index.knn_block(queries.data() + static_cast<size_t>(first) * kDim, std::min(32, n - first), k, thr,
+                      out.data() + first, checks);
+  };
   for (const bool avx2 : {false, true}) {
     index.set_avx2_bounds(avx2);
     for (const int k : {1, 3})
       for (const float thr : {0.05f, 0.5f, 4.f})
         for (const int checks : {0, 64, 16}) {
-          Result with(static_cast<size_t>(n)), without(static_cast<size_t>(n));
-          index.set_clusters(true);
-          index.knn_block(queries.data(), n, k, thr, with.data(), checks);
+          Result without(static_cast<size_t>(n));
           index.set_clusters(false);
-          index.knn_block(queries.data(), n, k, thr, without.data(), checks);
-          for (int i = 0; i < n; ++i) {
-            ASSERT_EQ(with[static_cast<size_t>(i)], without[static_cast<size_t>(i)])
-                << "query " << i << " k " << k << " threshold " << thr << " checks " << checks << " avx2 " << avx2;
-            found += with[static_cast<size_t>(i)].size();
+          search(k, thr, checks, without);
+          for (const double share : {2.0, 0.0, 0.3}) {
+            Result with(static_cast<size_t>(n));
+            index.set_clusters(true);
+            index.set_dense_share(share);
+            search(k, thr, checks, with);
+            for (int i = 0; i < n; ++i) {
+              ASSERT_EQ(with[static_cast<size_t>(i)], without[static_cast<size_t>(i)])
+                  << "query " << i << " k " << k << " threshold " << thr << " checks " << checks << " avx2 " << avx2
+                  << " share " << share;
+              found += with[static_cast<size_t>(i)].size();
+            }
           }
         }
   }
-  EXPECT_GT(found, 2000u);  // the comparison is not between empty answers
+  EXPECT_GT(found, 6000u);  // the comparison is not between empty answers
+  // Blocks of 16 whose first eight queries are rows' exact copies (a small
+  // limit: the clusters) and whose last eight are far from every row under a
+  // threshold of 4 (the limit spans most rows: every row's bound from the
+  // ninth query on, where the search next judges), against the search
+  // without clusters.
+  std::vector<float> mixed;
+  pb::Rng far_rng(5);
+  const std::vector<float> far = shot_rows(400, far_rng);  // other centres
+  for (int b = 0; b < 10; ++b) {
+    for (int j = 0; j < 8; ++j) {
+      const int src = rng.uniform_int(0, rows - 1);
+      mixed.insert(mixed.end(), data.begin() + src * kDim, data.begin() + (src + 1) * kDim);
+    }
+    mixed.insert(mixed.end(), far.begin() + (8 * b) * kDim, far.begin() + (8 * b + 8) * kDim);
+  }
+  index.set_dense_share(0.4);
+  for (const int checks : {0, 64}) {
+    Result with(160), without(160);
+    for (const bool clusters : {true, false}) {
+      index.set_clusters(clusters);
+      for (int first = 0; first < 160; first += 16)
+        index.knn_block(mixed.data() + static_cast<size_t>(first) * kDim, 16, 1, 4.f,
+                        (clusters ? with : without).data() + first, checks);
+    }
+    EXPECT_EQ(with, without) << "checks " << checks;
+  }
+  index.set_clusters(true);
+  // A cap of every row: the capped search gives the exact search's answers.
+  for (const int k : {1, 3}) {
+    Result exact(static_cast<size_t>(n)), all(static_cast<size_t>(n));
+    index.knn_block(queries.data(), n, k, 4.f, exact.data());
+    index.knn_block(queries.data(), n, k, 4.f, all.data(), rows);
+    EXPECT_EQ(all, exact) << "k " << k;
+  }
 }
 
 }  // namespace

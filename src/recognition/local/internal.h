@@ -147,6 +147,11 @@ class DescriptorIndex {
   // (tests run both). has_clusters: whether the index has them.
   void set_clusters(bool on);
   bool has_clusters() const;
+  // The share of the blocks of bounds a query's likely limit may span by
+  // the clusters before it and the block's remaining queries take every
+  // row's bound (default 0.4; judged every eight queries; a value over 1:
+  // never).
+  void set_dense_share(double share);
   // The lower bounds knn_block ranks the rows by, for `n` queries (n x rows,
   // row-major): for tests, which check that every path gives the same bits.
   std::vector<float> lower_bounds(const float* queries, int n) const;
@@ -156,6 +161,9 @@ class DescriptorIndex {
   // lower_bounds into lbs; true when it also wrote each query's smallest
   // bound into mins (n floats; nullptr: not wanted)
   bool bounds(const float* queries, int n, float* lbs, float* mins) const;
+  // The same from the queries' projections (n x the axes) and their squared
+  // norms.
+  bool bounds_projected(const float* zq, const float* zn, int n, float* lbs, float* mins) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -22,12 +22,10 @@
 // in clusters of their projections (match_clusters.h): a query's bounds are
 // then computed only for the rows whose bound can be among its kk smallest
 // (first pass) or up to its limit (second pass), by the triangle inequality
-// to the clusters' centroids. Every bound computed has the full
-// computation's bits and every row skipped has a bound above what it is
-// compared with, so the answers are those of every row's bound, exact and
-// capped alike. On the warehouse's 13,278 SHOT rows a query computed about
-// 260 blocks of eight rows' bounds instead of 1,660 (results/bench/README.md,
-// thirty-fifth round).
+// to the clusters' centroids, with the full computation's bits: the same
+// answers, exact and capped. On the warehouse's 13,278 SHOT rows a query
+// computed about 260 blocks of eight rows' bounds instead of 1,660
+// (results/bench/README.md, thirty-fifth round).
 //
 // Why no kd-tree: for SHOT one visits nearly every leaf (measured: no faster
 // than a linear scan). FPFH used FLANN's single kd-tree (the index
@@ -58,6 +56,8 @@ namespace {
 constexpr int kShortRows = 64;  // rows of at most this many values are short
 constexpr size_t kPcaRows = 1000;  // at most this many (evenly spaced) rows estimate the axes
 constexpr size_t kClusterRows = 4096;  // long rows: from this many on, bounds only where they can matter
+constexpr double kDenseShare = 0.4;    // ... while a query's likely runs span at most this share of the blocks
+constexpr int kDenseProbe = 8;         // (judged every this many queries: a multiple of the AVX2 bounds kernel's four)
 using RowMat = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 }
 
@@ -75,6 +75,23 @@ struct DescriptorIndex::Impl {
   bool avx2_bounds = false;    // bounds from short_bounds_fma (with FMA) / long_bounds_avx2
   RowClusters clusters;        // long rows, at least kClusterRows of them, every value finite
   bool use_clusters = false;   // the pruned bounds (match_clusters.h) where there are clusters
+  double dense_share = kDenseShare;
+
+  // Whether query q (its distances to the centroids in cq) had better take
+  // every row's bound: the work it is likely to need by the clusters, from
+  // the best row of its nearest centroid's cluster, is the runs of that
+  // row's bound (the first pass) and of the limit its exact distance gives
+  // (the second). Where they span more than the dense share of the blocks,
+  // yes (on the warehouse, a block of eight bounds took about 15 ns by the
+  // clusters and 7.5 ns among every row's, whose loads four queries share).
+  bool dense_better(const ClusterQuery& cq, const float* q, float max_sq_dist) const {
+    const auto [b, r] = cluster_near_best(clusters, cq);
+    const auto d = avx2_bounds ? sq_dist_avx2 : sq_dist;
+    const float t = r < 0 ? max_sq_dist : d(q, data.data() + static_cast<size_t>(r) * dim, static_cast<size_t>(dim));
+    const size_t reach =
+        cluster_reach(clusters, cq, b) + cluster_reach(clusters, cq, std::min(t, max_sq_dist) + cq.margin);
+    return static_cast<double>(reach) > dense_share * static_cast<double>(clusters.block_count());
+  }
 
   // The projections of n queries on the basis (n x proj_dim) and, into zn,
   // their squared norms.
@@ -148,6 +165,8 @@ void DescriptorIndex::set_avx2_bounds(bool on) { impl_->avx2_bounds = on && !imp
 void DescriptorIndex::set_clusters(bool on) { impl_->use_clusters = on && has_clusters(); }
 
 bool DescriptorIndex::has_clusters() const { return impl_->clusters.count() > 0; }
+
+void DescriptorIndex::set_dense_share(double share) { impl_->dense_share = share; }
 
 size_t DescriptorIndex::size() const { return impl_->rows; }
 
@@ -251,9 +270,15 @@ void smallest_at_most(const float* v, size_t n, float limit, size_t cap, std::ve
 }
 
 bool DescriptorIndex::bounds(const float* queries, int n, float* lbs, float* mins) const {
-  const Impl& m = *impl_;
   std::vector<float> zn;
-  const RowMat Zq = m.project(queries, n, zn);  // n x proj_dim
+  const RowMat Zq = impl_->project(queries, n, zn);  // n x proj_dim
+  return bounds_projected(Zq.data(), zn.data(), n, lbs, mins);
+}
+
+bool DescriptorIndex::bounds_projected(const float* zq, const float* zn_in, int n, float* lbs, float* mins) const {
+  const Impl& m = *impl_;
+  const Eigen::Map<const RowMat> Zq(zq, n, m.proj_dim);
+  const std::vector<float> zn(zn_in, zn_in + n);
   // Long rows: long_bounds, or its AVX2 kernel (the same bits, and each
   // query's smallest bound where every bound is finite). Short rows: the
   // AVX2 + FMA kernel (with each query's smallest bound), or Eigen's n x
@@ -317,18 +342,22 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
   // the L2 cache; the warehouse's 17,526 rows for a block of 32 took 2.2 MB).
   // Long rows: the whole block at once, each tile of the rows' projections
   // read for every query of the block (groups of four took 15% longer).
+  // With clusters, the queries go by them until one (judged every
+  // kDenseProbe) is likely to need more than kDenseShare of the blocks
+  // (queries far from every row, whose limit is the threshold: nearly every
+  // bound is under it); that one and the block's rest then take every row's
+  // bound, in one group (the same answers either way).
   const int group = m.dim > kShortRows ? n : 4;
-  const std::unique_ptr<float[]> all(pruned ? nullptr : new float[static_cast<size_t>(group) * m.rows]);
+  std::unique_ptr<float[]> all;
   std::vector<float> mins(static_cast<size_t>(group));
   bool have_mins = false;
+  int dense_from = pruned ? n : 0;  // queries from this one on: every row's bound
   const auto dist = m.avx2_bounds ? sq_dist_avx2 : sq_dist;  // the same bits
   std::vector<std::pair<float, int>> cand, within;
   ClusterQuery cq;
   cq.avx2 = m.avx2_bounds;
   SecondPass pass{m.data.data(), dim, kk, max_sq_dist, dist, {}, {}};
   for (int i = 0; i < n; ++i) {
-    if (!pruned && i % group == 0)
-      have_mins = bounds(queries + static_cast<size_t>(i) * dim, std::min(group, n - i), all.get(), mins.data());
     out[i].clear();
     const float* q = queries + static_cast<size_t>(i) * dim;
     float qn = 0;
@@ -340,17 +369,26 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
       cq.zn = zn[static_cast<size_t>(i)];
       cq.margin = margin;
       cluster_distances(m.clusters, cq);
+      if (i % kDenseProbe == 0 && m.dense_better(cq, q, max_sq_dist)) pruned = false, dense_from = i;
+    }
+    if (!pruned && (i - dense_from) % group == 0) {
+      if (!all) all.reset(new float[static_cast<size_t>(group) * m.rows]);
+      const int count = std::min(group, n - i);
+      have_mins = Zq.rows() > 0  // the block's projections are at hand (clusters)
+                      ? bounds_projected(Zq.row(i).data(), zn.data() + i, count, all.get(), mins.data())
+                      : bounds(q, count, all.get(), mins.data());
     }
     // First pass: the kk smallest bounds (value, then row); their exact
     // distances cap the k-th best (tau0), so only rows with a bound up to
     // tau0 remain candidates.
-    const float* lbs = pruned ? nullptr : all.get() + static_cast<size_t>(i % group) * m.rows;
+    const int slot = pruned ? 0 : (i - dense_from) % group;
+    const float* lbs = pruned ? nullptr : all.get() + static_cast<size_t>(slot) * m.rows;
     cand.clear();
     if (pruned) {
       cluster_smallest(m.clusters, cq, kk, cand);
     } else if (kk == 1) {  // the smallest bound, the lowest row among equal ones
       size_t arg = m.rows;
-      if (have_mins) arg = first_equal_avx2(lbs, m.rows, mins[static_cast<size_t>(i % group)]);
+      if (have_mins) arg = first_equal_avx2(lbs, m.rows, mins[static_cast<size_t>(slot)]);
       if (arg == m.rows) arg = first_argmin(lbs, m.rows);  // no minimum given, or none equals it (NaN)
       cand.emplace_back(lbs[arg], static_cast<int>(arg));
     } else {
@@ -375,8 +413,7 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
           std::nth_element(within.begin(), within.begin() + static_cast<long>(cap - 1), within.end());
           within.resize(cap);
         }
-        cand.swap(within);
-        pass.capped(q, margin, cand, out[i]);
+        pass.capped(q, margin, within, out[i]);
         continue;
       }
       std::sort(within.begin(), within.end(), [](const auto& a, const auto& b) { return a.second < b.second; });

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -190,9 +191,14 @@ void compute(const RowClusters& c, const ClusterQuery& q, Scratch& s) {
   const auto kernel = q.avx2 ? long_bounds_blocks_avx2 : long_bounds_blocks;
   kernel(q.zq, q.zn, c.pd, c.blocks.data(), c.psq.data(), s.todo.data(), m, s.fresh.data());
   for (size_t j = 0; j < m; ++j) {
-    std::copy_n(s.fresh.data() + 8 * j, 8, s.cache.data() + 8 * static_cast<size_t>(s.todo[j]));
+    std::memcpy(s.cache.data() + 8 * static_cast<size_t>(s.todo[j]), s.fresh.data() + 8 * j, 8 * sizeof(float));
     s.stamp[s.todo[j]] = s.token;
   }
+}
+
+size_t nearest_cluster(const RowClusters& c, const ClusterQuery& q) {
+  return static_cast<size_t>(std::min_element(q.cd.begin(), q.cd.begin() + static_cast<long>(c.count())) -
+                             q.cd.begin());
 }
 
 }  // namespace
@@ -277,6 +283,30 @@ void cluster_distances(const RowClusters& c, ClusterQuery& q) {
   scratch.start_query(c);
 }
 
+std::pair<float, int> cluster_near_best(const RowClusters& c, const ClusterQuery& q) {
+  std::pair<float, int> best(std::numeric_limits<float>::infinity(), -1);
+  if (c.count() == 0) return best;
+  Scratch& s = scratch;
+  const size_t near = nearest_cluster(c, q);
+  s.clear(c);
+  add_positions(c.begin[near], c.end[near], s);
+  compute(c, q, s);
+  for (size_t i = 0; i < s.n; ++i)
+    for (unsigned m = s.lanes[i]; m != 0; m &= m - 1) {
+      const unsigned l = static_cast<unsigned>(__builtin_ctz(m));
+      const std::pair<float, int> e(s.cache[8 * static_cast<size_t>(s.ids[i]) + l], c.row[8 * s.ids[i] + l]);
+      if (e < best || best.second < 0) best = e;
+    }
+  return best;
+}
+
+size_t cluster_reach(const RowClusters& c, const ClusterQuery& q, float X) {
+  Scratch& s = scratch;
+  s.clear(c);
+  add_runs(c, q, X, c.count(), s);
+  return s.n;
+}
+
 void cluster_smallest(const RowClusters& c, const ClusterQuery& q, size_t kk,
                       std::vector<std::pair<float, int>>& out) {
   out.clear();
@@ -299,8 +329,7 @@ void cluster_smallest(const RowClusters& c, const ClusterQuery& q, size_t kk,
   // The nearest centroid's cluster in full, then every other one's rows that
   // can have a bound up to the kk-th smallest so far (any X at least the
   // final one skips only rows that are not among the kk smallest).
-  const size_t near = static_cast<size_t>(
-      std::min_element(q.cd.begin(), q.cd.begin() + static_cast<long>(c.count())) - q.cd.begin());
+  const size_t near = nearest_cluster(c, q);
   s.clear(c);
   add_positions(c.begin[near], c.end[near], s);
   compute(c, q, s);

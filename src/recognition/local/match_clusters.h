@@ -32,6 +32,7 @@ struct RowClusters {
   std::vector<float> blocks;      // per eight positions: pd x 8 projections (axis, then position)
   std::vector<float> psq;         // position -> the projection's squared norm (padding: 0)
   size_t count() const { return radius.size(); }
+  size_t block_count() const { return row.size() / 8; }
 };
 
 // The clusters of `rows` projected rows (proj: rows x pd, row-major; psq:
@@ -53,6 +54,15 @@ struct ClusterQuery {
 // The query's distances to the centroids, into q.cd: first, before the two
 // searches below.
 void cluster_distances(const RowClusters& c, ClusterQuery& q);
+
+// The smallest (bound, row) of the nearest centroid's cluster ((inf, -1)
+// without clusters): a row near the query whose exact distance tells the
+// limit the searches are likely to have.
+std::pair<float, int> cluster_near_best(const RowClusters& c, const ClusterQuery& q);
+
+// How many blocks of eight bounds the rows that can have a bound up to X
+// span (cluster_within's work for that limit; nothing is computed).
+size_t cluster_reach(const RowClusters& c, const ClusterQuery& q, float X);
 
 // The kk smallest (bound, row) pairs over every row (value, then row), in
 // ascending order: what knn_block's first pass takes from the full bounds.
