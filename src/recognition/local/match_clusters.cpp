@@ -84,7 +84,7 @@ thread_local Scratch scratch;
 
 // The squared distances of a query to the centroids, eight centroids at a
 // time, in float (their rounding, at most a few parts in a million, is
-// within add_run's slack).
+// within add_runs' slack).
 void centroid_sq(const float* zq, int pd, const float* ct, size_t cstride, float* out) {
   for (size_t c = 0; c < cstride; ++c) out[c] = 0.f;
   for (int a = 0; a < pd; ++a)
@@ -158,10 +158,10 @@ void add_positions(size_t lo, size_t hi, Scratch& s) {
 
 // Appends, for every cluster but `skip`, the blocks covering the run of
 // positions whose rows can have a bound up to X (every row where X is
-// infinite): a row r outside it has |d(q, c) - d(r, c)| > s, so its exact
-// projected distance is above sqrt(X + margin) (s's slack covers the
-// rounding of the float distances, to the centroids and of the rows), and
-// its bound, within `margin` of that distance squared, above X.
+// infinite): a row r outside it has |d(q, c) - d(r, c)| > reach, so its
+// exact projected distance is above sqrt(X + margin) (reach's slack covers
+// the rounding of the float distances, to the centroids and of the rows),
+// and its bound, within `margin` of that distance squared, above X.
 void add_runs(const RowClusters& c, const ClusterQuery& q, double X, size_t skip, Scratch& s) {
   const bool all = !std::isfinite(X);
   const double root = all ? 0.0 : std::sqrt(X + static_cast<double>(q.margin));
@@ -208,7 +208,7 @@ RowClusters cluster_rows(const float* proj, const float* psq, size_t rows, int p
   out.pd = pd;
   out.rows = rows;
   if (rows == 0 || pd <= 0) return out;
-  const size_t k = std::max<size_t>(1, rows / kRowsPerCluster);
+  size_t k = std::max<size_t>(1, rows / kRowsPerCluster);
   const Eigen::Map<const RowMatF> Z(proj, static_cast<Eigen::Index>(rows), pd);
   std::vector<double> centroid(k * pd);
   for (size_t c = 0; c < k; ++c)  // evenly spaced rows
@@ -226,6 +226,24 @@ RowClusters cluster_rows(const float* proj, const float* psq, size_t rows, int p
       if (n[c] > 0)
         for (int a = 0; a < pd; ++a) centroid[c * pd + a] = sum[c * pd + a] / static_cast<double>(n[c]);
     member = assign(Z, centroid, k, pd);
+  }
+  // Clusters left empty are dropped (a nearest centroid then always has
+  // rows).
+  {
+    std::vector<int> kept(k, -1);
+    std::vector<char> used(k, 0);
+    for (const int c : member) used[static_cast<size_t>(c)] = 1;
+    size_t m = 0;
+    for (size_t c = 0; c < k; ++c)
+      if (used[c]) {
+        kept[c] = static_cast<int>(m);
+        if (m != c)
+          std::copy_n(centroid.begin() + static_cast<long>(c * pd), pd, centroid.begin() + static_cast<long>(m * pd));
+        ++m;
+      }
+    for (int& c : member) c = kept[static_cast<size_t>(c)];
+    k = m;
+    centroid.resize(k * pd);
   }
   // The centroids as the queries' distances read them (float, axis by axis);
   // each row's distance to its centroid in double from those floats.

@@ -4,7 +4,8 @@
 // inequality the projected distance of a query q to a row r of the cluster
 // with centroid c is at least |d(q, c) - d(r, c)|; rows are kept in order of
 // d(r, c) within each cluster, so the rows that can have a bound up to some X
-// are one run of positions per cluster, found by binary search. Skipping the
+// are one run of positions per cluster, found by counting the sorted
+// distances below its ends. Skipping the
 // others changes no answer: the bounds computed are long_bounds' bits (the
 // same float operations, match_kernels.h), and a row is skipped only where
 // its bound is provably above X, with the rounding margin the search already
@@ -38,7 +39,7 @@ struct RowClusters {
 // The clusters of `rows` projected rows (proj: rows x pd, row-major; psq:
 // their squared norms, as the bounds use them): about one cluster per 100
 // rows, k-means from evenly spaced rows for a fixed number of iterations
-// (deterministic).
+// (deterministic); clusters left empty are dropped.
 RowClusters cluster_rows(const float* proj, const float* psq, size_t rows, int pd);
 
 // One query's pruned bounds: its projection zq (pd values) and squared norm
