@@ -184,7 +184,7 @@ TEST(RowClusters, SearchGivesTheSameAnswersWithAndWithoutClusters) {
           Result without(static_cast<size_t>(n));
           index.set_clusters(false);
           search(k, thr, checks, without);
-          for (const double share : {2.0, 0.0, 0.3}) {
+          for (const double share : {2.0, 0.0, 0.4}) {
             Result with(static_cast<size_t>(n));
             index.set_clusters(true);
             index.set_dense_share(share);
