@@ -275,10 +275,9 @@ bool DescriptorIndex::bounds(const float* queries, int n, float* lbs, float* min
   return bounds_projected(Zq.data(), zn.data(), n, lbs, mins);
 }
 
-bool DescriptorIndex::bounds_projected(const float* zq, const float* zn_in, int n, float* lbs, float* mins) const {
+bool DescriptorIndex::bounds_projected(const float* zq, const float* zn, int n, float* lbs, float* mins) const {
   const Impl& m = *impl_;
   const Eigen::Map<const RowMat> Zq(zq, n, m.proj_dim);
-  const std::vector<float> zn(zn_in, zn_in + n);
   // Long rows: long_bounds, or its AVX2 kernel (the same bits, and each
   // query's smallest bound where every bound is finite). Short rows: the
   // AVX2 + FMA kernel (with each query's smallest bound), or Eigen's n x
@@ -289,15 +288,15 @@ bool DescriptorIndex::bounds_projected(const float* zq, const float* zn_in, int 
     // no bound is NaN, so the first row equal to the smallest bound is
     // first_argmin's row.
     const bool finite_bounds = m.finite && m.max_sq_norm < 1e30f &&
-                               std::all_of(zn.begin(), zn.end(), [](float v) { return v < 1e30f; });
-    long_bounds_avx2(Zq.data(), zn.data(), n, m.proj_dim, m.proj_t.data(), m.proj_sq.data(), m.rows, lbs,
+                               std::all_of(zn, zn + n, [](float v) { return v < 1e30f; });
+    long_bounds_avx2(Zq.data(), zn, n, m.proj_dim, m.proj_t.data(), m.proj_sq.data(), m.rows, lbs,
                      mins && finite_bounds ? mins : nullptr);
     return mins && finite_bounds;
   } else if (m.dim > kShortRows) {
-    long_bounds(Zq.data(), zn.data(), n, m.proj_dim, m.proj_t.data(), m.proj_sq.data(), m.rows, lbs);
+    long_bounds(Zq.data(), zn, n, m.proj_dim, m.proj_t.data(), m.proj_sq.data(), m.rows, lbs);
   } else if (m.avx2_bounds && m.proj_dim == kProjDimShort && cpu_has_fma()) {
     std::vector<float> own(mins ? 0 : static_cast<size_t>(n));
-    short_bounds_fma(Zq.data(), zn.data(), n, m.proj_t.data(), m.proj_sq.data(), m.rows, lbs,
+    short_bounds_fma(Zq.data(), zn, n, m.proj_t.data(), m.proj_sq.data(), m.rows, lbs,
                      mins ? mins : own.data());
     return mins != nullptr;
   } else {
@@ -392,13 +391,8 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
       if (arg == m.rows) arg = first_argmin(lbs, m.rows);  // no minimum given, or none equals it (NaN)
       cand.emplace_back(lbs[arg], static_cast<int>(arg));
     } else {
-      for (size_t r = 0; r < m.rows; ++r) {
-        const float lb = lbs[r];
-        if (cand.size() == kk && !(lb < cand.back().first)) continue;
-        if (cand.size() == kk) cand.pop_back();
-        cand.insert(std::upper_bound(cand.begin(), cand.end(), std::make_pair(lb, static_cast<int>(r))),
-                    {lb, static_cast<int>(r)});
-      }
+      for (size_t r = 0; r < m.rows; ++r)
+        if (cand.size() < kk || lbs[r] < cand.back().first) keep_smallest(cand, kk, {lbs[r], static_cast<int>(r)});
     }
     float tau0 = 0;
     for (const auto& c : cand)

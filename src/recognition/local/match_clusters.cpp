@@ -206,7 +206,6 @@ size_t nearest_cluster(const RowClusters& c, const ClusterQuery& q) {
 RowClusters cluster_rows(const float* proj, const float* psq, size_t rows, int pd) {
   RowClusters out;
   out.pd = pd;
-  out.rows = rows;
   if (rows == 0 || pd <= 0) return out;
   size_t k = std::max<size_t>(1, rows / kRowsPerCluster);
   const Eigen::Map<const RowMatF> Z(proj, static_cast<Eigen::Index>(rows), pd);
@@ -336,12 +335,7 @@ void cluster_smallest(const RowClusters& c, const ClusterQuery& q, size_t kk,
         const unsigned l = static_cast<unsigned>(__builtin_ctz(m));
         const float v = s.cache[8 * static_cast<size_t>(s.ids[i]) + l];
         if (out.size() == kk && v > out.back().first) continue;  // most lanes: no row needed
-        const std::pair<float, int> e(v, c.row[8 * s.ids[i] + l]);
-        if (out.size() == kk) {
-          if (!(e < out.back())) continue;
-          out.pop_back();
-        }
-        out.insert(std::upper_bound(out.begin(), out.end(), e), e);
+        keep_smallest(out, kk, {v, c.row[8 * s.ids[i] + l]});
       }
   };
   // The nearest centroid's cluster in full, then every other one's rows that

@@ -22,7 +22,6 @@ namespace pb::local {
 
 struct RowClusters {
   int pd = 0;                     // axes of the projections
-  size_t rows = 0;                // rows indexed
   std::vector<float> centroid_t;  // pd x cstride: the centroids axis by axis (zero padding)
   size_t cstride = 0;             // values per axis in centroid_t (clusters rounded up to eight)
   std::vector<double> radius;     // per cluster: the largest d(r, c) of its rows

@@ -61,7 +61,6 @@ size_t next_at_most(const float* v, size_t from, size_t n, float bar) {
   return n;
 }
 
-
 #if defined(__x86_64__) || defined(__i386__)
 // sq_dist with the eight partial sums in one AVX2 register: each lane does
 // the same operations in the same order (no fused multiply-add), so the

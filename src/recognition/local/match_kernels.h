@@ -6,8 +6,11 @@
 // per lane, with no fused multiply-add: the same bits.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
+#include <vector>
 
 namespace pb::local {
 
@@ -49,6 +52,17 @@ float sq_dist_avx2(const float* a, const float* b, size_t dim);
 // search allows for.
 void short_bounds_fma(const float* zq, const float* zn, int nq, const float* zt, const float* psq, size_t rows,
                       float* lbs, float* mins);
+
+// Keeps in `out` (ascending) the kk smallest (bound, row) pairs offered, in
+// any order: the search's first pass, over every row's bounds or the
+// clusters' (match_clusters.h).
+inline void keep_smallest(std::vector<std::pair<float, int>>& out, size_t kk, std::pair<float, int> e) {
+  if (out.size() == kk) {
+    if (!(e < out.back())) return;
+    out.pop_back();
+  }
+  out.insert(std::upper_bound(out.begin(), out.end(), e), e);
+}
 
 // The first index of the smallest of v[0..n) (n > 0; as the scan `if (v[r] <
 // v[arg]) arg = r`, for finite values), and the first r in [from, n) with
