@@ -17,6 +17,30 @@ namespace {
 constexpr int kCrhBins = 90;
 using CrhHistogram = pcl::Histogram<kCrhBins>;
 
+constexpr int kHarm = kCrhBins / 2;  // 45: the Nyquist harmonic
+constexpr int kSteps = 360;          // the correlation's samples: one degree
+
+// cos(k th) and sin(k th) at th = 2 pi j / kSteps, for every sample j and
+// harmonic k (row j): the correlation's terms depend on the spectra only
+// through their weights, so the 33,000 cosines and sines are computed once
+// per process, by the same expressions (the same bits), not per call.
+struct Harmonics {
+  std::vector<double> c, s;
+  Harmonics() : c(kSteps * (kHarm + 1)), s(kSteps * (kHarm + 1)) {
+    for (int j = 0; j < kSteps; ++j) {
+      const double th = 2 * M_PI * j / kSteps;
+      for (int k = 0; k <= kHarm; ++k) {
+        c[static_cast<size_t>(j * (kHarm + 1) + k)] = std::cos(k * th);
+        s[static_cast<size_t>(j * (kHarm + 1) + k)] = std::sin(k * th);
+      }
+    }
+  }
+};
+const Harmonics& harmonics() {
+  static const Harmonics h;
+  return h;
+}
+
 pcl::PointCloud<CrhHistogram> to_pcl(const std::vector<float>& v) {
   pcl::PointCloud<CrhHistogram> c;
   c.resize(1);
@@ -68,7 +92,6 @@ std::vector<double> crh_roll_peaks(const std::vector<float>& S, const std::vecto
   // Normalized cross power spectrum P_k = S_k conj(V_k) / |.|; with the
   // scene histogram equal to the view's shifted by theta0, P_k =
   // exp(-i k theta0) and sum_k Re(P_k exp(i k theta)) peaks at theta0.
-  constexpr int kHarm = kCrhBins / 2;  // 45: the Nyquist harmonic
   std::vector<double> pr(kHarm + 1, 0.0), pi(kHarm + 1, 0.0);
   pr[0] = static_cast<double>(S[0]) * V[0];  // DC, unnormalized as PCL
   for (int k = 1; k < kHarm; ++k) {
@@ -82,12 +105,13 @@ std::vector<double> crh_roll_peaks(const std::vector<float>& S, const std::vecto
   }
   const double ny = static_cast<double>(S[kCrhBins - 1]) * V[kCrhBins - 1];
   pr[kHarm] = ny > 0 ? 1.0 : (ny < 0 ? -1.0 : 0.0);
-  constexpr int kSteps = 360;  // one degree
+  const Harmonics& h = harmonics();
   std::vector<double> corr(kSteps);
   for (int j = 0; j < kSteps; ++j) {
-    const double th = 2 * M_PI * j / kSteps;
+    const double* cj = h.c.data() + j * (kHarm + 1);
+    const double* sj = h.s.data() + j * (kHarm + 1);
     double sum = 0;
-    for (int k = 0; k <= kHarm; ++k) sum += pr[k] * std::cos(k * th) - pi[k] * std::sin(k * th);
+    for (int k = 0; k <= kHarm; ++k) sum += pr[k] * cj[k] - pi[k] * sj[k];
     corr[j] = sum;
   }
   // Local maxima (circular), refined by a parabola through three samples.
