@@ -53,12 +53,51 @@ struct Cell {
   int x, y, z;
   bool operator==(const Cell& o) const { return x == o.x && y == o.y && z == o.z; }
 };
-struct CellHash {
-  size_t operator()(const Cell& c) const {
-    return static_cast<size_t>((static_cast<uint64_t>(static_cast<uint32_t>(c.x)) * 73856093u) ^
-                               (static_cast<uint64_t>(static_cast<uint32_t>(c.y)) * 19349663u) ^
-                               (static_cast<uint64_t>(static_cast<uint32_t>(c.z)) * 83492791u));
+// The cells' ids by open addressing (linear probing, a power-of-two
+// capacity of at least twice the points, so never full): no allocation per
+// cell, and the 62 lookups of a cell's neighbours cost a probe or two each.
+// Which id a cell gets does not change the clusters (components, then
+// sorted).
+class CellTable {
+ public:
+  explicit CellTable(size_t points) {
+    size_t cap = 64;
+    while (cap < 2 * points) cap *= 2;
+    keys_.resize(cap);
+    ids_.assign(cap, -1);
   }
+  int find(const Cell& c) const {
+    for (size_t i = slot(c);; i = (i + 1) & (ids_.size() - 1)) {
+      if (ids_[i] < 0) return -1;
+      if (keys_[i] == c) return ids_[i];
+    }
+  }
+  // The id of c, `fresh` when c is new (then *added = true).
+  int insert(const Cell& c, int fresh, bool* added) {
+    size_t i = slot(c);
+    for (; ids_[i] >= 0; i = (i + 1) & (ids_.size() - 1))
+      if (keys_[i] == c) {
+        *added = false;
+        return ids_[i];
+      }
+    keys_[i] = c;
+    ids_[i] = fresh;
+    *added = true;
+    return fresh;
+  }
+
+ private:
+  size_t slot(const Cell& c) const {
+    uint64_t h = (static_cast<uint64_t>(static_cast<uint32_t>(c.x)) * 73856093u) ^
+                 (static_cast<uint64_t>(static_cast<uint32_t>(c.y)) * 19349663u) ^
+                 (static_cast<uint64_t>(static_cast<uint32_t>(c.z)) * 83492791u);
+    h ^= h >> 33;
+    h *= 0xff51afd7ed558ccdull;
+    h ^= h >> 33;
+    return static_cast<size_t>(h) & (ids_.size() - 1);
+  }
+  std::vector<Cell> keys_;
+  std::vector<int> ids_;
 };
 
 }  // namespace
@@ -72,8 +111,8 @@ std::vector<std::vector<int>> euclidean_clusters(const std::vector<Vec3f>& point
   const float t2 = static_cast<float>(tol_f * tol_f);
   // Cells small enough that their diagonal stays below t after rounding.
   const double edge = tolerance_mm / std::sqrt(3.0) * (1.0 - 1e-4);
-  std::unordered_map<Cell, int, CellHash> cell_id;
-  std::vector<std::vector<int>> members;
+  CellTable cell_id(points.size());
+  std::vector<int> cell_of(points.size(), -1);  // then the points cell by cell (CSR)
   std::vector<Cell> cells;
   for (size_t i = 0; i < points.size(); ++i) {
     const Vec3f& p = points[i];
@@ -86,43 +125,55 @@ std::vector<std::vector<int>> euclidean_clusters(const std::vector<Vec3f>& point
                                     " mm is too small for points " + std::to_string(p[a]) + " mm away");
       c[a] = static_cast<int>(v);
     }
-    const auto [it, added] = cell_id.emplace(Cell{c[0], c[1], c[2]}, static_cast<int>(members.size()));
-    if (added) {
-      members.emplace_back();
-      cells.push_back(Cell{c[0], c[1], c[2]});
-    }
-    members[static_cast<size_t>(it->second)].push_back(static_cast<int>(i));
+    bool added = false;
+    cell_of[i] = cell_id.insert(Cell{c[0], c[1], c[2]}, static_cast<int>(cells.size()), &added);
+    if (added) cells.push_back(Cell{c[0], c[1], c[2]});
   }
-  Components comp(members.size());
-  for (size_t a = 0; a < members.size(); ++a) {
+  // Each cell's points, in input order: start[a] .. start[a + 1] of `order`.
+  std::vector<int> start(cells.size() + 1, 0), order;
+  for (int k : cell_of)
+    if (k >= 0) ++start[static_cast<size_t>(k) + 1];
+  for (size_t a = 0; a < cells.size(); ++a) start[a + 1] += start[a];
+  order.resize(static_cast<size_t>(start.back()));
+  {
+    std::vector<int> next(start.begin(), start.end() - 1);
+    for (size_t i = 0; i < points.size(); ++i)
+      if (const int k = cell_of[i]; k >= 0)
+        order[static_cast<size_t>(next[static_cast<size_t>(k)]++)] = static_cast<int>(i);
+  }
+  const auto members = [&](size_t a) {
+    return std::make_pair(order.data() + start[a], order.data() + start[a + 1]);
+  };
+  Components comp(cells.size());
+  for (size_t a = 0; a < cells.size(); ++a) {
     const Cell& c = cells[a];
     for (int dx = -2; dx <= 2; ++dx)
       for (int dy = -2; dy <= 2; ++dy)
         for (int dz = -2; dz <= 2; ++dz) {
           // Each pair of cells once: the offset must be lexicographically positive.
           if (dx < 0 || (dx == 0 && (dy < 0 || (dy == 0 && dz <= 0)))) continue;
-          const auto it = cell_id.find(Cell{c.x + dx, c.y + dy, c.z + dz});
-          if (it == cell_id.end()) continue;
-          const int b = it->second;
+          const int b = cell_id.find(Cell{c.x + dx, c.y + dy, c.z + dz});
+          if (b < 0) continue;
           if (comp.find(static_cast<int>(a)) == comp.find(b)) continue;
           bool near = false;
-          for (int i : members[a]) {
-            for (int j : members[static_cast<size_t>(b)])
-              if (sq_dist(points[static_cast<size_t>(i)], points[static_cast<size_t>(j)]) < t2) {
+          const auto [ai, ae] = members(a);
+          const auto [bi, be] = members(static_cast<size_t>(b));
+          for (const int* i = ai; i != ae && !near; ++i)
+            for (const int* j = bi; j != be; ++j)
+              if (sq_dist(points[static_cast<size_t>(*i)], points[static_cast<size_t>(*j)]) < t2) {
                 near = true;
                 break;
               }
-            if (near) break;
-          }
           if (near) comp.join(static_cast<int>(a), b);
         }
   }
   std::unordered_map<int, size_t> cluster_of;  // component root -> out index
-  for (size_t a = 0; a < members.size(); ++a) {
+  for (size_t a = 0; a < cells.size(); ++a) {
     const auto [it, added] = cluster_of.emplace(comp.find(static_cast<int>(a)), out.size());
     if (added) out.emplace_back();
     std::vector<int>& cl = out[it->second];
-    cl.insert(cl.end(), members[a].begin(), members[a].end());
+    const auto [ai, ae] = members(a);
+    cl.insert(cl.end(), ai, ae);
   }
   const size_t lo = static_cast<size_t>(std::max(min_points, 1)), hi = static_cast<size_t>(std::max(max_points, 1));
   out.erase(std::remove_if(out.begin(), out.end(), [&](const auto& c) { return c.size() < lo || c.size() > hi; }),
