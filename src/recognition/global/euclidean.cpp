@@ -144,15 +144,39 @@ std::vector<std::vector<int>> euclidean_clusters(const std::vector<Vec3f>& point
   const auto members = [&](size_t a) {
     return std::make_pair(order.data() + start[a], order.data() + start[a + 1]);
   };
+  // The neighbour lookups: an array over the cells' box, padded by the two
+  // cells a neighbour may lie beyond it, where that box is small (a table
+  // scene's: tens of thousands of cells), so a neighbour is an offset
+  // away; else the table.
+  constexpr int64_t kDenseCells = int64_t(1) << 20;
+  int clo[3] = {cells.empty() ? 0 : cells[0].x, cells.empty() ? 0 : cells[0].y, cells.empty() ? 0 : cells[0].z};
+  int chi[3] = {clo[0], clo[1], clo[2]};
+  for (const Cell& c : cells) {
+    clo[0] = std::min(clo[0], c.x), chi[0] = std::max(chi[0], c.x);
+    clo[1] = std::min(clo[1], c.y), chi[1] = std::max(chi[1], c.y);
+    clo[2] = std::min(clo[2], c.z), chi[2] = std::max(chi[2], c.z);
+  }
+  const int64_t ex = int64_t(chi[0]) - clo[0] + 5, ey = int64_t(chi[1]) - clo[1] + 5, ez = int64_t(chi[2]) - clo[2] + 5;
+  const bool dense = ex * ey <= kDenseCells && ex * ey * ez <= kDenseCells;
+  std::vector<int> grid;
+  const auto at = [&](const Cell& c) {
+    return ((int64_t(c.z) - clo[2] + 2) * ey + (int64_t(c.y) - clo[1] + 2)) * ex + (int64_t(c.x) - clo[0] + 2);
+  };
+  if (dense) {
+    grid.assign(static_cast<size_t>(ex * ey * ez), -1);
+    for (size_t a = 0; a < cells.size(); ++a) grid[static_cast<size_t>(at(cells[a]))] = static_cast<int>(a);
+  }
   Components comp(cells.size());
   for (size_t a = 0; a < cells.size(); ++a) {
     const Cell& c = cells[a];
+    const int64_t here = dense ? at(c) : 0;
     for (int dx = -2; dx <= 2; ++dx)
       for (int dy = -2; dy <= 2; ++dy)
         for (int dz = -2; dz <= 2; ++dz) {
           // Each pair of cells once: the offset must be lexicographically positive.
           if (dx < 0 || (dx == 0 && (dy < 0 || (dy == 0 && dz <= 0)))) continue;
-          const int b = cell_id.find(Cell{c.x + dx, c.y + dy, c.z + dz});
+          const int b = dense ? grid[static_cast<size_t>(here + (int64_t(dz) * ey + dy) * ex + dx)]
+                              : cell_id.find(Cell{c.x + dx, c.y + dy, c.z + dz});
           if (b < 0) continue;
           if (comp.find(static_cast<int>(a)) == comp.find(b)) continue;
           bool near = false;
