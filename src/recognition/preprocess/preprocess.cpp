@@ -347,6 +347,7 @@ PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings&
                                   s.veil_angle_deg > 0 ? detail::veil_pixels(cloud, s.veil_angle_deg)
                                                        : std::vector<char>{},
                                   detail::RangeCutIsa::best, box);
+  ps.pixel.clear();  // no cell's nearest pixel wanted (preprocess.h)
   VoxelGridOptions grid{s.voxel_mm};
   grid.box = box;
   // Before the grid: the range-cut points, the widening's median over
