@@ -20,6 +20,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "recognition/cell_table.h"
 #include "recognition/global/internal.h"
 
 namespace pb::global {
@@ -49,57 +50,6 @@ inline float sq_dist(const Vec3f& a, const Vec3f& b) {
   return dx * dx + dy * dy + dz * dz;
 }
 
-struct Cell {
-  int x, y, z;
-  bool operator==(const Cell& o) const { return x == o.x && y == o.y && z == o.z; }
-};
-// The cells' ids by open addressing (linear probing, a power-of-two
-// capacity of at least twice the points, so never full): no allocation per
-// cell, and the 62 lookups of a cell's neighbours cost a probe or two each.
-// Which id a cell gets does not change the clusters (components, then
-// sorted).
-class CellTable {
- public:
-  explicit CellTable(size_t points) {
-    size_t cap = 64;
-    while (cap < 2 * points) cap *= 2;
-    keys_.resize(cap);
-    ids_.assign(cap, -1);
-  }
-  int find(const Cell& c) const {
-    for (size_t i = slot(c);; i = (i + 1) & (ids_.size() - 1)) {
-      if (ids_[i] < 0) return -1;
-      if (keys_[i] == c) return ids_[i];
-    }
-  }
-  // The id of c, `fresh` when c is new (then *added = true).
-  int insert(const Cell& c, int fresh, bool* added) {
-    size_t i = slot(c);
-    for (; ids_[i] >= 0; i = (i + 1) & (ids_.size() - 1))
-      if (keys_[i] == c) {
-        *added = false;
-        return ids_[i];
-      }
-    keys_[i] = c;
-    ids_[i] = fresh;
-    *added = true;
-    return fresh;
-  }
-
- private:
-  size_t slot(const Cell& c) const {
-    uint64_t h = (static_cast<uint64_t>(static_cast<uint32_t>(c.x)) * 73856093u) ^
-                 (static_cast<uint64_t>(static_cast<uint32_t>(c.y)) * 19349663u) ^
-                 (static_cast<uint64_t>(static_cast<uint32_t>(c.z)) * 83492791u);
-    h ^= h >> 33;
-    h *= 0xff51afd7ed558ccdull;
-    h ^= h >> 33;
-    return static_cast<size_t>(h) & (ids_.size() - 1);
-  }
-  std::vector<Cell> keys_;
-  std::vector<int> ids_;
-};
-
 }  // namespace
 
 std::vector<std::vector<int>> euclidean_clusters(const std::vector<Vec3f>& points, double tolerance_mm,
@@ -111,23 +61,25 @@ std::vector<std::vector<int>> euclidean_clusters(const std::vector<Vec3f>& point
   const float t2 = static_cast<float>(tol_f * tol_f);
   // Cells small enough that their diagonal stays below t after rounding.
   const double edge = tolerance_mm / std::sqrt(3.0) * (1.0 - 1e-4);
-  CellTable cell_id(points.size());
+  // The cells numbered as they first come (which number a cell gets does
+  // not change the clusters: components, then sorted).
+  CellTable<CellKey> cell_id(points.size() / 2);
   std::vector<int> cell_of(points.size(), -1);  // then the points cell by cell (CSR)
-  std::vector<Cell> cells;
+  std::vector<CellKey> cells;
   for (size_t i = 0; i < points.size(); ++i) {
     const Vec3f& p = points[i];
     if (!p.allFinite()) continue;  // in no cluster (the pipeline's clouds are finite)
-    int c[3];
+    CellKey c;
     for (int a = 0; a < 3; ++a) {
       const double v = std::floor(p[a] / edge);
       if (!(std::abs(v) < 1e9))
         throw std::invalid_argument("euclidean_clusters: a tolerance of " + std::to_string(tolerance_mm) +
                                     " mm is too small for points " + std::to_string(p[a]) + " mm away");
-      c[a] = static_cast<int>(v);
+      c[static_cast<size_t>(a)] = static_cast<int64_t>(v);
     }
     bool added = false;
-    cell_of[i] = cell_id.insert(Cell{c[0], c[1], c[2]}, static_cast<int>(cells.size()), &added);
-    if (added) cells.push_back(Cell{c[0], c[1], c[2]});
+    cell_of[i] = cell_id.find_or_insert(c, static_cast<int>(cells.size()), &added);
+    if (added) cells.push_back(c);
   }
   // Each cell's points, in input order: start[a] .. start[a + 1] of `order`.
   std::vector<int> start(cells.size() + 1, 0), order;
@@ -149,18 +101,14 @@ std::vector<std::vector<int>> euclidean_clusters(const std::vector<Vec3f>& point
   // scene's: tens of thousands of cells), so a neighbour is an offset
   // away; else the table.
   constexpr int64_t kDenseCells = int64_t(1) << 20;
-  int clo[3] = {cells.empty() ? 0 : cells[0].x, cells.empty() ? 0 : cells[0].y, cells.empty() ? 0 : cells[0].z};
-  int chi[3] = {clo[0], clo[1], clo[2]};
-  for (const Cell& c : cells) {
-    clo[0] = std::min(clo[0], c.x), chi[0] = std::max(chi[0], c.x);
-    clo[1] = std::min(clo[1], c.y), chi[1] = std::max(chi[1], c.y);
-    clo[2] = std::min(clo[2], c.z), chi[2] = std::max(chi[2], c.z);
-  }
-  const int64_t ex = int64_t(chi[0]) - clo[0] + 5, ey = int64_t(chi[1]) - clo[1] + 5, ez = int64_t(chi[2]) - clo[2] + 5;
+  CellKey clo = cells.empty() ? CellKey{} : cells[0], chi = clo;
+  for (const CellKey& c : cells)
+    for (size_t a = 0; a < 3; ++a) clo[a] = std::min(clo[a], c[a]), chi[a] = std::max(chi[a], c[a]);
+  const int64_t ex = chi[0] - clo[0] + 5, ey = chi[1] - clo[1] + 5, ez = chi[2] - clo[2] + 5;
   const bool dense = ex * ey <= kDenseCells && ex * ey * ez <= kDenseCells;
   std::vector<int> grid;
-  const auto at = [&](const Cell& c) {
-    return ((int64_t(c.z) - clo[2] + 2) * ey + (int64_t(c.y) - clo[1] + 2)) * ex + (int64_t(c.x) - clo[0] + 2);
+  const auto at = [&](const CellKey& c) {
+    return ((c[2] - clo[2] + 2) * ey + (c[1] - clo[1] + 2)) * ex + (c[0] - clo[0] + 2);
   };
   if (dense) {
     grid.assign(static_cast<size_t>(ex * ey * ez), -1);
@@ -168,7 +116,7 @@ std::vector<std::vector<int>> euclidean_clusters(const std::vector<Vec3f>& point
   }
   Components comp(cells.size());
   for (size_t a = 0; a < cells.size(); ++a) {
-    const Cell& c = cells[a];
+    const CellKey& c = cells[a];
     const int64_t here = dense ? at(c) : 0;
     for (int dx = -2; dx <= 2; ++dx)
       for (int dy = -2; dy <= 2; ++dy)
@@ -176,7 +124,7 @@ std::vector<std::vector<int>> euclidean_clusters(const std::vector<Vec3f>& point
           // Each pair of cells once: the offset must be lexicographically positive.
           if (dx < 0 || (dx == 0 && (dy < 0 || (dy == 0 && dz <= 0)))) continue;
           const int b = dense ? grid[static_cast<size_t>(here + (int64_t(dz) * ey + dy) * ex + dx)]
-                              : cell_id.find(Cell{c.x + dx, c.y + dy, c.z + dz});
+                              : cell_id.find(CellKey{c[0] + dx, c[1] + dy, c[2] + dz});
           if (b < 0) continue;
           if (comp.find(static_cast<int>(a)) == comp.find(b)) continue;
           bool near = false;

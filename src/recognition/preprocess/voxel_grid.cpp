@@ -8,30 +8,14 @@
 #include <limits>
 #include <memory>
 
+#include "recognition/cell_table.h"
 #include "recognition/preprocess/voxel_keys.h"
 
 namespace pb {
 
 namespace {
 
-using Key = std::array<int64_t, 3>;  // cell index, in sort priority order
-
-// The spatial hash of Teschner et al. 2003 (hash-table buckets only, never
-// persisted: the output order comes from sorting the keys), and a 64-bit
-// finalizer that folds the high bits in (the table masks keep the low ones).
-inline uint64_t key_hash(const Key& k) {
-  return (static_cast<uint64_t>(k[0]) * 73856093u) ^ (static_cast<uint64_t>(k[1]) * 19349663u) ^
-         (static_cast<uint64_t>(k[2]) * 83492791u);
-}
-inline uint64_t key_hash(uint64_t k) { return k; }
-template <class K>
-inline uint64_t mix(const K& k) {
-  uint64_t h = key_hash(k);
-  h ^= h >> 33;
-  h *= 0xff51afd7ed558ccdull;
-  h ^= h >> 33;
-  return h;
-}
+using Key = CellKey;  // cell index, in sort priority order
 
 // Points grouped by cell: cell_of[i] (or -1), cells numbered in order of
 // first appearance, the first point of each cell and its count; `order`
@@ -45,62 +29,14 @@ struct Cells {
   size_t size() const { return first.size(); }
 };
 
-// Open addressing over the cell keys (linear probing, power-of-two
-// capacity, grown at half load): no allocation per cell.
-template <class K>
-class KeyTable {
- public:
-  explicit KeyTable(size_t expected) {
-    size_t cap = 64;
-    while (cap < 2 * expected) cap *= 2;
-    keys_.resize(cap);
-    slots_.assign(cap, -1);
-  }
-  // The slot of k, inserting `fresh` when k is new (then *inserted = true).
-  int find_or_insert(const K& k, int fresh, bool* inserted) {
-    const uint64_t h = mix(k);
-    if (2 * (size_ + 1) > slots_.size()) grow();
-    size_t i = static_cast<size_t>(h) & (slots_.size() - 1);
-    *inserted = false;
-    while (slots_[i] >= 0 && !(keys_[i] == k)) i = (i + 1) & (slots_.size() - 1);
-    if (slots_[i] < 0) {
-      keys_[i] = k;
-      slots_[i] = fresh;
-      ++size_;
-      *inserted = true;
-    }
-    return slots_[i];
-  }
-
- private:
-  void grow() {
-    std::vector<K> keys;
-    std::vector<int> slots;
-    keys.swap(keys_);
-    slots.swap(slots_);
-    keys_.resize(2 * keys.size());
-    slots_.assign(2 * slots.size(), -1);
-    for (size_t j = 0; j < slots.size(); ++j) {
-      if (slots[j] < 0) continue;
-      size_t i = static_cast<size_t>(mix(keys[j])) & (slots_.size() - 1);
-      while (slots_[i] >= 0) i = (i + 1) & (slots_.size() - 1);
-      keys_[i] = keys[j];
-      slots_[i] = slots[j];
-    }
-  }
-  std::vector<K> keys_;
-  std::vector<int> slots_;
-  size_t size_ = 0;
-};
-
-// KeyTable for keys of at most 32 bits (the packed keys of image-sized
+// CellTable for keys of at most 32 bits (the packed keys of image-sized
 // grids): key and slot side by side in one 8-byte entry, so a probe touches
 // one cache line (a table frame's 50,000 cells: 1 MB of entries instead of
 // 1.5 MB in two arrays). An empty entry has slot -1 (the high half all
 // ones).
-class KeyTable32 {
+class CellTable32 {
  public:
-  explicit KeyTable32(size_t expected) {
+  explicit CellTable32(size_t expected) {
     size_t cap = 64;
     while (cap < 2 * expected) cap *= 2;
     entries_.assign(cap, kEmpty);
@@ -108,7 +44,7 @@ class KeyTable32 {
   int find_or_insert(uint64_t key, int fresh, bool* inserted) {
     if (2 * (size_ + 1) > entries_.size()) grow();
     const uint32_t k = static_cast<uint32_t>(key);
-    size_t i = static_cast<size_t>(mix(key)) & (entries_.size() - 1);
+    size_t i = static_cast<size_t>(cell_mix(key)) & (entries_.size() - 1);
     *inserted = false;
     for (;; i = (i + 1) & (entries_.size() - 1)) {
       const uint64_t e = entries_[i];
@@ -128,7 +64,7 @@ class KeyTable32 {
     old.swap(entries_);
     for (const uint64_t e : old) {
       if (e == kEmpty) continue;
-      size_t i = static_cast<size_t>(mix(static_cast<uint64_t>(static_cast<uint32_t>(e)))) & (entries_.size() - 1);
+      size_t i = static_cast<size_t>(cell_mix(static_cast<uint64_t>(static_cast<uint32_t>(e)))) & (entries_.size() - 1);
       while (entries_[i] != kEmpty) i = (i + 1) & (entries_.size() - 1);
       entries_[i] = e;
     }
@@ -143,7 +79,7 @@ class KeyTable32 {
 // only then in the hash table. (A guess from the cell last seen in the
 // point's pixel column, tried before the table, cost more than the lookups
 // it saved: a simulated Astra table frame 5.3 -> 4.8 ms without it.)
-template <class K, class Table = KeyTable<K>, class KeyOf, class Skip>
+template <class K, class Table = CellTable<K>, class KeyOf, class Skip>
 Cells group_by(size_t n, KeyOf key_of, Skip skip, std::vector<K>& keys) {
   Cells c;
   c.cell_of.assign(n, -1);
@@ -257,7 +193,7 @@ Cells group(const std::vector<Vec3f>& pts, const VoxelGridOptions& opt) {
     const int bits = width[0] + width[1] + width[2];
     const auto key_of = [&](size_t i) { return point_key[i]; };
     const auto skip = [&](size_t i) { return point_key[i] == detail::kNoCell; };
-    Cells c = bits <= 32 ? group_by<uint64_t, KeyTable32>(n, key_of, skip, keys)
+    Cells c = bits <= 32 ? group_by<uint64_t, CellTable32>(n, key_of, skip, keys)
                          : group_by<uint64_t>(n, key_of, skip, keys);
     sorted_order(keys, bits, c.order);
     return c;
