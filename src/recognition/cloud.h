@@ -16,7 +16,7 @@ struct PointSet {
   std::vector<Vec3f> points;
   std::vector<Vec3f> normals;    // unit, oriented toward the viewpoint; may be empty
   std::vector<float> curvature;  // surface variation; may be empty
-  std::vector<int> pixel;        // may be empty
+  std::vector<int> pixel;        // may be empty (a preprocessed scene keeps none: preprocess.h)
   int source_width = 0, source_height = 0;
 
   size_t size() const { return points.size(); }
