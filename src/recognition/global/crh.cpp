@@ -22,8 +22,9 @@ constexpr int kSteps = 360;          // the correlation's samples: one degree
 
 // cos(k th) and sin(k th) at th = 2 pi j / kSteps, for every sample j and
 // harmonic k (row j): the correlation's terms depend on the spectra only
-// through their weights, so the 33,000 cosines and sines are computed once
-// per process, by the same expressions (the same bits), not per call.
+// through their weights, so the 16,560 cosines and as many sines are
+// computed once per process, by the same expressions (the same bits), not
+// per call.
 struct Harmonics {
   std::vector<double> c, s;
   Harmonics() : c(kSteps * (kHarm + 1)), s(kSteps * (kHarm + 1)) {
