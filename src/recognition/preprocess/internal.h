@@ -83,6 +83,11 @@ enum class RangeCutIsa { best, scalar };
 PointSet range_cut(const OrganizedCloud& cloud, double min_z, double max_z, const std::vector<char>& drop = {},
                    RangeCutIsa isa = RangeCutIsa::best, float* box = nullptr);
 
+// The pixels of every n-th column of every n-th row (n >= 1), and their
+// `drop` flags thinned alike (when not empty): an organized cloud of
+// ceil(width / n) x ceil(height / n) pixels.
+OrganizedCloud every_nth_pixel(const OrganizedCloud& cloud, int n, std::vector<char>& drop);
+
 // Keeps the points whose flag is set (all per-point arrays).
 PointSet select(const PointSet& in, const std::vector<char>& keep);
 

@@ -343,11 +343,14 @@ void remove_planes(PointSet& ps, const OrganizedCloud& cloud, const PreprocessSe
 
 PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings& s, uint64_t seed) {
   float box[6];  // the range cut's points' box, which the grid needs first
-  PointSet ps = detail::range_cut(cloud, s.min_range_mm, s.max_range_mm,
-                                  s.veil_angle_deg > 0 ? detail::veil_pixels(cloud, s.veil_angle_deg)
-                                                       : std::vector<char>{},
+  std::vector<char> veil = s.veil_angle_deg > 0 ? detail::veil_pixels(cloud, s.veil_angle_deg) : std::vector<char>{};
+  OrganizedCloud thinned;  // pixel_stride > 1: the pixels the cut reads (the veil found on all of them)
+  if (s.pixel_stride > 1) thinned = detail::every_nth_pixel(cloud, s.pixel_stride, veil);
+  PointSet ps = detail::range_cut(s.pixel_stride > 1 ? thinned : cloud, s.min_range_mm, s.max_range_mm, veil,
                                   detail::RangeCutIsa::best, box);
   ps.pixel.clear();  // no cell's nearest pixel wanted (preprocess.h)
+  ps.source_width = cloud.width;
+  ps.source_height = cloud.height;
   VoxelGridOptions grid{s.voxel_mm};
   grid.box = box;
   // Before the grid: the range-cut points, the widening's median over

@@ -140,6 +140,23 @@ __attribute__((target("avx2"))) size_t cut_avx2(const OrganizedCloud& cloud, dou
 
 }  // namespace
 
+OrganizedCloud every_nth_pixel(const OrganizedCloud& cloud, int n, std::vector<char>& drop) {
+  OrganizedCloud out;
+  out.width = (cloud.width + n - 1) / n;
+  out.height = (cloud.height + n - 1) / n;
+  out.points.reserve(static_cast<size_t>(out.width) * static_cast<size_t>(out.height));
+  std::vector<char> kept;
+  if (!drop.empty()) kept.reserve(out.points.capacity());
+  for (int y = 0; y < cloud.height; y += n)
+    for (int x = 0; x < cloud.width; x += n) {
+      const size_t i = static_cast<size_t>(y) * static_cast<size_t>(cloud.width) + static_cast<size_t>(x);
+      out.points.push_back(cloud.points[i]);
+      if (!drop.empty()) kept.push_back(drop[i]);
+    }
+  drop.swap(kept);
+  return out;
+}
+
 PointSet range_cut(const OrganizedCloud& cloud, double min_z, double max_z, const std::vector<char>& drop,
                    RangeCutIsa isa, float* box) {
   PointSet ps;
