@@ -426,6 +426,70 @@ TEST_F(TableScenePreprocess, RemovesTheTableKeepsTheObjectWithOrientedNormals) {
   }
 }
 
+// pixel_stride n: the range cut reads every n-th pixel of every n-th row.
+// Where a voxel is many pixels wide (640 x 480 at 0.7 m: 10 mm is about 10
+// pixels, as the warehouse's 20 mm at 1-1.5 m) the grid's cells are
+// centroids of fewer samples of the same surfaces: about as many cells,
+// each within a voxel of one from every pixel, the table still gone. (At
+// 320 x 240, 5 pixels a voxel, stride 2 loses a fifth of the cells: those
+// the object's outline barely enters.)
+TEST_F(TableScenePreprocess, PixelStrideKeepsTheObjectsCells) {
+  pbtest::TableSceneOptions o;
+  o.width = 640;
+  o.height = 480;
+  const pbtest::TableScene scene = pbtest::render_table_scene(*mesh_, o);
+  const pb::OrganizedCloud cloud = pb::OrganizedCloud::from_depth(scene.depth, scene.K);
+  pb::PreprocessSettings s;
+  const PointSet all = pb::preprocess_scene(cloud, s, 5);
+  s.pixel_stride = 2;
+  const PointSet thin = pb::preprocess_scene(cloud, s, 5);
+  ASSERT_GT(all.size(), 50u);
+  EXPECT_NEAR(static_cast<double>(thin.size()), static_cast<double>(all.size()), 0.15 * all.size());
+  EXPECT_NE(thin.points, all.points);
+  EXPECT_EQ(thin.source_width, 640);
+  EXPECT_EQ(thin.source_height, 480);
+  ASSERT_TRUE(thin.has_normals());
+  size_t near = 0;
+  for (const Vec3f& p : thin.points) {
+    float best = std::numeric_limits<float>::max();
+    for (const Vec3f& q : all.points) best = std::min(best, (p - q).norm());
+    near += best <= static_cast<float>(s.voxel_mm);
+  }
+  EXPECT_GE(near, thin.size() * 97 / 100);
+  const pb::Pose T_model_cam = scene.T_cam_model.inverse();
+  Eigen::AlignedBox3f box = mesh_->bounds();
+  box.min() -= Vec3f::Constant(12.f);
+  box.max() += Vec3f::Constant(12.f);
+  size_t on_object = 0;
+  for (const Vec3f& p : thin.points)
+    on_object += box.contains((T_model_cam.R * p.cast<double>() + T_model_cam.t).cast<float>());
+  EXPECT_GE(on_object, thin.size() * 97 / 100);
+}
+
+// every_nth_pixel: the pixels (x, y) with x and y multiples of n, in pixel
+// order, and their drop flags alike.
+TEST(Preprocess, EveryNthPixelThinsPointsAndFlagsAlike) {
+  pb::OrganizedCloud c;
+  c.width = 5;
+  c.height = 3;
+  std::vector<char> drop;
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 5; ++x) {
+      c.points.emplace_back(static_cast<float>(x), static_cast<float>(y), 1000.f);
+      drop.push_back(static_cast<char>(x == 4 && y == 2));
+    }
+  std::vector<char> flags = drop;
+  const pb::OrganizedCloud t = pb::detail::every_nth_pixel(c, 2, flags);
+  ASSERT_EQ(t.width, 3);
+  ASSERT_EQ(t.height, 2);
+  const std::vector<Vec3f> want = {{0, 0, 1000}, {2, 0, 1000}, {4, 0, 1000}, {0, 2, 1000}, {2, 2, 1000}, {4, 2, 1000}};
+  EXPECT_EQ(t.points, want);
+  EXPECT_EQ(flags, (std::vector<char>{0, 0, 0, 0, 0, 1}));
+  std::vector<char> none;
+  EXPECT_EQ(pb::detail::every_nth_pixel(c, 1, none).points, c.points);
+  EXPECT_TRUE(none.empty());
+}
+
 TEST_F(TableScenePreprocess, SameBitsWithOneAndTwoThreads) {
   const pb::OrganizedCloud cloud = pb::OrganizedCloud::from_depth(scene_->depth, scene_->K);
   pb::PreprocessSettings s;
