@@ -129,6 +129,22 @@ void preprocess_scene_bench(benchmark::State& st, bool planes_first) {
 void BM_PreprocessScene(benchmark::State& st) { preprocess_scene_bench(st, false); }
 void BM_PreprocessScenePlanesFirst(benchmark::State& st) { preprocess_scene_bench(st, true); }
 
+// The whole preprocess_scene reading every n-th pixel of every n-th row
+// (preprocess.pixel_stride; the bench's warehouse takes 2), with the range
+// cut's points (cut) and the grid's cells before the planes (cells).
+void BM_PreprocessSceneStride(benchmark::State& st) {
+  const Frame& f = frame(static_cast<int>(st.range(0)));
+  const OrganizedCloud c = OrganizedCloud::from_depth(f.depth, f.K);
+  PreprocessSettings s = f.s;
+  s.pixel_stride = static_cast<int>(st.range(1));
+  size_t n = 0;
+  for (auto _ : st) n = preprocess_scene(c, s, 1).size();
+  st.counters["points"] = static_cast<double>(n);
+  PreprocessSettings grid_only = s;
+  grid_only.remove_plane = false;
+  st.counters["cells"] = static_cast<double>(preprocess_scene(c, grid_only, 1).size());
+}
+
 void Args(benchmark::internal::Benchmark* b) {
   b->Arg(0)->Arg(1)->ArgName("warehouse")->Unit(benchmark::kMillisecond);
 }
@@ -142,5 +158,9 @@ BENCHMARK(BM_Normals)->Apply(Args);
 BENCHMARK(BM_KdTreeBuild)->Apply(Args);
 BENCHMARK(BM_PreprocessScene)->Apply(Args);
 BENCHMARK(BM_PreprocessScenePlanesFirst)->Apply(Args);
+BENCHMARK(BM_PreprocessSceneStride)
+    ->ArgsProduct({{0, 1}, {1, 2}})
+    ->ArgNames({"warehouse", "stride"})
+    ->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

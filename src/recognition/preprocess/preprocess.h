@@ -21,9 +21,10 @@ struct PreprocessSettings {
   int pixel_stride = 1;             // the range cut reads every n-th pixel of every n-th row (1 =
                                     // every pixel): the voxel grid then averages about n^2 times
                                     // fewer samples per cell. For cells many pixels wide (the
-                                    // warehouse's 20 mm at 1-1.5 m: about 9 pixels). The plane's
-                                    // noise estimate still reads every pixel. Measured:
-                                    // results/bench/README.md, thirty-seventh round
+                                    // warehouse's 20 mm: 4-10 pixels where its objects stand, 2-5 m
+                                    // away). The veil filter and the plane's noise estimate still
+                                    // read every pixel. Measured: results/bench/README.md,
+                                    // thirty-seventh round
   double voxel_mm = 10.0;           // downsampling voxel (Table 4.2: 20 warehouse, 10 table)
   bool remove_plane = true;         // remove the dominant plane (floor / table)
   double plane_threshold_mm = 10.0; // RANSAC inlier distance for the plane
