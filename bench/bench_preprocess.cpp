@@ -130,8 +130,9 @@ void BM_PreprocessScene(benchmark::State& st) { preprocess_scene_bench(st, false
 void BM_PreprocessScenePlanesFirst(benchmark::State& st) { preprocess_scene_bench(st, true); }
 
 // The whole preprocess_scene reading every n-th pixel of every n-th row
-// (preprocess.pixel_stride; the bench's warehouse takes 2), with the range
-// cut's points (cut) and the grid's cells before the planes (cells).
+// (preprocess.pixel_stride; the bench's warehouse takes 2). Counters: what
+// preprocessing leaves (points) and the grid's cells before the planes
+// (cells).
 void BM_PreprocessSceneStride(benchmark::State& st) {
   const Frame& f = frame(static_cast<int>(st.range(0)));
   const OrganizedCloud c = OrganizedCloud::from_depth(f.depth, f.K);

@@ -18,8 +18,9 @@ struct PreprocessSettings {
                                     // also the edge's last pixel on each side). 0 = off, as the thesis
                                     // (which describes no such filter). Measured on the Kinect One
                                     // rows: results/thesis/FINDINGS.md
-  int pixel_stride = 1;             // the range cut reads every n-th pixel of every n-th row (1 =
-                                    // every pixel): the voxel grid then averages about n^2 times
+  int pixel_stride = 1;             // a scene's range cut reads every n-th pixel of every n-th row
+                                    // (1 = every pixel; training views always read every pixel):
+                                    // the voxel grid then averages about n^2 times
                                     // fewer samples per cell. For cells many pixels wide (the
                                     // warehouse's 20 mm: 4-10 pixels where its objects stand, 2-5 m
                                     // away). The veil filter and the plane's noise estimate still
