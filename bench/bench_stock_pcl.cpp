@@ -26,7 +26,8 @@
 // machine), *_found (translation error to the ground truth < 50 mm),
 // *_t_err_mm, *_hyps (hypotheses refined), ours_<stage>_ms (ours per stage:
 // pre(process), desc(ribe), match, group (with the initial pose), refine,
-// verify). The Time column is ours + stock.
+// verify), stock_<stage>_ms (stock's: pre, hyp (describe to initial pose),
+// refine (ICP and the inlier counts)). The Time column is ours + stock.
 // The process keeps freed memory (core/memory.h, as a `posebench run`
 // worker does; bench/keep_freed_memory.cpp), for both sides: it took ours'
 // preprocessing from 9-13 ms to 8 ms here and left stock's times within
@@ -178,15 +179,23 @@ struct Outcome {
   bool ok = false;
   Mat4 T = Mat4::Identity();  // T_cam_model, metres
   size_t hypotheses = 0;
+  double pre_s = 0, hyp_s = 0, refine_s = 0;  // stage times (refine: ICP and the inlier counts)
 };
 
 // Online: depth image -> preprocessed scene -> hypotheses -> ICP -> inliers.
 Outcome recognize(const pb::DepthImage& depth, const pb::Intrinsics& K, const Model& m,
                   const pb::RecognitionSettings& s) {
+  using Clock = std::chrono::steady_clock;
+  const auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
   Outcome o;
+  auto t = Clock::now();
   const Prepared scene = preprocess(depth_to_cloud(depth, K), s.preprocess, true);
+  o.pre_s = since(t);
   if (scene.cloud->size() < 3) return o;
+  t = Clock::now();
   const std::vector<Hyp> hyps = m.method->hypothesize(scene);
+  o.hyp_s = since(t);
+  t = Clock::now();
   o.hypotheses = hyps.size();
   // Verification: pcl::KdTreeFLANN over the scene; an inlier is a model
   // point within inlier_threshold of its nearest scene point.
@@ -220,6 +229,7 @@ Outcome recognize(const pb::DepthImage& depth, const pb::Intrinsics& K, const Mo
       o.T = icp.getFinalTransformation();
     }
   }
+  o.refine_s = since(t);
   return o;
 }
 
@@ -307,6 +317,7 @@ void BM_StockVsOurs(benchmark::State& state, const std::string& descriptor) {
   stock::Outcome st = stock::recognize(f.depth, f.K, *m.stock, s);
   double ours_s = 0, stock_s = 0, ours_cpu = 0, stock_cpu = 0;
   StageTimes ours_stages;  // summed over the iterations
+  double stock_pre = 0, stock_hyp = 0, stock_refine = 0;
   for (auto _ : state) {
     const auto t0 = Clock::now();
     const std::clock_t c0 = std::clock();
@@ -327,6 +338,9 @@ void BM_StockVsOurs(benchmark::State& state, const std::string& descriptor) {
     ours_stages.refine += ours.times.refine;
     ours_stages.verify += ours.times.verify;
     stock_s += b;
+    stock_pre += st.pre_s;
+    stock_hyp += st.hyp_s;
+    stock_refine += st.refine_s;
     ours_cpu += double(c1 - c0) / CLOCKS_PER_SEC;
     stock_cpu += double(c2 - c1) / CLOCKS_PER_SEC;
     state.SetIterationTime(a + b);
@@ -354,6 +368,11 @@ void BM_StockVsOurs(benchmark::State& state, const std::string& descriptor) {
   state.counters["ours_refine_ms"] = 1e3 * ours_stages.refine / n;
   state.counters["ours_verify_ms"] = 1e3 * ours_stages.verify / n;
   state.counters["stock_hyps"] = double(st.hypotheses);
+  // Stock per stage: preprocessing, hypotheses (describe, match, group and
+  // initial pose), refinement with the inlier counts (ours: refine + verify).
+  state.counters["stock_pre_ms"] = 1e3 * stock_pre / n;
+  state.counters["stock_hyp_ms"] = 1e3 * stock_hyp / n;
+  state.counters["stock_refine_ms"] = 1e3 * stock_refine / n;
 }
 
 void Configure(benchmark::internal::Benchmark* b) { b->UseManualTime()->Unit(benchmark::kMillisecond); }
