@@ -3,8 +3,10 @@
 // whose components are close to the tolerance apart: the same clusters, in
 // the same order, for tolerances from under a point spacing to many spacings,
 // with the size limits applied as PCL applies them. The neighbour lookups go
-// through both of their structures: at 6, 11 and 15 mm the cells' box spans more
-// than 2^20 cells (the hashed table), from 24 mm on fewer (the array).
+// through their three structures: on the blobs, at 6, 11 and 15 mm the
+// cells' box spans more than 2^20 cells (the cells by column), from 24 mm on
+// fewer (the array); with a copy of the blobs 20 m away, at 6, 11 and 15 mm
+// the box's x-y extent spans more than 2^22 columns (the hashed table).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -37,8 +39,10 @@ std::vector<Vec3f> blobs(uint64_t seed) {
 }
 
 TEST(GlobalClusters, SameAsPcl) {
-  for (uint64_t seed : {1, 2, 3}) {
-    const std::vector<Vec3f> pts = blobs(seed);
+  for (uint64_t seed : {1, 2, 3, 4}) {
+    std::vector<Vec3f> pts = blobs(seed);
+    if (seed == 4)
+      for (const Vec3f& p : blobs(5)) pts.push_back(p + Vec3f(20000.f, 20000.f, 0.f));
     for (double tol : {6.0, 11.0, 15.0, 24.0, 47.0, 130.0}) {
       for (auto [lo, hi] : {std::pair{1, 1000000}, std::pair{20, 150}}) {
         const auto ours = global::euclidean_clusters(pts, tol, lo, hi);
