@@ -5,8 +5,9 @@
 // with the size limits applied as PCL applies them. The neighbour lookups go
 // through their three structures: on the blobs, at 6, 11 and 15 mm the
 // cells' box spans more than 2^20 cells (the cells by column), from 24 mm on
-// fewer (the array); with a copy of the blobs 20 m away, at 6, 11 and 15 mm
-// the box's x-y extent spans more than 2^22 columns (the hashed table).
+// fewer (the array); with a copy of the blobs 20 m away, from 6 to 47 mm
+// the box's x-y extent spans more than 2^18 columns and 16 per cell (the
+// hashed table), at 130 mm fewer (the columns).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -98,12 +98,12 @@ Cells cells_of(const std::vector<Vec3f>& points, double edge, double tolerance_m
 // pair once (the offset from a to b lexicographically positive). Where the
 // cells' box, padded by the two cells a neighbour may lie beyond it, is
 // small (at most 2^20 cells), an array over it, so a neighbour is an
-// offset away. Else, where the box has at most 2^22 columns (x-y), the
-// cells by column, each column's sorted by z: a neighbour lies in one of 13
-// columns within two steps in z. Else the hashed table. The same pairs of
-// cells whichever it is, so the same components. (On 24 table_astra frames
-// with CVFH's settings, the scene's box held 0.1-7.4 million cells in
-// 1,700-37,000 columns: its far points make it large.)
+// offset away. Else, where the box has at most 2^18 x-y columns (or 16
+// per cell), the cells by column, each column's sorted by z: a neighbour
+// lies in one of 13 columns within two steps in z. Else the hashed table.
+// The same pairs of cells whichever it is, so the same components. (On 24
+// table_astra frames with CVFH's settings, the scene's box held 0.1-7.4
+// million cells in 1,700-37,000 columns: its far points make it large.)
 class Neighbours {
  public:
   explicit Neighbours(const Cells& cells) : cells_(cells) {
@@ -118,7 +118,7 @@ class Neighbours {
       kind_ = Kind::kDense;
       grid_.assign(static_cast<size_t>(ex_ * ey_ * ez), -1);
       for (size_t a = 0; a < keys.size(); ++a) grid_[static_cast<size_t>(at(keys[a]))] = static_cast<int>(a);
-    } else if (ex_ * ey_ <= kColumns) {
+    } else if (ex_ * ey_ <= std::max(kColumns, 16 * static_cast<int64_t>(keys.size()))) {
       kind_ = Kind::kColumns;
       grid_.assign(static_cast<size_t>(ex_ * ey_ + 1), 0);  // each column's start in column_cells_
       for (const CellKey& c : keys) ++grid_[static_cast<size_t>(column(c)) + 1];
@@ -162,7 +162,9 @@ class Neighbours {
   }
 
  private:
-  static constexpr int64_t kDenseCells = int64_t(1) << 20, kColumns = int64_t(1) << 22;
+  // The array's and the columns' limits: their set-up (an array of that
+  // many ints, cleared) stays small next to the lookups it saves.
+  static constexpr int64_t kDenseCells = int64_t(1) << 20, kColumns = int64_t(1) << 18;
   enum class Kind { kDense, kColumns, kHashed };
   int64_t at(const CellKey& c) const {
     return ((c[2] - lo_[2] + 2) * ey_ + (c[1] - lo_[1] + 2)) * ex_ + (c[0] - lo_[0] + 2);
