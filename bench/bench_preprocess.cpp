@@ -115,35 +115,29 @@ void BM_KdTreeBuild(benchmark::State& st) {
 }
 
 // The whole preprocess_scene at the frame's settings, the planes removed
-// after the grid (default) or before it (preprocess.planes_before_grid).
-void preprocess_scene_bench(benchmark::State& st, bool planes_first) {
+// after the grid (default) or before it (preprocess.planes_before_grid),
+// reading every `stride`-th pixel of every `stride`-th row
+// (preprocess.pixel_stride; the bench's warehouse takes 2). Counters: what
+// preprocessing leaves (points) and, where asked, the grid's cells before
+// the planes (cells).
+void preprocess_scene_bench(benchmark::State& st, bool planes_first, int stride, bool count_cells) {
   const Frame& f = frame(static_cast<int>(st.range(0)));
   const OrganizedCloud c = OrganizedCloud::from_depth(f.depth, f.K);
   PreprocessSettings s = f.s;
   s.planes_before_grid = planes_first;
+  s.pixel_stride = stride;
   size_t n = 0;
   for (auto _ : st) n = preprocess_scene(c, s, 1).size();
   st.counters["points"] = static_cast<double>(n);
+  if (!count_cells) return;
+  s.remove_plane = false;
+  st.counters["cells"] = static_cast<double>(preprocess_scene(c, s, 1).size());
 }
 
-void BM_PreprocessScene(benchmark::State& st) { preprocess_scene_bench(st, false); }
-void BM_PreprocessScenePlanesFirst(benchmark::State& st) { preprocess_scene_bench(st, true); }
-
-// The whole preprocess_scene reading every n-th pixel of every n-th row
-// (preprocess.pixel_stride; the bench's warehouse takes 2). Counters: what
-// preprocessing leaves (points) and the grid's cells before the planes
-// (cells).
+void BM_PreprocessScene(benchmark::State& st) { preprocess_scene_bench(st, false, 1, false); }
+void BM_PreprocessScenePlanesFirst(benchmark::State& st) { preprocess_scene_bench(st, true, 1, false); }
 void BM_PreprocessSceneStride(benchmark::State& st) {
-  const Frame& f = frame(static_cast<int>(st.range(0)));
-  const OrganizedCloud c = OrganizedCloud::from_depth(f.depth, f.K);
-  PreprocessSettings s = f.s;
-  s.pixel_stride = static_cast<int>(st.range(1));
-  size_t n = 0;
-  for (auto _ : st) n = preprocess_scene(c, s, 1).size();
-  st.counters["points"] = static_cast<double>(n);
-  PreprocessSettings grid_only = s;
-  grid_only.remove_plane = false;
-  st.counters["cells"] = static_cast<double>(preprocess_scene(c, grid_only, 1).size());
+  preprocess_scene_bench(st, false, static_cast<int>(st.range(1)), true);
 }
 
 void Args(benchmark::internal::Benchmark* b) {
