@@ -40,7 +40,7 @@ struct Intrinsics {
 
   Mat3 K() const;
   static Intrinsics from_K(const Mat3& K, int width, int height);
-  // Square pixels from a horizontal and vertical field of view in degrees;
+  // Focal lengths from a horizontal and a vertical field of view (deg);
   // the principal point at the image centre ((w-1)/2, (h-1)/2).
   static Intrinsics from_fov(int width, int height, double hfov_deg, double vfov_deg);
   // Projects a camera-frame point (mm) to pixel coordinates.

@@ -73,6 +73,30 @@ SensorProfile sensor_profile(const std::string& name, const std::string& file, c
   return s;
 }
 
+Intrinsics parse_intrinsics(const YamlNode& node, const Intrinsics& base) {
+  Intrinsics K = base;
+  K.width = base.width > 0 ? node.get_or<int>("width", base.width) : node.get<int>("width");
+  K.height = base.height > 0 ? node.get_or<int>("height", base.height) : node.get<int>("height");
+  if (K.width < 1 || K.width > 16384) node["width"].fail("must be 1..16384");
+  if (K.height < 1 || K.height > 16384) node["height"].fail("must be 1..16384");
+  const bool focal = node.has("fx") || node.has("fy");
+  const bool fov = node.has("hfov_deg") || node.has("vfov_deg");
+  if (focal && fov) node.fail("give either fx, fy or hfov_deg, vfov_deg, not both");
+  if (fov) {
+    K = Intrinsics::from_fov(K.width, K.height, fov_deg(node, "hfov_deg"), fov_deg(node, "vfov_deg"));
+  } else {
+    K.fx = base.fx > 0 ? node.get_or<double>("fx", base.fx) : node.get<double>("fx");
+    K.fy = base.fy > 0 ? node.get_or<double>("fy", base.fy) : node.get<double>("fy");
+  }
+  // The principal point: given, else the base's for an image of its size,
+  // else the image centre.
+  const bool same_size = K.width == base.width && K.height == base.height;
+  K.cx = node.get_or<double>("cx", same_size ? base.cx : 0.5 * (K.width - 1));
+  K.cy = node.get_or<double>("cy", same_size ? base.cy : 0.5 * (K.height - 1));
+  check_intrinsics(node, K);
+  return K;
+}
+
 SensorProfile parse_sensor(const YamlNode& node) {
   if (!node.defined()) node.fail("missing sensor (a name or a map of intrinsics)");
   if (node.is_scalar()) {
@@ -86,32 +110,18 @@ SensorProfile parse_sensor(const YamlNode& node) {
                               node.has("cx") || node.has("cy") || node.has("hfov_deg") || node.has("vfov_deg");
   SensorProfile s;
   const std::string name = node.get_or<std::string>("name", "custom");
-  if (!has_intrinsics) {
-    if (!is_builtin(name)) node["name"].fail(unknown_sensor(name));
+  if (is_builtin(name)) {
+    // A built-in profile, with other optics or ranges where the map gives them.
     s = sensor_profile(name, node.file(), node["name"].path());
+    if (has_intrinsics) s.K = parse_intrinsics(node, s.K);
   } else {
+    if (!has_intrinsics) node["name"].fail(unknown_sensor(name));
     s.name = name;
     s.noise.model = "gaussian";
     s.min_range_mm = 100;
     s.max_range_mm = 6500;
     s.depth_scale = 0.1;
-    Intrinsics& K = s.K;
-    K.width = node.get<int>("width");
-    K.height = node.get<int>("height");
-    if (K.width < 1 || K.width > 16384) node["width"].fail("must be 1..16384");
-    if (K.height < 1 || K.height > 16384) node["height"].fail("must be 1..16384");
-    const bool focal = node.has("fx") || node.has("fy");
-    const bool fov = node.has("hfov_deg") || node.has("vfov_deg");
-    if (focal && fov) node.fail("give either fx, fy or hfov_deg, vfov_deg, not both");
-    if (fov) {
-      K = Intrinsics::from_fov(K.width, K.height, fov_deg(node, "hfov_deg"), fov_deg(node, "vfov_deg"));
-    } else {
-      K.fx = node.get<double>("fx");
-      K.fy = node.get<double>("fy");
-    }
-    K.cx = node.get_or<double>("cx", 0.5 * (K.width - 1));
-    K.cy = node.get_or<double>("cy", 0.5 * (K.height - 1));
-    check_intrinsics(node, K);
+    s.K = parse_intrinsics(node, Intrinsics{});
   }
   s.depth_scale = node.get_positive("depth_scale", s.depth_scale);
   s.min_range_mm = node.get_nonnegative("min_range_mm", s.min_range_mm);

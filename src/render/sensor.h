@@ -125,9 +125,17 @@ SensorProfile sensor_profile(const std::string& name, const std::string& file = 
 // A `sensor:` YAML node: either a name or a map {name, width, height, fx, fy,
 // cx, cy, depth_scale, min_range_mm, max_range_mm} (custom intrinsics; instead
 // of fx, fy also hfov_deg, vfov_deg; cx, cy default to the image centre). A
-// map naming a built-in profile without intrinsics overrides its ranges and
-// depth_scale. A custom sensor's default noise is gaussian 1 mm.
+// map naming a built-in profile starts from it (noise model, ranges,
+// depth_scale, intrinsics) and replaces what the map gives: for example
+// {name: kinect_one, fx: 365, fy: 365} is the Kinect One's time-of-flight
+// sensor with the real Kinect v2's optics (70.6 x 60 deg) instead of Table
+// 2.1's 57 x 43 deg. A custom sensor's default noise is gaussian 1 mm.
 SensorProfile parse_sensor(const YamlNode& node);
+// Intrinsics from a YAML map {width, height, fx, fy | hfov_deg, vfov_deg, cx,
+// cy}, each key defaulting to `base`'s (required where `base` has none; cx,
+// cy to the image centre when the size differs from base's). InputError
+// naming the file and the field on a bad value.
+Intrinsics parse_intrinsics(const YamlNode& node, const Intrinsics& base);
 // A `noise:` YAML node: a model name, or a map {model, sigma_mm (gaussian);
 // baseline_mm, disparity_step_px, disparity_sigma_px, smoothing_radius_px,
 // smoothing_edge_px, max_incidence_deg, shadows (structured_light);

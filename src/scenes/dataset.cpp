@@ -44,7 +44,7 @@ void write_models_and_camera(const fs::path& tmp, const SceneGenerator& gen) {
     infos[m.obj_id] = m.info;
   }
   write_models_info((tmp / "models" / "models_info.json").string(), infos);
-  write_camera_json((tmp / "camera.json").string(), s.sensor.K, s.depth_scale);
+  write_camera_json((tmp / "camera.json").string(), dataset_intrinsics(s), s.depth_scale);
 }
 
 // One image's result kept for the scene files and the trace.

@@ -339,6 +339,10 @@ void SceneGenerator::Impl::annotate(Layout& L, const AloneStats& target_alone, i
     if (!(z > 0.f) || !std::isfinite(z) || z > zmax_png) z = 0.f;
   const std::vector<Visible> vis = visible_of(img.labels, static_cast<int>(stats.size()), W, H);
   for (size_t k = 0; k < stats.size(); ++k) img.info.gt_info.push_back(gt_info_of(stats[k], vis[k], img));
+  if (s.has_stated_intrinsics) {  // the files state other intrinsics: the poses as they read them
+    for (auto& gt : img.info.gt) gt.T_cam_model = stated_pose(gt.T_cam_model, K, s.stated_intrinsics);
+    img.info.K = s.stated_intrinsics;
+  }
 }
 
 }  // namespace pb

@@ -208,13 +208,23 @@ void parse_identity_and_sensor(const YamlNode& root, SceneSettings& s) {
   s.sensor_name = s.sensor.name;
   s.noise = root.has("noise") ? parse_noise(root["noise"], s.sensor.noise) : s.sensor.noise;
   s.depth_scale = root.get_positive("depth_scale", s.sensor.depth_scale);
+  if (root.has("stated_intrinsics")) {
+    const YamlNode st = root["stated_intrinsics"];
+    st.check_keys({"width", "height", "fx", "fy", "cx", "cy", "hfov_deg", "vfov_deg"});
+    s.stated_intrinsics = parse_intrinsics(st, s.sensor.K);
+    if (s.stated_intrinsics.width != s.sensor.K.width || s.stated_intrinsics.height != s.sensor.K.height)
+      st.fail("must keep the sensor's image size (" + std::to_string(s.sensor.K.width) + " x " +
+              std::to_string(s.sensor.K.height) + ")");
+    s.has_stated_intrinsics = true;
+  }
 }
 
 }  // namespace
 
 SceneSettings parse_scene_settings(const YamlNode& root) {
   root.check_keys({"scenario", "description", "scene_id", "seed", "images", "sensor", "noise",
-                   "depth_scale", "registry", "target", "target_upright_probability", "target_free_probability",
+                   "depth_scale", "stated_intrinsics", "registry", "target", "target_upright_probability",
+                   "target_free_probability",
                    "target_tilt_deg", "min_target_visib", "distractors", "occlusion", "camera", "table", "warehouse",
                    "masks", "max_attempts"});
   const std::string scen = root.get<std::string>("scenario");
@@ -345,6 +355,10 @@ std::string scene_settings_json(const SceneSettings& s) {
         {"edge_filter_far_mm", n.tof.edge_filter_far_mm},
         {"edge_filter_span_mm", n.tof.edge_filter_span_mm}}}};
   j["depth_scale"] = s.depth_scale;
+  if (s.has_stated_intrinsics) {  // older sets' json
+    const Intrinsics& S = s.stated_intrinsics;
+    j["stated_intrinsics"] = {{"fx", S.fx}, {"fy", S.fy}, {"cx", S.cx}, {"cy", S.cy}};
+  }
   j["registry"] = s.registry.empty() ? "(default)" : s.registry;
   j["target"] = s.target;
   j["target_upright_probability"] = s.target_upright_probability;
@@ -375,6 +389,16 @@ std::string scene_settings_json(const SceneSettings& s) {
   j["masks"] = s.masks;
   j["max_attempts"] = s.max_attempts;
   return j.dump(2);
+}
+
+const Intrinsics& dataset_intrinsics(const SceneSettings& s) {
+  return s.has_stated_intrinsics ? s.stated_intrinsics : s.sensor.K;
+}
+
+Pose stated_pose(const Pose& T_cam_model, const Intrinsics& K, const Intrinsics& stated) {
+  Pose T = T_cam_model;
+  T.t = stated.K().inverse() * (K.K() * T_cam_model.t);
+  return T;
 }
 
 }  // namespace pb

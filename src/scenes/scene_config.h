@@ -13,6 +13,7 @@
 //   sensor: astra                   # synthetic | astra | kinect_one | {name: custom, width: ...}
 //   noise: {model: gaussian, sigma_mm: 1.0}   # default: the sensor's model
 //   depth_scale: 0.1                # png value * depth_scale = mm; default: the sensor's
+//   stated_intrinsics: {hfov_deg: 57, vfov_deg: 43}   # what the files state; default: the sensor's
 //   registry: ../../models/models.yaml        # relative to this file; default: the tree's
 //   target: ls5
 //   target_upright_probability: 0.5
@@ -184,6 +185,16 @@ struct SceneSettings {
   SensorProfile sensor;       // resolved profile (intrinsics, range)
   NoiseSettings noise;        // noise applied to the rendered depth (default: the sensor's)
   double depth_scale = 0.1;   // png * depth_scale = mm (default: the sensor's)
+  // Intrinsics the data set states (camera.json, scene_camera.json) where
+  // they differ from the optics that rendered it (`sensor`): frames that a
+  // program back-projects with a data sheet's field of view instead of the
+  // sensor's own. A true camera-frame point p then reads as K_stated^-1 K p
+  // (its depth kept), so the ground truth's translation is mapped so and its
+  // rotation kept: the pose whose model overlays the object in the image, as
+  // a visual check accepts it. Same image size as the sensor's. Off
+  // (default): the sensor's intrinsics.
+  bool has_stated_intrinsics = false;
+  Intrinsics stated_intrinsics;
   std::string registry;       // model registry file, "" = the default registry
   std::string target = "ls5"; // registry name of the object of interest
   // Probability that the target stands upright (the thesis's real scenes: 1).
@@ -220,6 +231,15 @@ SceneSettings default_scene_settings(Scenario s);
 // or sensor.
 SceneSettings parse_scene_settings(const YamlNode& root);
 SceneSettings load_scene_settings(const std::string& path);
+
+// The intrinsics the data set's files state: stated_intrinsics when set,
+// else the sensor's.
+const Intrinsics& dataset_intrinsics(const SceneSettings& s);
+
+// A ground-truth pose as a data set with stated intrinsics `stated` reads it
+// when the optics were K: the translation mapped by stated^-1 K, the
+// rotation kept (see SceneSettings::stated_intrinsics).
+Pose stated_pose(const Pose& T_cam_model, const Intrinsics& K, const Intrinsics& stated);
 
 // The resolved settings as JSON text (posebench_scene.json, traceability).
 std::string scene_settings_json(const SceneSettings& s);
