@@ -220,6 +220,7 @@ SceneGenerator::Impl::Placed SceneGenerator::Impl::on_ground_rotated(int mi, con
 // other objects; then the target's visibility (occluder height) and the
 // annotation. Every step draws from `rng` in this order.
 bool SceneGenerator::Impl::generate_attempt(int im_id, int attempt, GeneratedImage& img, std::string& why) {
+  if (s.setups > 0) return generate_setup_attempt(im_id, attempt, img, why);
   Rng rng(derive_seed(s.seed, {static_cast<uint64_t>(s.scene_id), static_cast<uint64_t>(im_id),
                                static_cast<uint64_t>(attempt)}));
   Layout L;
@@ -240,6 +241,49 @@ bool SceneGenerator::Impl::generate_attempt(int im_id, int attempt, GeneratedIma
   if (!reach_visibility(L, target_alone, why)) return false;
   img.occluded = L.occl.on;
   img.occluder_height_mm = L.occl.height;
+  annotate(L, target_alone, im_id, img);
+  return true;
+}
+
+bool SceneGenerator::Impl::setup_layout(int k, Layout& L, std::string& why) {
+  for (int attempt = 0; attempt < s.max_attempts; ++attempt) {
+    Rng rng(derive_seed(s.seed, {static_cast<uint64_t>(s.scene_id), kSetupStream, static_cast<uint64_t>(k),
+                                 static_cast<uint64_t>(attempt)}));
+    L = Layout();
+    L.objs.reserve(1 + s.distractors.max_count);
+    GeneratedImage reference;
+    place_target(rng, L);
+    if (!place_camera(rng, L, reference, why)) continue;
+    place_background(rng, L);
+    if (!fits(L, L.target(), {})) continue;
+    if (!place_occluder(rng, L, why) || !place_distractors(rng, L, why)) continue;
+    AloneStats target_alone;
+    if (!alone(L.target(), L.T_cam_world, target_alone) || target_alone.px_all == 0) continue;
+    if (!reach_visibility(L, target_alone, why)) continue;
+    L.full.reset();  // the reference camera's render
+    return true;
+  }
+  why = "set-up " + std::to_string(k) + ": no valid layout (last: " + why + ")";
+  return false;
+}
+
+bool SceneGenerator::Impl::generate_setup_attempt(int im_id, int attempt, GeneratedImage& img, std::string& why) {
+  Layout L;
+  if (!setup_layout(im_id % s.setups, L, why)) return false;
+  Rng rng(derive_seed(s.seed, {static_cast<uint64_t>(s.scene_id), static_cast<uint64_t>(im_id),
+                               static_cast<uint64_t>(attempt)}));
+  if (!place_camera(rng, L, img, why)) return false;
+  for (const auto& p : L.objs)
+    if (!clear_of_camera(L, p)) {
+      why = "camera too close to an object";
+      return false;
+    }
+  AloneStats target_alone;
+  if (!alone(L.target(), L.T_cam_world, target_alone) || target_alone.px_all == 0) {
+    why = "target outside the image";
+    return false;
+  }
+  if (!reach_visibility(L, target_alone, why)) return false;
   annotate(L, target_alone, im_id, img);
   return true;
 }

@@ -22,6 +22,10 @@
 // occluder, or outside the occlusion range) is resampled (next attempt).
 // Objects whose silhouette lies entirely outside the image are left out of
 // the ground truth. Table, floor, wall and occluders are not annotated.
+// With setups > 0, image i shows set-up i mod setups: its objects drawn
+// once from Rng(derive_seed(seed, {scene_id, kSetupStream, k, attempt}))
+// (steps 1-5 with a reference camera, accepted as an image would be), and
+// only the camera drawn per image (step 2, from the image's stream).
 #pragma once
 
 #include <memory>
@@ -35,6 +39,7 @@
 namespace pb {
 
 constexpr uint64_t kNoiseStream = 0x6e6f697365ull;  // "noise"
+constexpr uint64_t kSetupStream = 0x7365747570ull;  // "setup": set-up k's layout (SceneSettings::setups)
 
 // One generated image.
 struct GeneratedImage {

@@ -125,6 +125,12 @@ struct SceneGenerator::Impl : scene_detail::GeneratorState {
 
   // generator.cpp: one attempt at image im_id (false with `why`).
   bool generate_attempt(int im_id, int attempt, GeneratedImage& img, std::string& why);
+  // With setups: set-up k's objects (target first, background), drawn from
+  // their own stream until a reference camera accepts them as an image
+  // would; false with `why` after max_attempts.
+  bool setup_layout(int k, Layout& L, std::string& why);
+  // With setups: image im_id's camera around its set-up (false with `why`).
+  bool generate_setup_attempt(int im_id, int attempt, GeneratedImage& img, std::string& why);
 
   // generator_layout.cpp: the steps of an attempt, in their order of random
   // draws (false with `why` when the layout is rejected).
@@ -140,6 +146,8 @@ struct SceneGenerator::Impl : scene_detail::GeneratorState {
   // Whether a footprint fits: on the ground area, apart from `others`, and
   // far enough from the camera.
   bool fits(const Layout& L, const Placed& p, const std::vector<const Placed*>& others) const;
+  // Whether p keeps the camera clearances (camera.*clearance_mm) from L's camera.
+  bool clear_of_camera(const Layout& L, const Placed& p) const;
 
   // generator_render.cpp.
   // The render items of a layout's objects (labels 0..n-1), `extras`

@@ -134,6 +134,10 @@ bool SceneGenerator::Impl::fits(const Layout& L, const Placed& p, const std::vec
     if (!on_ground_area(L, q, gap)) return false;
   for (const Placed* o : others)
     if (convex_polygons_overlap(p.footprint, o->footprint, gap)) return false;
+  return clear_of_camera(L, p);
+}
+
+bool SceneGenerator::Impl::clear_of_camera(const Layout& L, const Placed& p) const {
   const Vec3 centre = p.T_world_model.t + p.T_world_model.R * Vec3::Zero();
   if ((L.T_cam_world * centre).z() - p.radius < rset.near_mm + s.camera.depth_clearance_mm) return false;
   if ((centre - L.eye).norm() < p.radius + rset.near_mm + s.camera.clearance_mm) return false;

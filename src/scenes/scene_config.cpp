@@ -226,7 +226,7 @@ SceneSettings parse_scene_settings(const YamlNode& root) {
                    "depth_scale", "stated_intrinsics", "registry", "target", "target_upright_probability",
                    "target_free_probability",
                    "target_tilt_deg", "min_target_visib", "distractors", "occlusion", "camera", "table", "warehouse",
-                   "masks", "max_attempts"});
+                   "setups", "masks", "max_attempts"});
   const std::string scen = root.get<std::string>("scenario");
   Scenario scenario;
   if (scen == "table") scenario = Scenario::table;
@@ -259,6 +259,12 @@ SceneSettings parse_scene_settings(const YamlNode& root) {
   if (root.has("camera")) parse_camera(root["camera"], s.camera);
   if (root.has("table")) parse_table(root["table"], s.table);
   if (root.has("warehouse")) parse_warehouse(root["warehouse"], s.warehouse);
+  s.setups = read_int_at_least(root, "setups", s.setups, 0);
+  if (s.setups > s.images) root["setups"].fail("must be at most images (" + std::to_string(s.images) + ")");
+  if (s.setups > 0 && s.occlusion.enabled)
+    root["setups"].fail("not with occlusion (its occluder stands on each camera's line of sight)");
+  if (s.setups > 0 && ((s.scenario == Scenario::warehouse && s.warehouse.wall) || s.table.wall_distance_mm.hi > 0))
+    root["setups"].fail("not with a wall (it stands behind the target as one camera sees it)");
   root.read("masks", s.masks);
   s.max_attempts = read_int_at_least(root, "max_attempts", s.max_attempts, 1);
   return s;
@@ -386,6 +392,7 @@ std::string scene_settings_json(const SceneSettings& s) {
                       {"wall_height_mm", s.warehouse.wall_height_mm},
                       {"gap_mm", s.warehouse.gap_mm}};
   add_layout_details(j, s);
+  if (s.setups > 0) j["setups"] = s.setups;  // older sets' json
   j["masks"] = s.masks;
   j["max_attempts"] = s.max_attempts;
   return j.dump(2);

@@ -25,6 +25,7 @@
 //   camera: {distance_mm: [600, 1500], elevation_deg: [30, 70], look_jitter: 0.15}
 //   table: {size_mm: 4000, thickness_mm: 40}
 //   warehouse: {object_size_mm: [1000, 1500], wall_distance_mm: [800, 2000], wall_height_mm: 5000}
+//   setups: 0                       # > 0: that many object layouts, the camera drawn per image
 //   masks: true
 //   max_attempts: 200
 // A scalar where a range is expected means a fixed value.
@@ -219,6 +220,16 @@ struct SceneSettings {
   SceneCameraSettings camera;
   TableSettings table;
   WarehouseSettings warehouse;
+  // > 0: the images show this many set-ups, image i set-up i mod setups. A
+  // set-up is one layout of the target and the other objects, drawn once
+  // from its own stream (and accepted from a reference camera as an image
+  // would be); each image then draws only its camera (camera.*) around it,
+  // keeping the objects where they stand: a few arrangements photographed
+  // many times, as the thesis's real frames show "the setup" of its Figure
+  // 4.3, so images of one set-up are not independent. 0 (default): a new
+  // layout per image. Not with occlusion or a wall (they are placed for
+  // one camera: on its line of sight, behind the target).
+  int setups = 0;
   bool masks = true;          // also write mask_visib/IIIIII_GGGGGG.png
   int max_attempts = 200;     // layouts tried per image before giving up
 };
