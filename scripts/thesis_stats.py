@@ -3,6 +3,8 @@
 wilson(k, n)            the 95% Wilson score interval of k of n
 fisher_exact(a, n, b, m) two-sided Fisher's exact test of a of n against b of m
 mcnemar_exact(b, c)     two-sided exact McNemar test of paired trials (b, c: the discordant pairs)
+chi2_homogeneity(ks, n) chi-square test that several counts k of n share one rate (statistic, df, p)
+chi2_sf(x, df)          the chi-square distribution's upper tail
 kendall_tau(x, y)       Kendall's tau-b of two equally long sequences (None when undefined)
 count_of(value, n)      the count k = round(value * n) behind a printed fraction
 printable_as_count(value, n)  whether a printed percentage can be some k/n
@@ -55,6 +57,60 @@ def mcnemar_exact(b, c):
     n = b + c
     tail = sum(math.comb(n, i) for i in range(min(b, c) + 1))
     return min(1.0, 2 * tail / 2 ** n)
+
+
+def chi2_sf(x, df):
+    """P(X >= x) for X chi-square with df degrees of freedom: the regularized
+    upper incomplete gamma Q(df / 2, x / 2), by its series below a + 1 and
+    its continued fraction (modified Lentz) above."""
+    if df <= 0:
+        raise ValueError("df must be positive: %r" % df)
+    if x <= 0:
+        return 1.0
+    a, z = df / 2.0, x / 2.0
+    log_front = a * math.log(z) - z - math.lgamma(a)
+    if z < a + 1:  # P by the series, Q = 1 - P
+        term = total = 1.0 / a
+        k = a
+        while abs(term) > abs(total) * 1e-15:
+            k += 1
+            term *= z / k
+            total += term
+        return max(0.0, 1.0 - total * math.exp(log_front))
+    tiny = 1e-300
+    b = z + 1 - a
+    c, d = 1 / tiny, 1 / b
+    h = d
+    for i in range(1, 10000):
+        an = -i * (i - a)
+        b += 2
+        d = an * d + b
+        d = tiny if abs(d) < tiny else d
+        c = b + an / c
+        c = tiny if abs(c) < tiny else c
+        d = 1 / d
+        delta = d * c
+        h *= delta
+        if abs(delta - 1) < 1e-15:
+            break
+    return min(1.0, math.exp(log_front) * h)
+
+
+def chi2_homogeneity(ks, n):
+    """Pearson's chi-square test that counts ks, each k of n trials, share one
+    rate (a len(ks) x 2 table): (statistic, df, p). p is 1 when every count is
+    the same (0 of n or n of n included: no spread to test). The chi-square
+    approximation is rough where expected counts fall below 5."""
+    if len(ks) < 2 or n <= 0 or any(not 0 <= k <= n for k in ks):
+        raise ValueError("need two or more counts, each of 0..%d: %r" % (n, ks))
+    df = len(ks) - 1
+    total = sum(ks)
+    if all(k == ks[0] for k in ks):
+        return 0.0, df, 1.0
+    p = total / (n * len(ks))
+    e1, e0 = n * p, n * (1 - p)
+    stat = sum((k - e1) ** 2 / e1 + ((n - k) - e0) ** 2 / e0 for k in ks)
+    return stat, df, chi2_sf(stat, df)
 
 
 def _sign(v, tol=1e-12):

@@ -1,6 +1,7 @@
 """scripts/thesis_stats.py and scripts/thesis_verdicts.py: known values of the
 statistics, and each conclusion's rule on small in-memory data giving each of
 its verdicts at least once (the verdict word and the counts it used)."""
+import math
 import os
 import sys
 import unittest
@@ -44,6 +45,29 @@ class Stats(unittest.TestCase):
         self.assertEqual(st.mcnemar_exact(1, 6), 0.125)
         with self.assertRaises(ValueError):
             st.mcnemar_exact(-1, 3)
+
+    def test_chi2_known_values(self):
+        # the 5% critical values of the chi-square tables
+        self.assertAlmostEqual(st.chi2_sf(3.841459, 1), 0.05, places=6)
+        self.assertAlmostEqual(st.chi2_sf(16.918978, 9), 0.05, places=6)
+        self.assertAlmostEqual(st.chi2_sf(21.665994, 9), 0.01, places=6)
+        self.assertAlmostEqual(st.chi2_sf(2.0, 2), math.exp(-1), places=12)  # df 2: exp(-x / 2)
+        self.assertEqual(st.chi2_sf(0.0, 3), 1.0)
+        with self.assertRaises(ValueError):
+            st.chi2_sf(1.0, 0)
+
+    def test_chi2_homogeneity(self):
+        # 2 x 2: 10 of 20 against 0 of 20, Pearson's statistic 13.33, df 1
+        stat, df, p = st.chi2_homogeneity([10, 0], 20)
+        self.assertAlmostEqual(stat, 40 / 3, places=12)
+        self.assertEqual(df, 1)
+        self.assertAlmostEqual(p, st.chi2_sf(40 / 3, 1), places=15)
+        self.assertLess(p, 0.001)
+        self.assertEqual(st.chi2_homogeneity([60, 60, 60], 60), (0.0, 2, 1.0))
+        self.assertEqual(st.chi2_homogeneity([0, 0], 60), (0.0, 1, 1.0))
+        self.assertGreater(st.chi2_homogeneity([30, 31, 29, 30], 60)[2], 0.9)
+        with self.assertRaises(ValueError):
+            st.chi2_homogeneity([61, 3], 60)
 
     def test_fisher_counts_tables_as_probable_as_the_observed(self):
         # 1 of 2 against 1 of 2: the tables 0/2-2/2 and 2/2-0/2 are less probable; 1-1 is the observed: p = 1.
