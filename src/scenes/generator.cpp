@@ -255,10 +255,16 @@ bool SceneGenerator::Impl::setup_layout(int k, Layout& L, std::string& why) {
     place_target(rng, L);
     if (!place_camera(rng, L, reference, why)) continue;
     place_background(rng, L);
-    if (!fits(L, L.target(), {})) continue;
+    if (!fits(L, L.target(), {})) {
+      why = "target does not fit (camera too close)";
+      continue;
+    }
     if (!place_occluder(rng, L, why) || !place_distractors(rng, L, why)) continue;
     AloneStats target_alone;
-    if (!alone(L.target(), L.T_cam_world, target_alone) || target_alone.px_all == 0) continue;
+    if (!alone(L.target(), L.T_cam_world, target_alone) || target_alone.px_all == 0) {
+      why = "target outside the image";
+      continue;
+    }
     if (!reach_visibility(L, target_alone, why)) continue;
     L.full.reset();  // the reference camera's render
     return true;
