@@ -274,8 +274,18 @@ bool SceneGenerator::Impl::setup_layout(int k, Layout& L, std::string& why) {
 }
 
 bool SceneGenerator::Impl::generate_setup_attempt(int im_id, int attempt, GeneratedImage& img, std::string& why) {
-  Layout L;
-  if (!setup_layout(im_id % s.setups, L, why)) return false;
+  const int k = im_id % s.setups;
+  auto made = setups_made.find(k);
+  if (made == setups_made.end()) {
+    SetUp u;
+    u.ok = setup_layout(k, u.layout, u.why);
+    made = setups_made.emplace(k, std::move(u)).first;
+  }
+  if (!made->second.ok) {
+    why = made->second.why;
+    return false;
+  }
+  Layout L = made->second.layout;  // this image's camera goes into its copy
   Rng rng(derive_seed(s.seed, {static_cast<uint64_t>(s.scene_id), static_cast<uint64_t>(im_id),
                                static_cast<uint64_t>(attempt)}));
   if (!place_camera(rng, L, img, why)) return false;

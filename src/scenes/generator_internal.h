@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -107,6 +108,14 @@ struct SceneGenerator::Impl : scene_detail::GeneratorState {
   using Vec2 = scene_detail::Vec2;
 
   std::unique_ptr<DepthRenderer> renderer;
+  // With setups: each set-up's layout (or why it has none), made once per
+  // generator by setup_layout and copied for every image that shows it.
+  struct SetUp {
+    bool ok = false;
+    Layout layout;
+    std::string why;
+  };
+  std::map<int, SetUp> setups_made;
 
   explicit Impl(const scene_detail::GeneratorState& state)
       : GeneratorState(state), renderer(std::make_unique<DepthRenderer>(K, rset)) {}
