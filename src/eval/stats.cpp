@@ -27,4 +27,14 @@ double quantile(std::vector<double> v, double q) {
   return v[i] + (pos - static_cast<double>(i)) * (v[j] - v[i]);
 }
 
+double mcnemar_exact_p(int b, int c) {
+  const int n = b + c, k = std::min(b, c);
+  if (n <= 0) return 1.0;
+  // P(X <= k) by summing the pmf in logs (n may be in the thousands).
+  double tail = 0;
+  for (int i = 0; i <= k; ++i)
+    tail += std::exp(std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) - n * std::log(2.0));
+  return std::min(1.0, 2.0 * tail);
+}
+
 }  // namespace pb

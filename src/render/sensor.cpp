@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <set>
 
 #include "core/error.h"
@@ -32,11 +33,23 @@ bool is_builtin(const std::string& name) {
   return std::find(names.begin(), names.end(), name) != names.end();
 }
 
+// A profile file named in a YAML file: relative to that file's folder,
+// else to the working directory; InputError naming the field when missing.
+std::string resolve_beside(const std::string& name, const YamlNode& node) {
+  namespace fs = std::filesystem;
+  if (fs::path(name).is_relative() && !node.file().empty()) {
+    const fs::path beside = fs::path(node.file()).parent_path() / name;
+    if (fs::exists(beside)) return beside.string();
+  }
+  if (!fs::exists(name)) node.fail("sensor profile file '" + name + "' does not exist");
+  return name;
+}
+
 std::string unknown_sensor(const std::string& name) {
   std::string list;
   for (const auto& n : sensor_names()) list += (list.empty() ? "" : ", ") + n;
   return "unknown sensor '" + name + "' (built in: " + list +
-         "; or give a map with width, height, fx, fy, cx, cy)";
+         "; or give a map with width, height, fx, fy, cx, cy, or a profile file NAME.yaml)";
 }
 
 }  // namespace
@@ -101,11 +114,16 @@ SensorProfile parse_sensor(const YamlNode& node) {
   if (!node.defined()) node.fail("missing sensor (a name or a map of intrinsics)");
   if (node.is_scalar()) {
     const std::string name = node.as<std::string>();
+    if (is_profile_file(name)) {
+      const YamlNode file = YamlNode::load_file(resolve_beside(name, node));
+      if (file.is_scalar()) file.fail("a sensor profile file holds a map (name, intrinsics, noise)");
+      return parse_sensor(file);
+    }
     if (!is_builtin(name)) node.fail(unknown_sensor(name));  // names file, field and line
     return sensor_profile(name, node.file(), node.path());
   }
   node.check_keys({"name", "width", "height", "fx", "fy", "cx", "cy", "hfov_deg", "vfov_deg", "depth_scale",
-                   "min_range_mm", "max_range_mm"});
+                   "min_range_mm", "max_range_mm", "noise"});
   const bool has_intrinsics = node.has("width") || node.has("height") || node.has("fx") || node.has("fy") ||
                               node.has("cx") || node.has("cy") || node.has("hfov_deg") || node.has("vfov_deg");
   SensorProfile s;
@@ -132,7 +150,15 @@ SensorProfile parse_sensor(const YamlNode& node) {
     node[node.has("max_range_mm") ? "max_range_mm" : "depth_scale"].fail(
         "max_range_mm " + std::to_string(s.max_range_mm) + " does not fit a uint16 depth PNG with depth_scale " +
         std::to_string(s.depth_scale) + " (limit 65535 * depth_scale)");
+  if (node.has("noise")) s.noise = parse_noise(node["noise"], s.noise);
   return s;
+}
+
+bool is_profile_file(const std::string& name) {
+  const auto ends = [&](const std::string& ext) {
+    return name.size() > ext.size() && name.compare(name.size() - ext.size(), ext.size(), ext) == 0;
+  };
+  return ends(".yaml") || ends(".yml");
 }
 
 NoiseSettings parse_noise(const YamlNode& node, const NoiseSettings& base) {
@@ -151,7 +177,8 @@ NoiseSettings parse_noise(const YamlNode& node, const NoiseSettings& base) {
   const std::set<std::string> gaussian_keys = {"sigma_mm"};
   const std::set<std::string> sl_keys = {"baseline_mm",         "disparity_step_px", "disparity_sigma_px",
                                          "smoothing_radius_px", "smoothing_edge_px", "max_incidence_deg",
-                                         "shadows"};
+                                         "shadows",             "edge_bleed_px",     "edge_dropout_rate",
+                                         "edge_dropout_px"};
   const std::set<std::string> tof_keys = {"sigma_base_mm",        "sigma_per_m2_mm",    "edge_jump_mm",
                                           "flying_fraction",      "max_incidence_deg",  "driver_edge_filter",
                                           "edge_filter_close_mm", "edge_filter_far_mm", "edge_filter_span_mm"};
@@ -188,6 +215,12 @@ NoiseSettings parse_noise(const YamlNode& node, const NoiseSettings& base) {
     s.smoothing_edge_px = node.get_nonnegative("smoothing_edge_px", s.smoothing_edge_px);
     s.max_incidence_deg = incidence(s.max_incidence_deg);
     node.read("shadows", s.shadows);
+    s.edge_bleed_px = node.get_nonnegative("edge_bleed_px", s.edge_bleed_px);
+    if (s.edge_bleed_px > 10) node["edge_bleed_px"].fail("must be 0..10");
+    s.edge_dropout_rate = node.get_nonnegative("edge_dropout_rate", s.edge_dropout_rate);
+    if (s.edge_dropout_rate > 1) node["edge_dropout_rate"].fail("must be in [0, 1]");
+    s.edge_dropout_px = node.get_positive("edge_dropout_px", s.edge_dropout_px);
+    if (s.edge_dropout_px > 50) node["edge_dropout_px"].fail("must be in (0, 50]");
   } else if (n.model == "tof") {
     TimeOfFlightNoise& t = n.tof;
     t.sigma_base_mm = node.get_nonnegative("sigma_base_mm", t.sigma_base_mm);

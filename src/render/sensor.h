@@ -62,6 +62,13 @@ struct StructuredLightNoise {
   double smoothing_edge_px = 1.0;    // neighbours whose true disparity differs more are not averaged
   double max_incidence_deg = 80.0;   // no depth beyond this angle between ray and normal
   bool shadows = true;               // drop pixels the projector cannot see
+  // Depth edges, as real frames with ground truth show them (posebench
+  // sensor-fit, results/sensors/README.md); both off by default. An edge is
+  // a true disparity step larger than smoothing_edge_px between 4-neighbours
+  // (or between depth and none).
+  double edge_bleed_px = 0;          // the nearer surface grows over the farther by this many px (correlation window)
+  double edge_dropout_rate = 0;      // probability of no depth at an edge pixel, falling off as
+  double edge_dropout_px = 2;        //   exp(-d / edge_dropout_px) with the distance d (px) to the edge
 };
 
 // Time of flight (Kinect-One-like): distance-dependent noise, flying pixels
@@ -130,7 +137,13 @@ SensorProfile sensor_profile(const std::string& name, const std::string& file = 
 // {name: kinect_one, fx: 365, fy: 365} is the Kinect One's time-of-flight
 // sensor with the real Kinect v2's optics (70.6 x 60 deg) instead of Table
 // 2.1's 57 x 43 deg. A custom sensor's default noise is gaussian 1 mm.
+// The map may also give `noise:` (as parse_noise reads it, starting from the
+// profile's own). A scalar ending in .yaml or .yml names a profile file
+// holding such a map (`posebench sensor-fit` writes one), relative to the
+// YAML file that names it.
 SensorProfile parse_sensor(const YamlNode& node);
+// Whether a sensor name is a profile file (ends in .yaml or .yml).
+bool is_profile_file(const std::string& name);
 // Intrinsics from a YAML map {width, height, fx, fy | hfov_deg, vfov_deg, cx,
 // cy}, each key defaulting to `base`'s (required where `base` has none; cx,
 // cy to the image centre when the size differs from base's). InputError
@@ -138,7 +151,8 @@ SensorProfile parse_sensor(const YamlNode& node);
 Intrinsics parse_intrinsics(const YamlNode& node, const Intrinsics& base);
 // A `noise:` YAML node: a model name, or a map {model, sigma_mm (gaussian);
 // baseline_mm, disparity_step_px, disparity_sigma_px, smoothing_radius_px,
-// smoothing_edge_px, max_incidence_deg, shadows (structured_light);
+// smoothing_edge_px, max_incidence_deg, shadows, edge_bleed_px,
+// edge_dropout_rate, edge_dropout_px (structured_light);
 // sigma_base_mm, sigma_per_m2_mm, edge_jump_mm, flying_fraction,
 // max_incidence_deg, driver_edge_filter, edge_filter_close_mm,
 // edge_filter_far_mm, edge_filter_span_mm (tof)}; fields default to `base`.

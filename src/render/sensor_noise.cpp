@@ -71,14 +71,110 @@ const std::vector<Vec3f>& normals_for(const DepthImage& depth, const RenderOutpu
   return storage;
 }
 
+void apply_structured_light_core(DepthImage& depth, const std::vector<Vec3f>& normals, const Intrinsics& K,
+                                 const StructuredLightNoise& s, Rng& rng);
+
 void apply_gaussian(DepthImage& depth, const GaussianNoise& g, Rng& rng) {
   if (g.sigma_mm <= 0) return;
   for (float& z : depth.z)
     if (valid_depth(z)) z = static_cast<float>(z + rng.normal(0.0, g.sigma_mm));
 }
 
+// Pixels next to a true disparity step larger than `edge` (4-neighbours; a
+// pixel with depth next to one without is on an edge too).
+std::vector<uint8_t> disparity_edges(const DepthImage& truth, double fb, double edge) {
+  const int W = truth.width, H = truth.height;
+  std::vector<uint8_t> e(truth.z.size(), 0);
+  auto disp = [&](size_t p) { return valid_depth(truth.z[p]) ? fb / truth.z[p] : 0.0; };
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u) {
+      const size_t p = static_cast<size_t>(v) * W + u;
+      const double d = disp(p);
+      const bool step = (u + 1 < W && std::abs(disp(p + 1) - d) > edge) ||
+                        (v + 1 < H && std::abs(disp(p + W) - d) > edge);
+      if (!step) continue;
+      e[p] = 1;
+      if (u + 1 < W && std::abs(disp(p + 1) - d) > edge) e[p + 1] = 1;
+      if (v + 1 < H && std::abs(disp(p + W) - d) > edge) e[p + W] = 1;
+    }
+  return e;
+}
+
+// The nearer surface grows over the farther (StructuredLightNoise::
+// edge_bleed_px): a pixel takes the measured depth of the closest pixel
+// (Chebyshev distance k) whose true disparity is larger by more than `edge`,
+// when k <= floor(b), or k = ceil(b) with probability b - floor(b).
+void bleed_edges(DepthImage& depth, const DepthImage& truth, double fb, double edge, double b, Rng& rng) {
+  const int W = depth.width, H = depth.height, R = static_cast<int>(std::ceil(b));
+  const double frac = b - std::floor(b);
+  const DepthImage measured = depth;
+  auto disp = [&](size_t p) { return valid_depth(truth.z[p]) ? fb / truth.z[p] : 0.0; };
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u) {
+      const size_t p = static_cast<size_t>(v) * W + u;
+      const double d = disp(p);
+      int best_k = R + 1;
+      size_t best = 0;
+      for (int dv = -R; dv <= R; ++dv)
+        for (int du = -R; du <= R; ++du) {
+          const int uu = u + du, vv = v + dv, k = std::max(std::abs(du), std::abs(dv));
+          if (uu < 0 || vv < 0 || uu >= W || vv >= H || k >= best_k || k == 0) continue;
+          const size_t q = static_cast<size_t>(vv) * W + uu;
+          if (valid_depth(measured.z[q]) && disp(q) > d + edge) best_k = k, best = q;
+        }
+      if (best_k > R) continue;
+      if (best_k == R && frac > 0 && !rng.bernoulli(frac)) continue;
+      depth.z[p] = measured.z[best];
+    }
+}
+
+// No depth near edges (edge_dropout_rate, edge_dropout_px): with probability
+// rate * exp(-d / px) at Chebyshev distance d from the nearest edge pixel,
+// up to 4 px.
+void drop_near_edges(DepthImage& depth, const std::vector<uint8_t>& edges, double rate, double px, Rng& rng) {
+  const int W = depth.width, H = depth.height;
+  const int cap = static_cast<int>(std::ceil(4 * px));
+  std::vector<int> dist(depth.z.size(), -1);
+  std::vector<size_t> frontier, next;
+  for (size_t p = 0; p < edges.size(); ++p)
+    if (edges[p]) dist[p] = 0, frontier.push_back(p);
+  for (int k = 1; k <= cap && !frontier.empty(); ++k) {
+    next.clear();
+    for (size_t p : frontier) {
+      const int u = static_cast<int>(p % W), v = static_cast<int>(p / W);
+      for (int dv = -1; dv <= 1; ++dv)
+        for (int du = -1; du <= 1; ++du) {
+          const int uu = u + du, vv = v + dv;
+          if (uu < 0 || vv < 0 || uu >= W || vv >= H) continue;
+          const size_t q = static_cast<size_t>(vv) * W + uu;
+          if (dist[q] >= 0) continue;
+          dist[q] = k;
+          next.push_back(q);
+        }
+    }
+    frontier.swap(next);
+  }
+  for (size_t p = 0; p < depth.z.size(); ++p)
+    if (dist[p] >= 0 && valid_depth(depth.z[p]) && rng.bernoulli(rate * std::exp(-dist[p] / px))) depth.z[p] = 0.f;
+}
+
 void apply_structured_light(DepthImage& depth, const std::vector<Vec3f>& normals, const Intrinsics& K,
                             const StructuredLightNoise& s, Rng& rng) {
+  const bool edge_effects = s.edge_bleed_px > 0 || s.edge_dropout_rate > 0;
+  DepthImage truth;
+  if (edge_effects) truth = depth;
+  apply_structured_light_core(depth, normals, K, s, rng);
+  if (!edge_effects) return;
+  const double fb = K.fx * s.baseline_mm;
+  if (s.edge_bleed_px > 0) bleed_edges(depth, truth, fb, s.smoothing_edge_px, s.edge_bleed_px, rng);
+  if (s.edge_dropout_rate > 0)
+    drop_near_edges(depth, disparity_edges(truth, fb, s.smoothing_edge_px), s.edge_dropout_rate, s.edge_dropout_px,
+                    rng);
+}
+
+// Disparity noise, smoothing, quantization, shadows and grazing angles.
+void apply_structured_light_core(DepthImage& depth, const std::vector<Vec3f>& normals, const Intrinsics& K,
+                                 const StructuredLightNoise& s, Rng& rng) {
   const int W = depth.width, H = depth.height;
   const size_t N = depth.z.size();
   const double fb = K.fx * s.baseline_mm;

@@ -320,6 +320,7 @@ Report build_report(const nlohmann::json& exp, const std::vector<TrialRecord>& r
   rep.records = records.size();
   for (const auto& r : records) ++rep.status_counts[r.status];
   rep.lengths = resolved_lengths(records);
+  rep.twin_gap = twin_gap(exp, records);
   const Layout l = layout_of(exp, records, opt);
   const Reference ref = load_reference(opt.reference_file, l.ref_id);
 
@@ -380,6 +381,7 @@ std::string to_markdown(const Report& r) {
     o << "\n" << (has_ref ? "In parentheses: the thesis's value. " : "") << "Up to " << n
       << " trials per cell; accuracy over correct trials only.\n\n";
   }
+  o << twin_gap_markdown(r.twin_gap);
   o << resolved_lengths_markdown(r.lengths);
   o << "Records: " << r.records;
   for (const auto& [k, v] : r.status_counts) o << ", " << k << " " << v;

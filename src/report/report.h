@@ -12,6 +12,7 @@
 
 #include "eval/record.h"
 #include "report/lengths.h"
+#include "report/twin_gap.h"
 
 namespace pb {
 
@@ -53,6 +54,7 @@ struct Report {
   size_t records = 0;
   std::map<std::string, size_t> status_counts;
   std::vector<ResolvedLengths> lengths;  // the lengths the trials resolved, per scene set and object
+  std::vector<TwinGapRow> twin_gap;      // real scene sets against their twins (scenes with twin_of)
 };
 
 struct ReportOptions {

@@ -138,7 +138,7 @@ void parse_settings_and_grid(const YamlNode& root, const std::string& path, Expe
 
 SceneSource parse_scene(const YamlNode& s, const std::string& path, std::set<std::string>& names) {
   s.check_keys({"name", "generate", "dataset", "clouds", "cloud", "split", "scene_ids", "images", "targets",
-                "scenario", "generator", "settings", "refinements"});
+                "scenario", "generator", "settings", "refinements", "twin_of"});
   SceneSource src;
   src.generate = resolve(path, s.get_or<std::string>("generate", ""));
   src.dataset = resolve(path, s.get_or<std::string>("dataset", ""));
@@ -166,6 +166,7 @@ SceneSource parse_scene(const YamlNode& s, const std::string& path, std::set<std
   src.images = s.get_or<int>("images", 0);
   if (src.images < 0) s["images"].fail("must be non-negative");
   src.targets = s.get_or<std::string>("targets", "");
+  src.twin_of = s.get_or<std::string>("twin_of", "");
   src.scenario = s.get_or<std::string>(
       "scenario", src.name.rfind("warehouse", 0) == 0 ? std::string("warehouse") : std::string("table"));
   if (src.scenario != "table" && src.scenario != "warehouse")
@@ -246,6 +247,7 @@ nlohmann::json canonical(const ExperimentConfig& c) {
   for (size_t i = 0; i < c.scenes.size(); ++i) {  // only when given: older hashes stay
     if (!c.scenes[i].targets.empty()) canon["scenes"][i]["targets"] = c.scenes[i].targets;
     if (!c.scenes[i].clouds.empty()) canon["scenes"][i]["clouds"] = {c.scenes[i].clouds, c.scenes[i].cloud};
+    if (!c.scenes[i].twin_of.empty()) canon["scenes"][i]["twin_of"] = c.scenes[i].twin_of;
   }
   canon["report"] = c.report;
   if (!c.judgements.empty()) canon["judgements"] = judgements_json(c.judgements);
@@ -274,6 +276,12 @@ ExperimentConfig load_experiment(const std::string& path) {
   if (!scenes.is_sequence() || scenes.size() == 0) scenes.fail("expected a non-empty list of scenes");
   std::set<std::string> names;
   for (size_t i = 0; i < scenes.size(); ++i) c.scenes.push_back(parse_scene(scenes.at(i), path, names));
+  for (size_t i = 0; i < scenes.size(); ++i) {
+    const std::string& of = c.scenes[i].twin_of;
+    if (of.empty()) continue;
+    if (of == c.scenes[i].name || !names.count(of))
+      scenes.at(i)["twin_of"].fail("must name another scene of this experiment (the real set)");
+  }
   if (c.object == kEveryTargetObject) {
     for (size_t i = 0; i < scenes.size(); ++i) {
       SceneSource& src = c.scenes[i];

@@ -35,6 +35,9 @@ struct SceneSource {
   // dataset root): only the images it lists for the experiment's object are
   // trials, and scene_ids defaults to their scenes. "" = every image.
   std::string targets;
+  // The name of the scene set this one is the twin of (`posebench twin`):
+  // the report pairs their trials ("Real and twin"). "" = none.
+  std::string twin_of;
   std::string scenario = "";   // table | warehouse: picks the translation threshold
   // Refinements for this scene set, replacing the experiment's list (the
   // thesis used ICP point-to-plane in the warehouse, point-to-point on tables).
