@@ -36,6 +36,16 @@ bool plot(const std::string& json, const std::string& dir) {
   return std::system(cmd.c_str()) == 0;
 }
 
+// The dataset as the outputs name it: under $POSEBENCH_REAL_DATA, relative
+// to it (the outputs are committed; the data folder differs per machine).
+std::string display_path(const std::string& dataset) {
+  const char* root = std::getenv("POSEBENCH_REAL_DATA");
+  if (!root || !*root) return dataset;
+  const fs::path rel = fs::absolute(dataset).lexically_normal().lexically_relative(fs::absolute(root).lexically_normal());
+  if (rel.empty() || *rel.begin() == "..") return dataset;
+  return "${POSEBENCH_REAL_DATA}/" + rel.string();
+}
+
 int sensor_fit_main(int argc, char** argv) {
   CLI::App app{"Fit a sensor's noise model to real depth frames with ground truth (a BOP dataset):\n"
                "each annotated object's pixels against the depth rendered from its GT pose, then\n"
@@ -69,17 +79,18 @@ int sensor_fit_main(int argc, char** argv) {
   s.max_images = images;
   s.stride = stride;
   s.seed = static_cast<uint64_t>(seed);
-  const pb::SensorFitResult r = pb::fit_sensor(dataset, s);
+  pb::SensorFitResult r = pb::fit_sensor(dataset, s);
+  r.dataset = display_path(dataset);
 
   fs::create_directories(out);
   const std::string json = (fs::path(out) / "sensor_fit.json").string();
   pb::atomic_write_text(json, pb::to_json(r).dump(1) + "\n");
-  const std::string comment = "Fitted by: posebench sensor-fit " + dataset + " --base " + base + " --seed " +
+  const std::string comment = "Fitted by: posebench sensor-fit " + r.dataset + " --base " + base + " --seed " +
                               std::to_string(seed) + (images ? " --images " + std::to_string(images) : "") +
                               (stride > 1 ? " --stride " + std::to_string(stride) : "") +
                               "\n(" + std::to_string(r.images) + " real images; statistics in sensor_fit.json)";
   pb::atomic_write_text((fs::path(out) / "profile.yaml").string(), pb::profile_yaml(r.profile, comment));
-  std::printf("sensor-fit %s: %d images, %lld object pixels (%.1f%% missing, %.1f%% nearer)\n", dataset.c_str(),
+  std::printf("sensor-fit %s: %d images, %lld object pixels (%.1f%% missing, %.1f%% nearer)\n", r.dataset.c_str(),
               r.images, static_cast<long long>(r.real.all.n), 100.0 * r.real.all.missing_rate(),
               r.real.all.n ? 100.0 * r.real.all.nearer / r.real.all.n : 0.0);
   std::printf("loss: base %.3f, fitted %.3f\n", r.base_loss.total(), pb::fit_loss(r.real, r.fitted).total());

@@ -178,7 +178,7 @@ NoiseSettings parse_noise(const YamlNode& node, const NoiseSettings& base) {
   const std::set<std::string> sl_keys = {"baseline_mm",         "disparity_step_px", "disparity_sigma_px",
                                          "smoothing_radius_px", "smoothing_edge_px", "max_incidence_deg",
                                          "shadows",             "edge_bleed_px",     "edge_dropout_rate",
-                                         "edge_dropout_px"};
+                                         "edge_dropout_px",     "reference_fx"};
   const std::set<std::string> tof_keys = {"sigma_base_mm",        "sigma_per_m2_mm",    "edge_jump_mm",
                                           "flying_fraction",      "max_incidence_deg",  "driver_edge_filter",
                                           "edge_filter_close_mm", "edge_filter_far_mm", "edge_filter_span_mm"};
@@ -221,6 +221,7 @@ NoiseSettings parse_noise(const YamlNode& node, const NoiseSettings& base) {
     if (s.edge_dropout_rate > 1) node["edge_dropout_rate"].fail("must be in [0, 1]");
     s.edge_dropout_px = node.get_positive("edge_dropout_px", s.edge_dropout_px);
     if (s.edge_dropout_px > 50) node["edge_dropout_px"].fail("must be in (0, 50]");
+    s.reference_fx = node.get_nonnegative("reference_fx", s.reference_fx);
   } else if (n.model == "tof") {
     TimeOfFlightNoise& t = n.tof;
     t.sigma_base_mm = node.get_nonnegative("sigma_base_mm", t.sigma_base_mm);

@@ -69,6 +69,10 @@ struct StructuredLightNoise {
   double edge_bleed_px = 0;          // the nearer surface grows over the farther by this many px (correlation window)
   double edge_dropout_rate = 0;      // probability of no depth at an edge pixel, falling off as
   double edge_dropout_px = 2;        //   exp(-d / edge_dropout_px) with the distance d (px) to the edge
+  // The focal length (px) the pixel-unit fields were fitted at; at another
+  // focal length the window and edge widths scale with it and the depth
+  // noise stays (f x baseline is kept). 0 = the image's own.
+  double reference_fx = 0;
 };
 
 // Time of flight (Kinect-One-like): distance-dependent noise, flying pixels
@@ -152,7 +156,7 @@ Intrinsics parse_intrinsics(const YamlNode& node, const Intrinsics& base);
 // A `noise:` YAML node: a model name, or a map {model, sigma_mm (gaussian);
 // baseline_mm, disparity_step_px, disparity_sigma_px, smoothing_radius_px,
 // smoothing_edge_px, max_incidence_deg, shadows, edge_bleed_px,
-// edge_dropout_rate, edge_dropout_px (structured_light);
+// edge_dropout_rate, edge_dropout_px, reference_fx (structured_light);
 // sigma_base_mm, sigma_per_m2_mm, edge_jump_mm, flying_fraction,
 // max_incidence_deg, driver_edge_filter, edge_filter_close_mm,
 // edge_filter_far_mm, edge_filter_span_mm (tof)}; fields default to `base`.

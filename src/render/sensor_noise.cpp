@@ -72,7 +72,7 @@ const std::vector<Vec3f>& normals_for(const DepthImage& depth, const RenderOutpu
 }
 
 void apply_structured_light_core(DepthImage& depth, const std::vector<Vec3f>& normals, const Intrinsics& K,
-                                 const StructuredLightNoise& s, Rng& rng);
+                                 const StructuredLightNoise& s, double shadow_baseline_mm, Rng& rng);
 
 void apply_gaussian(DepthImage& depth, const GaussianNoise& g, Rng& rng) {
   if (g.sigma_mm <= 0) return;
@@ -158,12 +158,28 @@ void drop_near_edges(DepthImage& depth, const std::vector<uint8_t>& edges, doubl
     if (dist[p] >= 0 && valid_depth(depth.z[p]) && rng.bernoulli(rate * std::exp(-dist[p] / px))) depth.z[p] = 0.f;
 }
 
+// The model at another focal length than the one its pixel-unit fields
+// were fitted at (StructuredLightNoise::reference_fx): f * b stays, so the
+// disparity-unit fields and the depth noise stay; the window and edge widths
+// scale with the focal length; the projector keeps its real baseline.
+StructuredLightNoise at_focal_length(const StructuredLightNoise& s, double fx) {
+  if (!(s.reference_fx > 0) || s.reference_fx == fx) return s;
+  const double k = fx / s.reference_fx;
+  StructuredLightNoise a = s;
+  a.baseline_mm = s.baseline_mm / k;
+  a.smoothing_radius_px = static_cast<int>(std::lround(s.smoothing_radius_px * k));
+  a.edge_bleed_px = s.edge_bleed_px * k;
+  a.edge_dropout_px = s.edge_dropout_px * k;
+  return a;
+}
+
 void apply_structured_light(DepthImage& depth, const std::vector<Vec3f>& normals, const Intrinsics& K,
-                            const StructuredLightNoise& s, Rng& rng) {
+                            const StructuredLightNoise& fitted, Rng& rng) {
+  const StructuredLightNoise s = at_focal_length(fitted, K.fx);
   const bool edge_effects = s.edge_bleed_px > 0 || s.edge_dropout_rate > 0;
   DepthImage truth;
   if (edge_effects) truth = depth;
-  apply_structured_light_core(depth, normals, K, s, rng);
+  apply_structured_light_core(depth, normals, K, s, fitted.baseline_mm, rng);
   if (!edge_effects) return;
   const double fb = K.fx * s.baseline_mm;
   if (s.edge_bleed_px > 0) bleed_edges(depth, truth, fb, s.smoothing_edge_px, s.edge_bleed_px, rng);
@@ -174,7 +190,7 @@ void apply_structured_light(DepthImage& depth, const std::vector<Vec3f>& normals
 
 // Disparity noise, smoothing, quantization, shadows and grazing angles.
 void apply_structured_light_core(DepthImage& depth, const std::vector<Vec3f>& normals, const Intrinsics& K,
-                                 const StructuredLightNoise& s, Rng& rng) {
+                                 const StructuredLightNoise& s, double shadow_baseline_mm, Rng& rng) {
   const int W = depth.width, H = depth.height;
   const size_t N = depth.z.size();
   const double fb = K.fx * s.baseline_mm;
@@ -188,7 +204,7 @@ void apply_structured_light_core(DepthImage& depth, const std::vector<Vec3f>& no
   d_noisy.resize(N);
   ok.resize(N);
   std::vector<uint8_t> shadow;
-  if (s.shadows) shadow = projector_shadow_mask(depth, K, s.baseline_mm);
+  if (s.shadows) shadow = projector_shadow_mask(depth, K, shadow_baseline_mm);
   const std::vector<uint8_t> grazing = grazing_mask(depth, normals, K, s.max_incidence_deg);
   for (size_t px = 0; px < N; ++px) {
     ok[px] = valid_depth(depth.z[px]) && !grazing[px] && !(s.shadows && shadow[px]);

@@ -1,6 +1,9 @@
 #include "runner/experiment.h"
 
+#include "render/sensor.h"
+
 #include <algorithm>
+#include <cstdlib>
 #include <climits>
 #include <cstdio>
 #include <filesystem>
@@ -136,15 +139,51 @@ void parse_settings_and_grid(const YamlNode& root, const std::string& path, Expe
 
 }
 
+// ${NAME} in a path: the environment variable's value; InputError naming
+// the field when it is not set.
+std::string expand_env(const YamlNode& node, std::string p) {
+  for (size_t a; (a = p.find("${")) != std::string::npos;) {
+    const size_t b = p.find('}', a);
+    if (b == std::string::npos) node.fail("unclosed ${ in '" + p + "'");
+    const std::string var = p.substr(a + 2, b - a - 2);
+    const char* v = std::getenv(var.c_str());
+    if (!v || !*v) node.fail("environment variable " + var + " is not set (it names where the data is)");
+    p.replace(a, b - a + 1, v);
+  }
+  return p;
+}
+
+// `twin: {sensor, keep_background, seed}` (SceneSource::twin_sensor).
+void parse_twin(const YamlNode& t, const std::string& path, SceneSource& src) {
+  t.check_keys({"sensor", "keep_background", "seed"});
+  src.twin_sensor = t.get<std::string>("sensor");
+  if (is_profile_file(src.twin_sensor)) {
+    src.twin_sensor = resolve(path, src.twin_sensor);
+    if (std::error_code ec; !fs::is_regular_file(src.twin_sensor, ec))
+      t["sensor"].fail("sensor profile file not found: " + src.twin_sensor);
+  } else {
+    parse_sensor(t["sensor"]);  // a built-in name, or InputError naming the field
+  }
+  src.twin_keep_background = t.get_or<bool>("keep_background", false);
+  const long long seed = t.get_or<long long>("seed", 1);
+  if (seed < 0) t["seed"].fail("must be non-negative");
+  src.twin_seed = static_cast<uint64_t>(seed);
+}
+
 SceneSource parse_scene(const YamlNode& s, const std::string& path, std::set<std::string>& names) {
   s.check_keys({"name", "generate", "dataset", "clouds", "cloud", "split", "scene_ids", "images", "targets",
-                "scenario", "generator", "settings", "refinements", "twin_of"});
+                "scenario", "generator", "settings", "refinements", "twin_of", "twin", "image_stride"});
   SceneSource src;
   src.generate = resolve(path, s.get_or<std::string>("generate", ""));
-  src.dataset = resolve(path, s.get_or<std::string>("dataset", ""));
+  src.dataset = resolve(path, expand_env(s["dataset"], s.get_or<std::string>("dataset", "")));
   for (const auto& c : s.get_or<std::vector<std::string>>("clouds", {})) src.clouds.push_back(resolve(path, c));
-  if (!src.generate.empty() + !src.dataset.empty() + !src.clouds.empty() != 1)
-    s.fail("give exactly one of 'generate' (a scene config), 'dataset' (a BOP dataset) or 'clouds' (point clouds)");
+  if (s.has("twin")) {
+    if (!s.has("twin_of")) s["twin"].fail("a twin names its real set: give 'twin_of'");
+    parse_twin(s["twin"], path, src);
+  }
+  if (!src.generate.empty() + !src.dataset.empty() + !src.clouds.empty() + !src.twin_sensor.empty() != 1)
+    s.fail("give exactly one of 'generate' (a scene config), 'dataset' (a BOP dataset), 'clouds' (point clouds) "
+           "or 'twin' (the twin of another scene set)");
   for (size_t i = 0; i < src.clouds.size(); ++i)
     if (std::error_code ec; !fs::is_regular_file(src.clouds[i], ec)) s["clouds"].fail("cloud " + std::to_string(i) + " not found: " + src.clouds[i]);
   if (s.has("cloud")) {
@@ -156,8 +195,9 @@ SceneSource parse_scene(const YamlNode& s, const std::string& path, std::set<std
   }
   if (std::error_code ec; !src.generate.empty() && !fs::exists(src.generate, ec))
     s["generate"].fail("scene config not found: " + src.generate);
+  if (!src.twin_sensor.empty() && !s.has("name")) s["twin"].fail("a twin needs a 'name'");
   src.name = s.get_or<std::string>(
-      "name", fs::path(!src.generate.empty() ? src.generate : !src.dataset.empty() ? src.dataset : src.clouds[0])
+      "name", fs::path(!src.generate.empty() ? src.generate : !src.dataset.empty() ? src.dataset : src.clouds.empty() ? "" : src.clouds[0])
                   .stem()
                   .string());
   if (!names.insert(src.name).second) s["name"].fail("duplicate scene name '" + src.name + "'");
@@ -165,6 +205,8 @@ SceneSource parse_scene(const YamlNode& s, const std::string& path, std::set<std
   src.scene_ids = s.get_or<std::vector<int>>("scene_ids", {});
   src.images = s.get_or<int>("images", 0);
   if (src.images < 0) s["images"].fail("must be non-negative");
+  src.image_stride = s.get_or<int>("image_stride", 1);
+  if (src.image_stride < 1) s["image_stride"].fail("must be >= 1");
   src.targets = s.get_or<std::string>("targets", "");
   src.twin_of = s.get_or<std::string>("twin_of", "");
   src.scenario = s.get_or<std::string>(
@@ -248,6 +290,11 @@ nlohmann::json canonical(const ExperimentConfig& c) {
     if (!c.scenes[i].targets.empty()) canon["scenes"][i]["targets"] = c.scenes[i].targets;
     if (!c.scenes[i].clouds.empty()) canon["scenes"][i]["clouds"] = {c.scenes[i].clouds, c.scenes[i].cloud};
     if (!c.scenes[i].twin_of.empty()) canon["scenes"][i]["twin_of"] = c.scenes[i].twin_of;
+    if (c.scenes[i].image_stride != 1) canon["scenes"][i]["image_stride"] = c.scenes[i].image_stride;
+    if (!c.scenes[i].twin_sensor.empty())
+      canon["scenes"][i]["twin"] = {{"sensor", c.scenes[i].twin_sensor},
+                                    {"keep_background", c.scenes[i].twin_keep_background},
+                                    {"seed", c.scenes[i].twin_seed}};
   }
   canon["report"] = c.report;
   if (!c.judgements.empty()) canon["judgements"] = judgements_json(c.judgements);
@@ -277,17 +324,27 @@ ExperimentConfig load_experiment(const std::string& path) {
   std::set<std::string> names;
   for (size_t i = 0; i < scenes.size(); ++i) c.scenes.push_back(parse_scene(scenes.at(i), path, names));
   for (size_t i = 0; i < scenes.size(); ++i) {
-    const std::string& of = c.scenes[i].twin_of;
-    if (of.empty()) continue;
-    if (of == c.scenes[i].name || !names.count(of))
-      scenes.at(i)["twin_of"].fail("must name another scene of this experiment (the real set)");
+    SceneSource& twin = c.scenes[i];
+    if (twin.twin_of.empty()) continue;
+    const auto real = std::find_if(c.scenes.begin(), c.scenes.end(),
+                                   [&](const SceneSource& x) { return x.name == twin.twin_of; });
+    if (twin.twin_of == twin.name || real == c.scenes.end() || !real->twin_of.empty())
+      scenes.at(i)["twin_of"].fail("must name another scene of this experiment that is no twin (the real set)");
+    if (twin.twin_sensor.empty()) continue;
+    if (real->dataset.empty())
+      scenes.at(i)["twin_of"].fail("a generated twin needs a real set given by 'dataset'");
+    for (const char* k : {"split", "scene_ids", "images", "image_stride", "targets", "scenario"})
+      if (scenes.at(i).has(k)) scenes.at(i)[k].fail("a twin takes it from its real set");
+    twin.split = real->split, twin.scene_ids = real->scene_ids, twin.images = real->images;
+    twin.image_stride = real->image_stride;
+    twin.targets = real->targets, twin.scenario = real->scenario;
   }
   if (c.object == kEveryTargetObject) {
     for (size_t i = 0; i < scenes.size(); ++i) {
       SceneSource& src = c.scenes[i];
       // A generated set lists its own targets (scene_test_targets).
       if (!src.generate.empty() && src.targets.empty()) src.targets = kGeneratedTargets;
-      if (src.targets.empty() || (src.dataset.empty() && src.generate.empty()))
+      if (src.targets.empty() || (src.dataset.empty() && src.generate.empty() && src.twin_sensor.empty()))
         scenes.at(i).fail("'object: all' takes the objects from the scene's BOP test targets: give 'generate' "
                           "(the generated set lists its own), or 'dataset' and 'targets' (e.g. "
                           "test_targets_bop19.json)");
@@ -422,9 +479,10 @@ std::vector<Trial> expand_trials(const ExperimentConfig& cfg) {
     for (int sid : sids) {
       const SceneInfo scene = ds.load_scene(src.split, sid);
       check_target_images(targets, scene);
-      int taken = 0;
+      int taken = 0, seen = 0;
       for (const auto& [im_id, im] : scene.images) {
         if (!src.targets.empty() && targets.images.count({sid, im_id}) == 0) continue;
+        if (seen++ % src.image_stride != 0) continue;
         if (src.images > 0 && taken >= src.images) break;
         ++taken;
         const auto& refinements = src.refinements.empty() ? cfg.refinements : src.refinements;

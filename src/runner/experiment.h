@@ -31,6 +31,7 @@ struct SceneSource {
   std::string split = "test";
   std::vector<int> scene_ids;  // empty = all scenes of the split
   int images = 0;              // first N images per scene (0 = all)
+  int image_stride = 1;        // every K-th image per scene (video sequences), before `images`
   // A BOP test-targets file (e.g. test_targets_bop19.json; relative to the
   // dataset root): only the images it lists for the experiment's object are
   // trials, and scene_ids defaults to their scenes. "" = every image.
@@ -38,6 +39,14 @@ struct SceneSource {
   // The name of the scene set this one is the twin of (`posebench twin`):
   // the report pairs their trials ("Real and twin"). "" = none.
   std::string twin_of;
+  // `twin: {sensor, keep_background, seed}`: the scene set is made by
+  // `posebench twin` from the twin_of set's dataset with this sensor (a
+  // built-in name or a profile file) before the run; it takes that set's
+  // split, scene_ids, images, targets and scenario. Empty sensor = not a
+  // generated twin.
+  std::string twin_sensor;
+  bool twin_keep_background = false;
+  uint64_t twin_seed = 1;
   std::string scenario = "";   // table | warehouse: picks the translation threshold
   // Refinements for this scene set, replacing the experiment's list (the
   // thesis used ICP point-to-plane in the warehouse, point-to-point on tables).

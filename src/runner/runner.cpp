@@ -1,5 +1,7 @@
 #include "runner/runner.h"
 
+#include "render/sensor.h"
+
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
@@ -114,8 +116,39 @@ static void import_scene_clouds(SceneSource& src, const ExperimentConfig& cfg, c
                       "scenes." + src.name + ".clouds", "importing the clouds failed");
 }
 
+// A twin scene set (SceneSource::twin_sensor) made by `posebench twin` from
+// its real set's dataset, once per real set, sensor, seed and twin version.
+static void make_twin(SceneSource& src, const ExperimentConfig& cfg, const RunOptions& opt) {
+  const auto real = std::find_if(cfg.scenes.begin(), cfg.scenes.end(),
+                                 [&](const SceneSource& x) { return x.name == src.twin_of; });
+  const std::string real_root = fs::absolute(real->dataset).lexically_normal().string();
+  std::string sensor = src.twin_sensor;
+  std::string identity = real_root + "#" + real->split + "#" + std::to_string(src.twin_seed) + "#" +
+                         (src.twin_keep_background ? "bg" : "") + "#twin_version=1#";
+  if (is_profile_file(sensor)) {
+    sensor = fs::absolute(sensor).lexically_normal().string();
+    std::ifstream in(sensor);
+    identity += std::string(std::istreambuf_iterator<char>(in), {});  // its content, not its name
+  } else {
+    identity += sensor;
+  }
+  const std::string stem = src.name + "_" + hash_hex(identity).substr(0, 8);
+  const fs::path dir = fs::path(opt.scenes_dir) / stem;
+  src.dataset = dir.string();
+  const auto command = [&]() -> std::vector<std::string> {
+    log_event(LogLevel::info, "make_twin", {{"scene", src.name}, {"of", src.twin_of}, {"dataset", dir.string()}});
+    std::vector<std::string> args{opt.binary, "twin",    real_root, "--sensor", sensor, "--out", dir.string(),
+                                  "--split",  real->split, "--seed", std::to_string(src.twin_seed)};
+    if (src.twin_keep_background) args.push_back("--keep-background");
+    return args;
+  };
+  make_scene_set_once(opt, stem, [&] { return fs::exists(dir / "posebench_twin.json"); }, command, cfg.file,
+                      "scenes." + src.name + ".twin", "making the twin failed");
+}
+
 void prepare_scenes(ExperimentConfig& cfg, const RunOptions& opt) {
   for (auto& src : cfg.scenes) {
+    if (!src.twin_sensor.empty()) make_twin(src, cfg, opt);
     if (!src.clouds.empty()) import_scene_clouds(src, cfg, opt);
     if (src.generate.empty()) continue;
     nlohmann::json gen = yaml_to_json_file(src.generate);

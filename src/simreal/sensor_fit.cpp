@@ -163,8 +163,11 @@ SensorFitResult fit_sensor(const std::string& dataset, const SensorFitSettings& 
   ModelMeshes meshes(ds);
   SensorStatsAccumulator real(s.stats);
   std::vector<FitFrame> frames;
+  double depth_lo = 1e300, depth_hi = 0;
   for (const auto& [sid, iid] : ids) {
     const GtFrame g = load_gt_frame(ds, s.split, sid, iid);
+    for (float z : g.depth.z)
+      if (z > 0) depth_lo = std::min<double>(depth_lo, z), depth_hi = std::max<double>(depth_hi, z);
     FitFrame f;
     f.info = g.info;
     f.scene_id = sid;
@@ -183,12 +186,17 @@ SensorFitResult fit_sensor(const std::string& dataset, const SensorFitSettings& 
     frames.push_back(std::move(f));
   }
   r.images = static_cast<int>(frames.size());
+  // The sensor measured what the frames show: the base's range widens to
+  // take it in (a close-range mode, say), else the simulation drops it.
+  SensorProfile base = s.base;
+  base.min_range_mm = std::min(base.min_range_mm, std::floor(0.95 * depth_lo));
+  base.max_range_mm = std::min(65535.0 * base.depth_scale, std::max(base.max_range_mm, std::ceil(1.05 * depth_hi)));
   r.real = real.finish();
   NoiseSettings start = s.base.noise;
   if (model == "structured_light")
     start.structured_light.disparity_step_px = disparity_step_from(
         r.real, r.K.fx, start.structured_light.baseline_mm, start.structured_light.disparity_step_px);
-  r.base = simulate(frames, s.base, s.base.noise, s);
+  r.base = simulate(frames, base, base.noise, s);
   r.base_loss = fit_loss(r.real, r.base);
   // Coordinate descent: each field in turn takes the value with the least
   // loss, the others held; passes until none changes (at most 3).
@@ -204,7 +212,7 @@ SensorFitResult fit_sensor(const std::string& dataset, const SensorFitSettings& 
       axes[k].set(c.noise, x[k]);
       c.params[axes[k].name] = x[k];
     }
-    c.loss = fit_loss(r.real, simulate(frames, s.base, c.noise, s));
+    c.loss = fit_loss(r.real, simulate(frames, base, c.noise, s));
     r.candidates.push_back(c);
     return seen[x] = c.loss.total();
   };
@@ -222,11 +230,12 @@ SensorFitResult fit_sensor(const std::string& dataset, const SensorFitSettings& 
     if (!changed) break;
   }
   for (size_t k = 0; k < axes.size(); ++k) axes[k].set(cur, at[k]);
-  r.profile = s.base;
+  r.profile = base;
   r.profile.name = s.name;
   r.profile.K = r.K;
   r.profile.noise = cur;
-  r.fitted = simulate(frames, s.base, r.profile.noise, s);
+  if (model == "structured_light") r.profile.noise.structured_light.reference_fx = r.K.fx;
+  r.fitted = simulate(frames, base, r.profile.noise, s);
   return r;
 }
 
@@ -245,7 +254,8 @@ nlohmann::ordered_json noise_json(const NoiseSettings& n) {
               {"shadows", s.shadows},
               {"edge_bleed_px", s.edge_bleed_px},
               {"edge_dropout_rate", s.edge_dropout_rate},
-              {"edge_dropout_px", s.edge_dropout_px}});
+              {"edge_dropout_px", s.edge_dropout_px},
+              {"reference_fx", s.reference_fx}});
   }
   if (n.model == "tof") {
     const auto& t = n.tof;
