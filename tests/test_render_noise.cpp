@@ -100,9 +100,10 @@ TEST(RenderNoise, StructuredLightErrorGrowsWithDepth) {
     EXPECT_GT(s.n, 0.95 * out.depth.valid_count());  // a plane: no shadows, no grazing
     rms.push_back(s.rms);
   }
-  // Error ~ z^2 / (fx b): (2500/800)^2 = 9.8; require clear growth.
+  // Error ~ z^2 / (fx b): (2500/800)^2 = 9.8; require clear growth. At
+  // 800 mm: 0.69 px of jitter over a 3 x 3 window is about 3.5 mm.
   EXPECT_GT(rms[1], 5.0 * rms[0]);
-  EXPECT_LT(rms[0], 2.0);
+  EXPECT_LT(rms[0], 5.0);
 }
 
 TEST(RenderNoise, StructuredLightQuantizesDisparity) {
@@ -204,6 +205,10 @@ TEST(RenderNoise, StructuredLightEqualsItsDefinitionBitForBit) {
         NoiseSettings n = astra.noise;
         n.structured_light.smoothing_radius_px = r;
         n.structured_light.smoothing_edge_px = edge;
+        // The edge effects come after this part of the model
+        // (StructuredLightEdgeEffects tests them).
+        n.structured_light.edge_bleed_px = 0;
+        n.structured_light.edge_dropout_rate = 0;
         const DepthImage got = noisy(out, sensor, n, 7);
         const DepthImage want = structured_light_by_definition(out, sensor, n.structured_light, 7);
         size_t differ = 0, measured = 0, rendered = 0;
@@ -221,6 +226,59 @@ TEST(RenderNoise, StructuredLightEqualsItsDefinitionBitForBit) {
         }
       }
   }
+}
+
+TEST(RenderNoise, StructuredLightEdgeEffects) {
+  // The box before the wall, no jitter, smoothing or shadows: only the edge
+  // effects move depths.
+  SensorProfile astra = sensor_profile("astra");
+  const RenderOutput out = render_box_wall(astra.K);
+  NoiseSettings n = astra.noise;
+  auto& s = n.structured_light;
+  s.disparity_sigma_px = 0, s.smoothing_radius_px = 0, s.shadows = false, s.max_incidence_deg = 90;
+  s.disparity_step_px = 1e-4;
+  const int W = astra.K.width, H = astra.K.height;
+  // Chebyshev distance of each wall pixel to the box (up to 6).
+  std::vector<int> to_box(out.labels.size(), 99);
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u) {
+      if (out.labels[static_cast<size_t>(v) * W + u] != 1) continue;
+      for (int dv = -6; dv <= 6; ++dv)
+        for (int du = -6; du <= 6; ++du) {
+          const int uu = u + du, vv = v + dv;
+          if (uu < 0 || vv < 0 || uu >= W || vv >= H || out.labels[static_cast<size_t>(vv) * W + uu] != 2) continue;
+          int& d = to_box[static_cast<size_t>(v) * W + u];
+          d = std::min(d, std::max(std::abs(du), std::abs(dv)));
+        }
+    }
+  // The box grows over the wall by exactly 2 px.
+  s.edge_bleed_px = 2, s.edge_dropout_rate = 0;
+  DepthImage d = noisy(out, astra, n, 9);
+  size_t grown = 0, near_wall = 0;
+  for (size_t p = 0; p < d.z.size(); ++p) {
+    if (out.labels[p] != 1) continue;
+    const bool like_box = d.z[p] > 0 && d.z[p] < 1000;
+    if (to_box[p] <= 2) EXPECT_TRUE(like_box) << p, ++grown;
+    else EXPECT_FALSE(like_box) << p, near_wall += to_box[p] <= 6;
+  }
+  EXPECT_GT(grown, 1000u);
+  EXPECT_GT(near_wall, 1000u);
+  // Rate 1 at the edge, falling off with distance: every pixel next to the
+  // outline is dropped, none farther than 4 edge widths.
+  s.edge_bleed_px = 0, s.edge_dropout_rate = 1, s.edge_dropout_px = 1;
+  d = noisy(out, astra, n, 9);
+  size_t edge_px = 0, kept_far = 0, far = 0;
+  const auto box = [&](size_t q) { return out.labels[q] == 2; };
+  for (size_t p = 0; p < d.z.size(); ++p) {
+    if (out.labels[p] != 1) continue;
+    const int u = static_cast<int>(p % W), v = static_cast<int>(p / W);
+    const bool outline = (u > 0 && box(p - 1)) || (u + 1 < W && box(p + 1)) || (v > 0 && box(p - W)) ||
+                         (v + 1 < H && box(p + W));
+    if (outline) EXPECT_EQ(d.z[p], 0.f), ++edge_px;  // next to the box: an edge pixel
+    if (to_box[p] >= 6 && to_box[p] < 99) ++far, kept_far += d.z[p] > 0;
+  }
+  EXPECT_GT(edge_px, 500u);
+  EXPECT_EQ(kept_far, far);
 }
 
 TEST(RenderNoise, WindowSumKernelsAgreeBitForBit) {

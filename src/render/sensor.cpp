@@ -238,4 +238,37 @@ NoiseSettings parse_noise(const YamlNode& node, const NoiseSettings& base) {
   return n;
 }
 
+nlohmann::ordered_json noise_json(const NoiseSettings& n) {
+  nlohmann::ordered_json j;
+  j["model"] = n.model;
+  if (n.model == "gaussian") j["sigma_mm"] = n.gaussian.sigma_mm;
+  if (n.model == "structured_light") {
+    const auto& s = n.structured_light;
+    j.update({{"baseline_mm", s.baseline_mm},
+              {"disparity_step_px", s.disparity_step_px},
+              {"disparity_sigma_px", s.disparity_sigma_px},
+              {"smoothing_radius_px", s.smoothing_radius_px},
+              {"smoothing_edge_px", s.smoothing_edge_px},
+              {"max_incidence_deg", s.max_incidence_deg},
+              {"shadows", s.shadows},
+              {"edge_bleed_px", s.edge_bleed_px},
+              {"edge_dropout_rate", s.edge_dropout_rate},
+              {"edge_dropout_px", s.edge_dropout_px},
+              {"reference_fx", s.reference_fx}});
+  }
+  if (n.model == "tof") {
+    const auto& t = n.tof;
+    j.update({{"sigma_base_mm", t.sigma_base_mm},
+              {"sigma_per_m2_mm", t.sigma_per_m2_mm},
+              {"edge_jump_mm", t.edge_jump_mm},
+              {"flying_fraction", t.flying_fraction},
+              {"max_incidence_deg", t.max_incidence_deg},
+              {"driver_edge_filter", t.driver_edge_filter},
+              {"edge_filter_close_mm", t.edge_filter_close_mm},
+              {"edge_filter_far_mm", t.edge_filter_far_mm},
+              {"edge_filter_span_mm", t.edge_filter_span_mm}});
+  }
+  return j;
+}
+
 }  // namespace pb

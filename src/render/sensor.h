@@ -30,6 +30,7 @@
 #pragma once
 
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -47,28 +48,33 @@ struct GaussianNoise {
 
 // Structured light (Astra-like): depth from quantized disparity with a
 // projector baseline, so the error grows with z^2; local smoothing; no depth
-// in projector shadows and at grazing angles.
-// Defaults: fitted to real PrimeSense-class frames (Kinect v1 / Xtion, the
-// Astra's technology) by scripts/fit_sensors.py, results/sensors/fit_astra.json
-// (disparity_step_px from the measured depth steps, 2.87e-6 z^2 per mm, times
-// this profile's fx * baseline; disparity_sigma_px and smoothing_radius_px
-// from the plane-fit noise per depth bin, 0.5-4 m; max_incidence_deg from the
-// missing rate per incidence angle). Before the fit: 0.125, 0.05, 1, 75.
+// in projector shadows, at grazing angles and in a band along depth edges;
+// the nearer surface grows over the farther.
+// Defaults: fitted by `posebench sensor-fit` to real PrimeSense-class frames
+// with ground truth (YCB-Video, Asus Xtion: results/sensors/real/ycbv, whose
+// profile.yaml has the fit at those frames' focal length, 1066.8 px), here at
+// this profile's (565.6 px): the disparity jitter, edge threshold and edge
+// widths times 565.6 / 1066.8 (the same depth noise and the same widths in
+// the scene). disparity_step_px keeps the steps measured on raw OpenNI
+// frames (results/sensors/fit_astra.json: 2.87e-6 z^2 per mm); the
+// ground-truth frames are registered to colour and interpolated and show
+// none. Before the fit on frames with ground truth: disparity_sigma_px 0.3,
+// smoothing_radius_px 2, smoothing_edge_px 1, max_incidence_deg 80, no edge
+// effects (configs/sensors/astra_no_gt.yaml; results/sim2real/README.md).
 struct StructuredLightNoise {
   double baseline_mm = 75.0;         // projector-camera baseline along +x
   double disparity_step_px = 0.1216; // disparity quantization (about the 1/8 px subpixel step)
-  double disparity_sigma_px = 0.3;   // Gaussian jitter on disparity before smoothing and quantization
-  int smoothing_radius_px = 2;       // box smoothing of disparity over (2r+1)^2 valid neighbours
-  double smoothing_edge_px = 1.0;    // neighbours whose true disparity differs more are not averaged
-  double max_incidence_deg = 80.0;   // no depth beyond this angle between ray and normal
+  double disparity_sigma_px = 0.69;  // Gaussian jitter on disparity before smoothing and quantization
+  int smoothing_radius_px = 1;       // box smoothing of disparity over (2r+1)^2 valid neighbours
+  double smoothing_edge_px = 0.13;   // neighbours whose true disparity differs more are not averaged
+  double max_incidence_deg = 90.0;   // no depth beyond this angle between ray and normal
   bool shadows = true;               // drop pixels the projector cannot see
-  // Depth edges, as real frames with ground truth show them (posebench
-  // sensor-fit, results/sensors/README.md); both off by default. An edge is
-  // a true disparity step larger than smoothing_edge_px between 4-neighbours
-  // (or between depth and none).
-  double edge_bleed_px = 0;          // the nearer surface grows over the farther by this many px (correlation window)
-  double edge_dropout_rate = 0;      // probability of no depth at an edge pixel, falling off as
-  double edge_dropout_px = 2;        //   exp(-d / edge_dropout_px) with the distance d (px) to the edge
+  // Depth edges, as real frames with ground truth show them. An edge is a
+  // step of the true depth between 4-neighbours larger than 10 mm + 1% of
+  // the nearer depth (or depth next to none).
+  double edge_bleed_px = 0.27;        // the nearer surface grows over the farther by this many px (correlation window)
+  double edge_dropout_rate = 0.5;    // probability of no depth at an edge pixel, falling off as
+  double edge_dropout_px = 2.12;     //   exp(-d / edge_dropout_px) with the distance d (px) to the edge
   // The focal length (px) the pixel-unit fields were fitted at; at another
   // focal length the window and edge widths scale with it and the depth
   // noise stays (f x baseline is kept). 0 = the image's own.
@@ -148,6 +154,8 @@ SensorProfile sensor_profile(const std::string& name, const std::string& file = 
 SensorProfile parse_sensor(const YamlNode& node);
 // Whether a sensor name is a profile file (ends in .yaml or .yml).
 bool is_profile_file(const std::string& name);
+// The model's fields as a `noise:` map (parse_noise reads it back).
+nlohmann::ordered_json noise_json(const NoiseSettings& n);
 // Intrinsics from a YAML map {width, height, fx, fy | hfov_deg, vfov_deg, cx,
 // cy}, each key defaulting to `base`'s (required where `base` has none; cx,
 // cy to the image centre when the size differs from base's). InputError

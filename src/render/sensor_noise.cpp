@@ -80,39 +80,40 @@ void apply_gaussian(DepthImage& depth, const GaussianNoise& g, Rng& rng) {
     if (valid_depth(z)) z = static_cast<float>(z + rng.normal(0.0, g.sigma_mm));
 }
 
-// Pixels next to a true disparity step larger than `edge` (4-neighbours; a
-// pixel with depth next to one without is on an edge too).
-std::vector<uint8_t> disparity_edges(const DepthImage& truth, double fb, double edge) {
+// Pixels next to a depth edge of the true image: a step between
+// 4-neighbours larger than 10 mm + 1% of the nearer depth, or depth next to
+// none (a sloped surface steps far less per pixel at these distances).
+bool depth_step(float a, float b) {
+  if (valid_depth(a) != valid_depth(b)) return true;
+  if (!valid_depth(a)) return false;
+  return std::abs(a - b) > 10.0 + 0.01 * std::min(a, b);
+}
+
+std::vector<uint8_t> depth_edges(const DepthImage& truth) {
   const int W = truth.width, H = truth.height;
   std::vector<uint8_t> e(truth.z.size(), 0);
-  auto disp = [&](size_t p) { return valid_depth(truth.z[p]) ? fb / truth.z[p] : 0.0; };
   for (int v = 0; v < H; ++v)
     for (int u = 0; u < W; ++u) {
       const size_t p = static_cast<size_t>(v) * W + u;
-      const double d = disp(p);
-      const bool step = (u + 1 < W && std::abs(disp(p + 1) - d) > edge) ||
-                        (v + 1 < H && std::abs(disp(p + W) - d) > edge);
-      if (!step) continue;
-      e[p] = 1;
-      if (u + 1 < W && std::abs(disp(p + 1) - d) > edge) e[p + 1] = 1;
-      if (v + 1 < H && std::abs(disp(p + W) - d) > edge) e[p + W] = 1;
+      if (u + 1 < W && depth_step(truth.z[p], truth.z[p + 1])) e[p] = e[p + 1] = 1;
+      if (v + 1 < H && depth_step(truth.z[p], truth.z[p + W])) e[p] = e[p + W] = 1;
     }
   return e;
 }
 
 // The nearer surface grows over the farther (StructuredLightNoise::
 // edge_bleed_px): a pixel takes the measured depth of the closest pixel
-// (Chebyshev distance k) whose true disparity is larger by more than `edge`,
-// when k <= floor(b), or k = ceil(b) with probability b - floor(b).
-void bleed_edges(DepthImage& depth, const DepthImage& truth, double fb, double edge, double b, Rng& rng) {
+// (Chebyshev distance k) whose true depth is nearer across a depth edge
+// (depth_step), when k <= floor(b), or k = ceil(b) with probability
+// b - floor(b).
+void bleed_edges(DepthImage& depth, const DepthImage& truth, double b, Rng& rng) {
   const int W = depth.width, H = depth.height, R = static_cast<int>(std::ceil(b));
   const double frac = b - std::floor(b);
   const DepthImage measured = depth;
-  auto disp = [&](size_t p) { return valid_depth(truth.z[p]) ? fb / truth.z[p] : 0.0; };
   for (int v = 0; v < H; ++v)
     for (int u = 0; u < W; ++u) {
       const size_t p = static_cast<size_t>(v) * W + u;
-      const double d = disp(p);
+      const float zp = truth.z[p];
       int best_k = R + 1;
       size_t best = 0;
       for (int dv = -R; dv <= R; ++dv)
@@ -120,7 +121,9 @@ void bleed_edges(DepthImage& depth, const DepthImage& truth, double fb, double e
           const int uu = u + du, vv = v + dv, k = std::max(std::abs(du), std::abs(dv));
           if (uu < 0 || vv < 0 || uu >= W || vv >= H || k >= best_k || k == 0) continue;
           const size_t q = static_cast<size_t>(vv) * W + uu;
-          if (valid_depth(measured.z[q]) && disp(q) > d + edge) best_k = k, best = q;
+          const float zq = truth.z[q];
+          if (valid_depth(measured.z[q]) && valid_depth(zq) && (!valid_depth(zp) || zq < zp) && depth_step(zq, zp))
+            best_k = k, best = q;
         }
       if (best_k > R) continue;
       if (best_k == R && frac > 0 && !rng.bernoulli(frac)) continue;
@@ -181,11 +184,8 @@ void apply_structured_light(DepthImage& depth, const std::vector<Vec3f>& normals
   if (edge_effects) truth = depth;
   apply_structured_light_core(depth, normals, K, s, fitted.baseline_mm, rng);
   if (!edge_effects) return;
-  const double fb = K.fx * s.baseline_mm;
-  if (s.edge_bleed_px > 0) bleed_edges(depth, truth, fb, s.smoothing_edge_px, s.edge_bleed_px, rng);
-  if (s.edge_dropout_rate > 0)
-    drop_near_edges(depth, disparity_edges(truth, fb, s.smoothing_edge_px), s.edge_dropout_rate, s.edge_dropout_px,
-                    rng);
+  if (s.edge_bleed_px > 0) bleed_edges(depth, truth, s.edge_bleed_px, rng);
+  if (s.edge_dropout_rate > 0) drop_near_edges(depth, depth_edges(truth), s.edge_dropout_rate, s.edge_dropout_px, rng);
 }
 
 // Disparity noise, smoothing, quantization, shadows and grazing angles.

@@ -123,15 +123,14 @@ static void make_twin(SceneSource& src, const ExperimentConfig& cfg, const RunOp
                                  [&](const SceneSource& x) { return x.name == src.twin_of; });
   const std::string real_root = fs::absolute(real->dataset).lexically_normal().string();
   std::string sensor = src.twin_sensor;
-  std::string identity = real_root + "#" + real->split + "#" + std::to_string(src.twin_seed) + "#" +
-                         (src.twin_keep_background ? "bg" : "") + "#twin_version=1#";
-  if (is_profile_file(sensor)) {
-    sensor = fs::absolute(sensor).lexically_normal().string();
-    std::ifstream in(sensor);
-    identity += std::string(std::istreambuf_iterator<char>(in), {});  // its content, not its name
-  } else {
-    identity += sensor;
-  }
+  if (is_profile_file(sensor)) sensor = fs::absolute(sensor).lexically_normal().string();
+  // One twin per real set, sensor model (what it resolves to, not its name:
+  // a built-in's defaults may change), seed and background.
+  const SensorProfile prof = parse_sensor(YamlNode::load_string(sensor, "scenes." + src.name + ".twin.sensor"));
+  const std::string identity = real_root + "#" + real->split + "#" + std::to_string(src.twin_seed) + "#" +
+                               (src.twin_keep_background ? "bg" : "") + "#twin_version=1#" + prof.name + "#" +
+                               noise_json(prof.noise).dump() + "#" + std::to_string(prof.min_range_mm) + "," +
+                               std::to_string(prof.max_range_mm);
   const std::string stem = src.name + "_" + hash_hex(identity).substr(0, 8);
   const fs::path dir = fs::path(opt.scenes_dir) / stem;
   src.dataset = dir.string();

@@ -31,8 +31,8 @@ std::vector<int> obj_ids_of(const ImageInfo& info) {
 }
 
 SensorStats simulate(const std::vector<FitFrame>& frames, const SensorProfile& base, const NoiseSettings& noise,
-                     const SensorFitSettings& s) {
-  SensorStatsAccumulator acc(s.stats);
+                     const SensorFitSettings& s, const SensorStatsSettings& stats) {
+  SensorStatsAccumulator acc(stats);
   for (const FitFrame& f : frames) {
     SensorProfile prof = base;
     prof.K = f.info.K;
@@ -83,10 +83,12 @@ struct Axis {
 std::vector<Axis> axes_for(const std::string& model) {
   if (model == "structured_light")
     return {
-        {"disparity_sigma_px", {0.1, 0.2, 0.3, 0.45, 0.6, 0.8, 1.0},
+        {"disparity_sigma_px", {0.1, 0.2, 0.3, 0.45, 0.6, 0.8, 1.0, 1.3},
          [](NoiseSettings& n, double v) { n.structured_light.disparity_sigma_px = v; }},
         {"smoothing_radius_px", {0, 1, 2, 3},
          [](NoiseSettings& n, double v) { n.structured_light.smoothing_radius_px = static_cast<int>(v); }},
+        {"smoothing_edge_px", {0.25, 0.5, 1.0, 2.0},
+         [](NoiseSettings& n, double v) { n.structured_light.smoothing_edge_px = v; }},
         {"max_incidence_deg", {65, 70, 75, 80, 85, 90},
          [](NoiseSettings& n, double v) { n.structured_light.max_incidence_deg = v; }},
         {"edge_bleed_px", {0, 0.5, 1, 1.5, 2, 3},
@@ -129,9 +131,10 @@ FitLoss fit_loss(const SensorStats& real, const SensorStats& sim, int64_t min_pi
                         return l * l;
                       },
                       [](const ResidualBin& a) { return a.inliers >= 100; });
-  const double r0a = interior_rate(real), r0b = interior_rate(sim);
+  // The real rates less what no model here produces; the simulated as they are.
+  const double r0 = interior_rate(real);
   auto miss = [&](const ResidualBin& a, const ResidualBin& b) {
-    const double d = (geometric_missing(b, r0b) - geometric_missing(a, r0a)) / 0.1;
+    const double d = (geometric_missing(b, 0) - geometric_missing(a, r0)) / 0.1;
     return d * d;
   };
   L.incidence = mean_over(real.by_incidence, sim.by_incidence, miss, all);
@@ -161,7 +164,10 @@ SensorFitResult fit_sensor(const std::string& dataset, const SensorFitSettings& 
   r.planes = nlohmann::ordered_json::array();
   RendererPool pool;
   ModelMeshes meshes(ds);
-  SensorStatsAccumulator real(s.stats);
+  // The final statistics also measure the normals (too slow for every candidate).
+  SensorStatsSettings with_normals = s.stats;
+  if (with_normals.normal_window_px == 0) with_normals.normal_window_px = 5;
+  SensorStatsAccumulator real(with_normals);
   std::vector<FitFrame> frames;
   double depth_lo = 1e300, depth_hi = 0;
   for (const auto& [sid, iid] : ids) {
@@ -196,7 +202,7 @@ SensorFitResult fit_sensor(const std::string& dataset, const SensorFitSettings& 
   if (model == "structured_light")
     start.structured_light.disparity_step_px = disparity_step_from(
         r.real, r.K.fx, start.structured_light.baseline_mm, start.structured_light.disparity_step_px);
-  r.base = simulate(frames, base, base.noise, s);
+  r.base = simulate(frames, base, base.noise, s, with_normals);
   r.base_loss = fit_loss(r.real, r.base);
   // Coordinate descent: each field in turn takes the value with the least
   // loss, the others held; passes until none changes (at most 3).
@@ -212,7 +218,7 @@ SensorFitResult fit_sensor(const std::string& dataset, const SensorFitSettings& 
       axes[k].set(c.noise, x[k]);
       c.params[axes[k].name] = x[k];
     }
-    c.loss = fit_loss(r.real, simulate(frames, base, c.noise, s));
+    c.loss = fit_loss(r.real, simulate(frames, base, c.noise, s, s.stats));
     r.candidates.push_back(c);
     return seen[x] = c.loss.total();
   };
@@ -235,41 +241,8 @@ SensorFitResult fit_sensor(const std::string& dataset, const SensorFitSettings& 
   r.profile.K = r.K;
   r.profile.noise = cur;
   if (model == "structured_light") r.profile.noise.structured_light.reference_fx = r.K.fx;
-  r.fitted = simulate(frames, base, r.profile.noise, s);
+  r.fitted = simulate(frames, base, r.profile.noise, s, with_normals);
   return r;
-}
-
-nlohmann::ordered_json noise_json(const NoiseSettings& n) {
-  nlohmann::ordered_json j;
-  j["model"] = n.model;
-  if (n.model == "gaussian") j["sigma_mm"] = n.gaussian.sigma_mm;
-  if (n.model == "structured_light") {
-    const auto& s = n.structured_light;
-    j.update({{"baseline_mm", s.baseline_mm},
-              {"disparity_step_px", s.disparity_step_px},
-              {"disparity_sigma_px", s.disparity_sigma_px},
-              {"smoothing_radius_px", s.smoothing_radius_px},
-              {"smoothing_edge_px", s.smoothing_edge_px},
-              {"max_incidence_deg", s.max_incidence_deg},
-              {"shadows", s.shadows},
-              {"edge_bleed_px", s.edge_bleed_px},
-              {"edge_dropout_rate", s.edge_dropout_rate},
-              {"edge_dropout_px", s.edge_dropout_px},
-              {"reference_fx", s.reference_fx}});
-  }
-  if (n.model == "tof") {
-    const auto& t = n.tof;
-    j.update({{"sigma_base_mm", t.sigma_base_mm},
-              {"sigma_per_m2_mm", t.sigma_per_m2_mm},
-              {"edge_jump_mm", t.edge_jump_mm},
-              {"flying_fraction", t.flying_fraction},
-              {"max_incidence_deg", t.max_incidence_deg},
-              {"driver_edge_filter", t.driver_edge_filter},
-              {"edge_filter_close_mm", t.edge_filter_close_mm},
-              {"edge_filter_far_mm", t.edge_filter_far_mm},
-              {"edge_filter_span_mm", t.edge_filter_span_mm}});
-  }
-  return j;
 }
 
 std::string profile_yaml(const SensorProfile& p, const std::string& comment) {

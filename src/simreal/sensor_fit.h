@@ -34,9 +34,10 @@ struct FitLoss {
   double silhouette = 0;  // ((object_rate_sim - object_rate_real) / 0.1)^2 for d = -2..3
   double total() const { return noise + incidence + edge + silhouette; }
 };
-// The missing rates compared are the geometric part: a set's rate r over
-// pixels nothing nearer covers, as (r - r0) / (1 - r0) with r0 its interior
-// frontal rate (which no noise model here produces, see SensorStats).
+// The missing rates compared are the geometric part: the rate r over pixels
+// nothing nearer covers; for the real frames as (r - r0) / (1 - r0) with r0
+// their interior frontal rate (dark or shiny surfaces: no noise model here
+// produces it, see SensorStats).
 FitLoss fit_loss(const SensorStats& real, const SensorStats& sim, int64_t min_pixels = 300);
 
 struct FitCandidate {
@@ -62,7 +63,6 @@ SensorFitResult fit_sensor(const std::string& dataset, const SensorFitSettings& 
 
 // The fitted profile as a YAML sensor map (parse_sensor reads it).
 std::string profile_yaml(const SensorProfile& p, const std::string& comment);
-nlohmann::ordered_json noise_json(const NoiseSettings& n);
 nlohmann::ordered_json to_json(const SensorFitResult& r);
 
 }  // namespace pb

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <Eigen/Eigenvalues>
 #include <deque>
 #include <functional>
 
@@ -97,6 +98,7 @@ SensorStatsAccumulator::SensorStatsAccumulator(SensorStatsSettings s) : s_(s) {
   const int nd = static_cast<int>(std::ceil(s_.max_depth_mm / s_.depth_bin_mm));
   depth_.resize(nd);
   quant_steps_.resize(nd);
+  normal_deg_.resize(nd);
   for (int i = 0; i < nd; ++i) depth_[i].bin.lo = i * s_.depth_bin_mm, depth_[i].bin.hi = (i + 1) * s_.depth_bin_mm;
   const int ni = static_cast<int>(std::ceil(90.0 / s_.incidence_bin_deg));
   incidence_.resize(ni);
@@ -190,6 +192,7 @@ void SensorStatsAccumulator::add(const DepthImage& measured, const RenderOutput&
         else ++b.object;
       }
     }
+  if (s_.normal_window_px > 0 && truth.normals.size() == truth.labels.size()) add_normals(measured, truth, K);
   // Quantization: distinct measured depths per bin of this frame.
   std::vector<std::vector<float>> vals(depth_.size());
   for (float z : measured.z) {
@@ -208,6 +211,39 @@ void SensorStatsAccumulator::add(const DepthImage& measured, const RenderOutput&
   }
 }
 
+void SensorStatsAccumulator::add_normals(const DepthImage& measured, const RenderOutput& truth, const Intrinsics& K) {
+  const int W = measured.width, H = measured.height, w = s_.normal_window_px;
+  const int step = std::max(1, s_.normal_stride);
+  for (int v = w; v < H - w; v += step)
+    for (int u = w; u < W - w; u += step) {
+      const size_t p = static_cast<size_t>(v) * W + u;
+      const int label = truth.labels[p];
+      if (label < 0 || !(measured.z[p] > 0)) continue;
+      const double zt = truth.depth.z[p], band = s_.outlier_mm + s_.outlier_rel * zt;
+      if (std::abs(measured.z[p] - zt) > band) continue;
+      // The window's measured points of the same object near the pixel's depth.
+      Vec3 c = Vec3::Zero();
+      std::vector<Vec3> pts;
+      for (int dv = -w; dv <= w; ++dv)
+        for (int du = -w; du <= w; ++du) {
+          const size_t q = static_cast<size_t>(v + dv) * W + (u + du);
+          if (truth.labels[q] != label || !(measured.z[q] > 0) || std::abs(measured.z[q] - measured.z[p]) > band)
+            continue;
+          pts.push_back(K.backproject(u + du, v + dv, measured.z[q]));
+          c += pts.back();
+        }
+      if (static_cast<int>(pts.size()) < (2 * w + 1) * (2 * w + 1) / 2) continue;
+      c /= static_cast<double>(pts.size());
+      Mat3 C = Mat3::Zero();
+      for (const Vec3& x : pts) C += (x - c) * (x - c).transpose();
+      const Vec3 n = Eigen::SelfAdjointEigenSolver<Mat3>(C).eigenvectors().col(0);
+      const Vec3 nt = truth.normals[p].cast<double>().normalized();
+      const double deg = std::acos(std::min(1.0, std::abs(n.dot(nt)))) * 180.0 / M_PI;
+      const int di = static_cast<int>(zt / s_.depth_bin_mm);
+      if (di >= 0 && di < static_cast<int>(normal_deg_.size())) normal_deg_[di].push_back(static_cast<float>(deg));
+    }
+}
+
 SensorStats SensorStatsAccumulator::finish() const {
   SensorStats s;
   s.settings = s_;
@@ -219,6 +255,14 @@ SensorStats SensorStatsAccumulator::finish() const {
   for (const Acc& a : edge_) s.by_edge_px.push_back(finish_bin(a.bin, a.r, a.rc));
   for (const auto& [id, a] : object_) s.by_object[id] = finish_bin(a.bin, a.r, a.rc);
   s.silhouette = sil_;
+  for (size_t i = 0; i < normal_deg_.size(); ++i) {
+    if (normal_deg_[i].empty()) continue;
+    std::vector<float> x = normal_deg_[i];
+    NormalBin b{depth_[i].bin.lo, depth_[i].bin.hi, static_cast<int64_t>(x.size()), median(x), 0};
+    std::sort(x.begin(), x.end());
+    b.p90_deg = x[static_cast<size_t>(0.9 * (x.size() - 1))];
+    s.normal_error.push_back(b);
+  }
   for (size_t i = 0; i < depth_.size(); ++i) {
     QuantBin q{depth_[i].bin.lo, depth_[i].bin.hi, static_cast<int>(quant_steps_[i].size()), 0};
     q.step_mm = median(quant_steps_[i]);
@@ -277,6 +321,11 @@ nlohmann::ordered_json to_json(const SensorStats& s) {
   for (const auto& b : s.quantization)
     if (b.frames > 0) q.push_back({{"lo", b.lo}, {"hi", b.hi}, {"frames", b.frames}, {"step_mm", b.step_mm}});
   j["quantization"] = q;
+  nlohmann::ordered_json ne = nlohmann::ordered_json::array();
+  for (const auto& b : s.normal_error)
+    ne.push_back({{"lo", b.lo}, {"hi", b.hi}, {"n", b.n}, {"median_deg", b.median_deg}, {"p90_deg", b.p90_deg}});
+  j["normal_error"] = ne;
+  j["settings"]["normal_window_px"] = s.settings.normal_window_px;
   return j;
 }
 

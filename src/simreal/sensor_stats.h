@@ -43,6 +43,19 @@ struct SensorStatsSettings {
   int silhouette_px = 5;          // signed silhouette distances -silhouette_px..silhouette_px
   int edge_bins_px = 12;          // inside distances 0..edge_bins_px-1, the last bin open
   int min_quant_values = 5;       // a frame's bin needs this many distinct depths for a step
+  // Normals: the plane through the measured points of a pixel's window
+  // (2w+1)^2 on the same object, against the rendered normal, at every
+  // normal_stride-th pixel of every normal_stride-th row. 0 = not measured.
+  int normal_window_px = 0;
+  int normal_stride = 3;
+};
+
+// The angle (deg) between the normal of the measured points and the true
+// normal, over the object pixels of one depth bin.
+struct NormalBin {
+  double lo = 0, hi = 0;  // true depth (mm)
+  int64_t n = 0;
+  double median_deg = 0, p90_deg = 0;
 };
 
 // Counts and residual statistics of the object pixels in one bin.
@@ -81,6 +94,7 @@ struct SensorStats {
   // below 45 deg and at least 8 px inside the outline (dark or shiny
   // surfaces, multipath, interference; no noise model here drops them).
   ResidualBin interior_frontal;
+  std::vector<NormalBin> normal_error;  // by depth; empty unless normal_window_px > 0
 };
 
 class SensorStatsAccumulator {
@@ -105,6 +119,8 @@ class SensorStatsAccumulator {
   std::map<int, Acc> object_;
   std::vector<SilhouetteBin> sil_;
   std::vector<std::vector<double>> quant_steps_;  // per depth bin, one step per frame
+  std::vector<std::vector<float>> normal_deg_;    // per depth bin
+  void add_normals(const DepthImage& measured, const RenderOutput& truth, const Intrinsics& K);
 };
 
 // Object pixels' distance (4-connected steps) to the nearest pixel of
