@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """Plots of `posebench sensor-fit`'s statistics: sensor_fit.json -> OUT/sensor_fit.png.
 
-Six panels, real frames against their twins with the base profile's noise and
-with the fitted noise: spread and bias of the depth residual per true depth,
-missing rate per incidence angle and per distance to the object's outline,
-what the measured depth is across the outline, and the quantization step.
+Eight panels, real frames against their twins with the base profile's noise
+and with the fitted noise: spread and bias of the depth residual per true
+depth, the quantization step, the normals' error, missing rate per incidence
+angle, per distance to the object's outline and per object, and what the
+measured depth is across the outline.
 Each real bin is labelled with its pixel count n (frames for the steps).
 """
 import json
@@ -97,6 +98,40 @@ def quantization(ax, data):
     ax.grid(alpha=0.3)
 
 
+def normals(ax, data):
+    for name, label, colour, marker, style in SETS:
+        if name not in data or not data[name].get("normal_error"):
+            continue
+        bins = data[name]["normal_error"]
+        xs = [0.5 * (b["lo"] + b["hi"]) for b in bins]
+        ys = [b["median_deg"] for b in bins]
+        ax.plot(xs, ys, color=colour, marker=marker, linestyle=style, label=label, markersize=4)
+        if name == "real":
+            label_n(ax, xs, ys, [b["n"] for b in bins])
+    ax.set_title("normal error (plane over 11 x 11 px)", fontsize=9)
+    ax.set_xlabel("true depth (mm)", fontsize=8)
+    ax.set_ylabel("median angle to the true normal (deg)", fontsize=8)
+    ax.tick_params(labelsize=7)
+    ax.grid(alpha=0.3)
+
+
+def per_object(ax, data):
+    ids = sorted(data["real"]["by_object"], key=int)
+    width = 0.27
+    for k, (name, label, colour, _, _) in enumerate(SETS):
+        if name not in data:
+            continue
+        objs = data[name]["by_object"]
+        xs = [i + (k - 1) * width for i in range(len(ids))]
+        ax.bar(xs, [objs[o]["missing_rate"] if o in objs else 0 for o in ids], width, color=colour, label=label)
+    ax.set_xticks(range(len(ids)))
+    ax.set_xticklabels([f"{o}\nn={data['real']['by_object'][o]['n']}" for o in ids], fontsize=5)
+    ax.set_title("missing data per object (obj_id, real pixels)", fontsize=9)
+    ax.set_ylabel("missing rate", fontsize=8)
+    ax.tick_params(labelsize=7)
+    ax.grid(alpha=0.3, axis="y")
+
+
 def main(argv):
     if len(argv) != 3:
         print("usage: sensor_fit_plot.py SENSOR_FIT.json OUT_DIR", file=sys.stderr)
@@ -107,7 +142,7 @@ def main(argv):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     os.makedirs(argv[2], exist_ok=True)
-    fig, axes = plt.subplots(2, 3, figsize=(15, 8.5))
+    fig, axes = plt.subplots(2, 4, figsize=(20, 8.5))
     panel(axes[0][0], data, "by_depth", lambda b: b["spread_mm"], "depth noise (robust spread)",
           "true depth (mm)", "1.4826 MAD of residual (mm)")
     axes[0][0].legend(fontsize=7)
@@ -119,6 +154,8 @@ def main(argv):
     panel(axes[1][1], data, "by_edge_px", geometric_missing, "missing data by distance to the outline",
           "distance inside the outline (px; last bin: and more)", "missing rate")
     silhouette(axes[1][2], data)
+    normals(axes[0][3], data)
+    per_object(axes[1][3], data)
     loss = data.get("loss", {})
     fig.suptitle(f"{data.get('dataset', '')}: {data.get('images', 0)} real images; loss base "
                  f"{loss.get('base', {}).get('total', float('nan')):.3f}, fitted "

@@ -124,7 +124,7 @@ TEST(CliSim2Real, AnExperimentPairsARealSetWithItsTwin) {
                     "descriptors: [ppf]\nrefinements: [icp]\n");
   const auto r = pbcli::run("run exp.yaml --out res --jobs 2 -q", tmp.path);
   ASSERT_EQ(r.code, 0) << r.err;
-  const auto rep = pbcli::run("report res --format md", tmp.path);
+  const auto rep = pbcli::run("report res --format md,csv", tmp.path);
   ASSERT_EQ(rep.code, 0) << rep.err;
   const size_t targets = pb::read_test_targets(tmp.path + "/real/test_targets_bop19.json").size();
   ASSERT_NE(rep.out.find("## Real and twin"), std::string::npos) << rep.out;
@@ -133,6 +133,8 @@ TEST(CliSim2Real, AnExperimentPairsARealSetWithItsTwin) {
   const size_t at = rep.out.find(row);
   ASSERT_NE(at, std::string::npos) << rep.out;
   EXPECT_NE(rep.out.find("/" + std::to_string(targets) + " [", at), std::string::npos) << rep.out.substr(at, 200);
+  const std::string csv = pbcli::slurp(tmp.path + "/res/twin_gap.csv");
+  EXPECT_NE(csv.find("real,real_twin,ppf+icp,," + std::to_string(targets) + ","), std::string::npos) << csv;
 }
 
 TEST(CliSim2Real, BadInputIsOneMessageAndExitCode2) {
@@ -144,6 +146,15 @@ TEST(CliSim2Real, BadInputIsOneMessageAndExitCode2) {
   r = pbcli::run("twin empty --sensor nosuch --out t", tmp.path);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("unknown sensor 'nosuch'"), std::string::npos) << r.err;
+  r = pbcli::run("twin empty --sensor nosuch.yaml --out t", tmp.path);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("sensor profile file 'nosuch.yaml' does not exist"), std::string::npos) << r.err;
+  pbcli::write_file(tmp.path + "/bad.yaml", "name: x\nwidth: 64\nheight: 48\nfx: 50\nfy: 50\n"
+                                            "noise: {model: structured_light, edge_dropout_rate: 2}\n");
+  r = pbcli::run("twin empty --sensor bad.yaml --out t", tmp.path);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("edge_dropout_rate"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("bad.yaml"), std::string::npos) << r.err;
   make_real(tmp.path, 1);
   r = pbcli::run("sensor-fit real --out f --base synthetic --no-plots", tmp.path);
   EXPECT_EQ(r.code, 2);

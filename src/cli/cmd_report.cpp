@@ -64,6 +64,8 @@ static void write_tables(const pb::Report& rep, const std::string& dir, const st
       std::cout << md;
     } else if (f == "csv") {
       pb::atomic_write_text((fs::path(dir) / "report.csv").string(), pb::to_csv(rep));
+      if (!rep.twin_gap.empty())
+        pb::atomic_write_text((fs::path(dir) / "twin_gap.csv").string(), pb::twin_gap_csv(rep.twin_gap));
     } else if (f == "tex") {
       pb::atomic_write_text((fs::path(dir) / "report.tex").string(), pb::to_latex(rep));
     } else {

@@ -80,4 +80,19 @@ std::string twin_gap_markdown(const std::vector<TwinGapRow>& rows) {
   return md + "\n";
 }
 
+std::string twin_gap_csv(const std::vector<TwinGapRow>& rows) {
+  std::string csv = "real,twin,method,condition,pairs,real_k,twin_k,both,real_only,twin_only,mcnemar_p\n";
+  char buf[512];
+  for (const auto& r : rows) {
+    std::string cond = r.condition;
+    for (char& c : cond)
+      if (c == ',' || c == '"') c = ';';
+    std::snprintf(buf, sizeof buf, "%s,%s,%s,%s,%d,%d,%d,%d,%d,%d,%.6g\n", r.real_scene.c_str(), r.twin_scene.c_str(),
+                  r.method.c_str(), cond.c_str(), r.pairs, r.real_k, r.twin_k, r.both, r.real_only, r.twin_only,
+                  r.mcnemar_p);
+    csv += buf;
+  }
+  return csv;
+}
+
 }  // namespace pb

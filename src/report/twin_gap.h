@@ -32,5 +32,9 @@ struct TwinGapRow {
 std::vector<TwinGapRow> twin_gap(const nlohmann::json& experiment, const std::vector<TrialRecord>& records);
 // The table in Markdown ("" when there is no row).
 std::string twin_gap_markdown(const std::vector<TwinGapRow>& rows);
+// The same as CSV (`report --format csv` writes it to twin_gap.csv): real,
+// twin, method, condition, pairs, real_k, twin_k, both, real_only,
+// twin_only, mcnemar_p.
+std::string twin_gap_csv(const std::vector<TwinGapRow>& rows);
 
 }  // namespace pb
