@@ -36,7 +36,7 @@ TEST(SimrealStats, GaussianNoiseGivesItsSpreadAndNoBias) {
   SensorStatsAccumulator acc;
   acc.add(m, truth, K, {7});
   const SensorStats s = acc.finish();
-  ASSERT_GT(s.all.n, 5000);
+  ASSERT_GT(s.all.n, 3000);  // the box covers 4144 pixels
   EXPECT_EQ(s.all.missing, 0);
   EXPECT_NEAR(s.all.bias_mm, 2.0, 0.1);     // the offset is bias...
   EXPECT_NEAR(s.all.spread_mm, 2.0, 0.1);   // ...and the noise spread
