@@ -133,7 +133,7 @@ void bleed_edges(DepthImage& depth, const DepthImage& truth, double b, Rng& rng)
 
 // No depth near edges (edge_dropout_rate, edge_dropout_px): with probability
 // rate * exp(-d / px) at Chebyshev distance d from the nearest edge pixel,
-// up to 4 px.
+// up to d = 4 edge_dropout_px (beyond, the probability is below 2% of the rate).
 void drop_near_edges(DepthImage& depth, const std::vector<uint8_t>& edges, double rate, double px, Rng& rng) {
   const int W = depth.width, H = depth.height;
   const int cap = static_cast<int>(std::ceil(4 * px));
