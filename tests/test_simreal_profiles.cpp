@@ -46,12 +46,9 @@ Losses losses(const std::string& dataset, int stride, const SensorProfile& profi
     const GtFrame f = load_gt_frame(ds, "test", sid, iid);
     std::vector<int> ids;
     for (const auto& g : f.info.gt) ids.push_back(g.obj_id);
-    const RenderOutput truth = render_gt(pool, meshes, f.info);
+    const TwinRender tr = render_twin(pool, meshes, f, 5);
+    const RenderOutput &truth = tr.truth, &scene = tr.scene;
     real.add(f.depth, truth, f.info.K, ids);
-    const SupportPlane plane = fit_support_plane(f.depth, truth.labels, f.info.K, 5);
-    Mesh plane_mesh;
-    if (plane.found) plane_mesh = support_plane_mesh(plane, f.info);
-    const RenderOutput scene = render_gt(pool, meshes, f.info, plane.found ? &plane_mesh : nullptr);
     for (auto [prof, acc] : {std::pair<SensorProfile, SensorStatsAccumulator*>{profile, &a}, {other, &b}}) {
       prof.K = f.info.K;
       prof.min_range_mm = std::min(prof.min_range_mm, 200.0);

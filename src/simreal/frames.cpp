@@ -137,4 +137,15 @@ Mesh support_plane_mesh(const SupportPlane& plane, const ImageInfo& info, double
   return m;
 }
 
+TwinRender render_twin(RendererPool& pool, ModelMeshes& meshes, const GtFrame& f, uint64_t plane_seed,
+                       double plane_inlier_mm) {
+  TwinRender r;
+  r.truth = render_gt(pool, meshes, f.info);
+  r.plane = fit_support_plane(f.depth, r.truth.labels, f.info.K, plane_seed, plane_inlier_mm);
+  Mesh plane_mesh;
+  if (r.plane.found) plane_mesh = support_plane_mesh(r.plane, f.info);
+  r.scene = render_gt(pool, meshes, f.info, r.plane.found ? &plane_mesh : nullptr);
+  return r;
+}
+
 }  // namespace pb

@@ -74,4 +74,15 @@ SupportPlane fit_support_plane(const DepthImage& measured, const std::vector<int
 // facing the camera.
 Mesh support_plane_mesh(const SupportPlane& plane, const ImageInfo& info, double half_size_mm = 4000);
 
+// What a twin of a real frame is rendered from: the GT objects alone (the
+// truth the statistics compare with) and the GT objects on the supporting
+// plane fitted to the measured depth (RANSAC seeded with plane_seed; the
+// scene the noise model degrades).
+struct TwinRender {
+  RenderOutput truth, scene;
+  SupportPlane plane;
+};
+TwinRender render_twin(RendererPool& pool, ModelMeshes& meshes, const GtFrame& f, uint64_t plane_seed,
+                       double plane_inlier_mm = 8.0);
+
 }  // namespace pb

@@ -178,14 +178,12 @@ SensorFitResult fit_sensor(const std::string& dataset, const SensorFitSettings& 
     f.info = g.info;
     f.scene_id = sid;
     f.obj_ids = obj_ids_of(g.info);
-    f.truth = render_gt(pool, meshes, g.info);
+    TwinRender tr = render_twin(pool, meshes, g, derive_seed(s.seed, {7, static_cast<uint64_t>(sid),
+                                                                        static_cast<uint64_t>(iid)}));
+    f.truth = std::move(tr.truth);
+    f.scene = std::move(tr.scene);
+    const SupportPlane& plane = tr.plane;
     real.add(g.depth, f.truth, g.info.K, f.obj_ids);
-    const SupportPlane plane = fit_support_plane(g.depth, f.truth.labels, g.info.K,
-                                                 derive_seed(s.seed, {7, static_cast<uint64_t>(sid),
-                                                                      static_cast<uint64_t>(iid)}));
-    Mesh plane_mesh;
-    if (plane.found) plane_mesh = support_plane_mesh(plane, g.info);
-    f.scene = render_gt(pool, meshes, g.info, plane.found ? &plane_mesh : nullptr);
     r.planes.push_back({{"scene_id", sid}, {"im_id", iid}, {"found", plane.found}, {"inliers", plane.inliers},
                         {"candidates", plane.candidates}});
     if (frames.empty()) r.K = g.info.K;

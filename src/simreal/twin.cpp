@@ -22,21 +22,17 @@ namespace {
 // keep_background, the measured depth where no object is drawn.
 DepthImage twin_depth(const GtFrame& f, const SensorProfile& sensor, const TwinSettings& s, RendererPool& pool,
                       ModelMeshes& meshes, SupportPlane& plane) {
-  const RenderOutput truth = render_gt(pool, meshes, f.info);
-  plane = fit_support_plane(f.depth, truth.labels, f.info.K, derive_seed(s.seed, {7, static_cast<uint64_t>(f.scene_id),
-                                                                                    static_cast<uint64_t>(f.info.im_id)}),
-                            s.plane_inlier_mm);
-  Mesh plane_mesh;
-  if (plane.found) plane_mesh = support_plane_mesh(plane, f.info);
-  RenderOutput scene = render_gt(pool, meshes, f.info, plane.found ? &plane_mesh : nullptr);
+  const uint64_t sid = static_cast<uint64_t>(f.scene_id), iid = static_cast<uint64_t>(f.info.im_id);
+  const TwinRender r = render_twin(pool, meshes, f, derive_seed(s.seed, {7, sid, iid}), s.plane_inlier_mm);
+  plane = r.plane;
   SensorProfile prof = sensor;
   prof.K = f.info.K;
-  Rng rng(derive_seed(s.seed, {static_cast<uint64_t>(f.scene_id), static_cast<uint64_t>(f.info.im_id)}));
-  DepthImage d = scene.depth;
-  apply_noise(d, scene, prof, prof.noise, rng);
+  Rng rng(derive_seed(s.seed, {sid, iid}));
+  DepthImage d = r.scene.depth;
+  apply_noise(d, r.scene, prof, prof.noise, rng);
   if (s.keep_background)
     for (size_t p = 0; p < d.z.size(); ++p)
-      if (truth.labels[p] < 0) d.z[p] = f.depth.z[p];
+      if (r.truth.labels[p] < 0) d.z[p] = f.depth.z[p];
   return d;
 }
 
