@@ -42,8 +42,9 @@ Losses losses(const std::string& dataset, int stride, const SensorProfile& profi
   RendererPool pool;
   ModelMeshes meshes(ds);
   SensorStatsAccumulator real, a, b;
-  for (const auto& [sid, iid] : list_gt_frames(ds, "test", 0, stride)) {
-    const GtFrame f = load_gt_frame(ds, "test", sid, iid);
+  for (GtFrame& f : list_gt_frames(ds, "test", 0, stride)) {
+    load_gt_depth(ds, "test", f);
+    const int sid = f.scene_id, iid = f.info.im_id;
     std::vector<int> ids;
     for (const auto& g : f.info.gt) ids.push_back(g.obj_id);
     const TwinRender tr = render_twin(pool, meshes, f, 5);

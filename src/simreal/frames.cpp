@@ -13,9 +13,8 @@ namespace pb {
 
 namespace fs = std::filesystem;
 
-std::vector<std::pair<int, int>> list_gt_frames(const BopDataset& ds, const std::string& split, int max_images,
-                                                int stride) {
-  std::vector<std::pair<int, int>> out;
+std::vector<GtFrame> list_gt_frames(const BopDataset& ds, const std::string& split, int max_images, int stride) {
+  std::vector<GtFrame> out;
   int seen = 0;
   for (int sid : ds.scene_ids(split)) {
     const SceneInfo scene = ds.load_scene(split, sid);
@@ -23,7 +22,7 @@ std::vector<std::pair<int, int>> list_gt_frames(const BopDataset& ds, const std:
       if (im.gt.empty()) continue;
       if (!fs::exists(bop_depth_path(ds.scene_dir(split, sid), iid))) continue;
       if (seen++ % std::max(1, stride) != 0) continue;
-      out.emplace_back(sid, iid);
+      out.push_back(GtFrame{sid, im, {}});
       if (max_images > 0 && static_cast<int>(out.size()) >= max_images) return out;
     }
   }
@@ -32,17 +31,12 @@ std::vector<std::pair<int, int>> list_gt_frames(const BopDataset& ds, const std:
   return out;
 }
 
-GtFrame load_gt_frame(const BopDataset& ds, const std::string& split, int scene_id, int im_id) {
-  const SceneInfo scene = ds.load_scene(split, scene_id);
-  GtFrame f;
-  f.scene_id = scene_id;
-  f.info = scene.images.at(im_id);
-  f.depth = ds.load_depth(split, scene_id, f.info);
+void load_gt_depth(const BopDataset& ds, const std::string& split, GtFrame& f) {
+  f.depth = ds.load_depth(split, f.scene_id, f.info);
   if (f.info.K.width <= 0) f.info.K.width = f.depth.width, f.info.K.height = f.depth.height;
   for (float z : f.depth.z)
     if (std::isnan(z))
-      throw InputError(bop_depth_path(ds.scene_dir(split, scene_id), im_id), "depth", "holds NaN depth");
-  return f;
+      throw InputError(bop_depth_path(ds.scene_dir(split, f.scene_id), f.info.im_id), "depth", "holds NaN depth");
 }
 
 const Mesh& ModelMeshes::get(int obj_id) {

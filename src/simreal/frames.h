@@ -22,14 +22,15 @@ struct GtFrame {
   DepthImage depth;   // measured, mm (0 = no depth)
 };
 
-// (scene_id, im_id) of every image of the split with a depth PNG and at least
-// one GT pose, in order: every stride-th of them, at most max_images (0 =
-// all). InputError naming the dataset when there is none.
-std::vector<std::pair<int, int>> list_gt_frames(const BopDataset& ds, const std::string& split, int max_images = 0,
-                                                int stride = 1);
-// Loads one of them; InputError naming the PNG when its size is not the
-// image's (camera.json) or it holds NaN.
-GtFrame load_gt_frame(const BopDataset& ds, const std::string& split, int scene_id, int im_id);
+// Every image of the split with a depth PNG and at least one GT pose, in
+// order (its scene and image info, each scene's JSON read once): every
+// stride-th of them, at most max_images (0 = all). InputError naming the
+// dataset when there is none.
+std::vector<GtFrame> list_gt_frames(const BopDataset& ds, const std::string& split, int max_images = 0,
+                                    int stride = 1);
+// Reads one of them's depth; InputError naming the PNG when its size is not
+// the image's (camera.json) or it holds NaN.
+void load_gt_depth(const BopDataset& ds, const std::string& split, GtFrame& f);
 
 // The dataset's meshes, each loaded once (mm, model frame).
 class ModelMeshes {

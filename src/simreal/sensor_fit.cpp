@@ -158,7 +158,7 @@ SensorFitResult fit_sensor(const std::string& dataset, const SensorFitSettings& 
     throw InputError(dataset, "--base", "the base profile's noise model is '" + model +
                                             "'; sensor-fit fits structured_light or tof");
   const BopDataset ds(dataset);
-  const auto ids = list_gt_frames(ds, s.split, s.max_images, s.stride);
+  std::vector<GtFrame> gt_frames = list_gt_frames(ds, s.split, s.max_images, s.stride);
   SensorFitResult r;
   r.dataset = dataset;
   r.planes = nlohmann::ordered_json::array();
@@ -170,8 +170,9 @@ SensorFitResult fit_sensor(const std::string& dataset, const SensorFitSettings& 
   SensorStatsAccumulator real(with_normals);
   std::vector<FitFrame> frames;
   double depth_lo = 1e300, depth_hi = 0;
-  for (const auto& [sid, iid] : ids) {
-    const GtFrame g = load_gt_frame(ds, s.split, sid, iid);
+  for (GtFrame& g : gt_frames) {
+    load_gt_depth(ds, s.split, g);
+    const int sid = g.scene_id, iid = g.info.im_id;
     for (float z : g.depth.z)
       if (z > 0) depth_lo = std::min<double>(depth_lo, z), depth_hi = std::max<double>(depth_hi, z);
     FitFrame f;
@@ -184,6 +185,7 @@ SensorFitResult fit_sensor(const std::string& dataset, const SensorFitSettings& 
     f.scene = std::move(tr.scene);
     const SupportPlane& plane = tr.plane;
     real.add(g.depth, f.truth, g.info.K, f.obj_ids);
+    g.depth = DepthImage();  // the renders are what the fit keeps
     r.planes.push_back({{"scene_id", sid}, {"im_id", iid}, {"found", plane.found}, {"inliers", plane.inliers},
                         {"candidates", plane.candidates}});
     if (frames.empty()) r.K = g.info.K;

@@ -41,7 +41,7 @@ DepthImage twin_depth(const GtFrame& f, const SensorProfile& sensor, const TwinS
 TwinSummary write_twin(const std::string& real_root, const SensorProfile& sensor, const TwinSettings& s,
                        const std::string& out_dir) {
   const BopDataset ds(real_root);
-  const auto frames = list_gt_frames(ds, s.split, s.max_images);
+  std::vector<GtFrame> frames = list_gt_frames(ds, s.split, s.max_images);
   if (fs::exists(out_dir) && !fs::is_empty(out_dir) && !fs::exists(fs::path(out_dir) / "posebench_twin.json"))
     throw InputError(out_dir, "--out", "exists and is not a twin set written by posebench; remove it or choose another");
   TwinSummary sum;
@@ -53,13 +53,15 @@ TwinSummary write_twin(const std::string& real_root, const SensorProfile& sensor
     std::map<int, SceneInfo> scenes;
     nlohmann::ordered_json planes = nlohmann::ordered_json::array();
     std::set<std::pair<int, int>> written;
-    for (const auto& [sid, iid] : frames) {
-      const GtFrame f = load_gt_frame(ds, s.split, sid, iid);
+    for (GtFrame& f : frames) {
+      load_gt_depth(ds, s.split, f);
+      const int sid = f.scene_id, iid = f.info.im_id;
       SupportPlane plane;
       const DepthImage d = twin_depth(f, sensor, s, pool, meshes, plane);
       const fs::path scene_dir = tmp / s.split / bop_id(sid);
       fs::create_directories(scene_dir / "depth");
       write_depth_png(bop_depth_path(scene_dir.string(), iid), d, f.info.depth_scale);
+      f.depth = DepthImage();  // one frame's depth in memory at a time
       SceneInfo& sc = scenes[sid];
       sc.scene_id = sid;
       sc.images[iid] = f.info;
