@@ -33,7 +33,7 @@ pb::Intrinsics camera() {
 }
 
 // Nearest surface along each pixel's ray: plate, cube front face, wall.
-pb::DepthImage render(const pb::Intrinsics& K) {
+pb::DepthImage render(const pb::Intrinsics& K, bool plate = true) {
   pb::DepthImage d;
   d.width = K.width;
   d.height = K.height;
@@ -47,7 +47,7 @@ pb::DepthImage render(const pb::Intrinsics& K) {
       };
       float z = 1000.f;                                         // wall
       if (hits(800, -50, 50, -50, 50)) z = 800.f;                // cube front face
-      if (hits(700, -80, 30 * 0.7 / 0.8, -80, 80)) z = 700.f;    // plate: hides x < 30 mm at the face
+      if (plate && hits(700, -80, 30 * 0.7 / 0.8, -80, 80)) z = 700.f;  // plate: hides x < 30 mm at the face
       d.z[static_cast<size_t>(v * K.width + u)] = z;
     }
   return d;
@@ -131,6 +131,55 @@ TEST(VerifyVisibility, PointsOffTheImageOrWithoutDepthCountInNothing) {
   // A depth image of another size than the intrinsics is a caller's error.
   depth.width = 10;
   EXPECT_THROW(pb::depth_evidence(model, at(0, 850), depth, K, 10), std::invalid_argument);
+}
+
+// A pose sunk into a surface: the cube 300 mm to the right with its front
+// face in the wall's plane. depth_evidence sees its front face on the wall
+// and the rest behind it (and the first row of the side face it shows the
+// camera on the wall too): it scores at least as well as the true cube (no
+// plate here). Its outline does not: around the true cube the wall lies
+// 200 mm behind the face; around the sunk one it continues the face, except
+// along that side face, whose hidden part reaches 100 mm behind the wall.
+TEST(VerifyOutline, APoseSunkIntoAWallHasAContinuousOutlineTheTrueOneAStep) {
+  const pb::Intrinsics K = camera();
+  const pb::DepthImage depth = render(K, /*plate=*/false);
+  const pb::PointSet model = cube_model();
+  const pb::Pose truth = at(0, 850), sunk = at(300, 1050);
+  const double tol = 10, spacing = 10;
+  const pb::DepthEvidence et = pb::depth_evidence(model, truth, depth, K, tol);
+  const pb::DepthEvidence es = pb::depth_evidence(model, sunk, depth, K, tol);
+  EXPECT_EQ(et.supported, 121);
+  EXPECT_EQ(et.violating, 0);
+  EXPECT_GE(es.supported, 121);
+  EXPECT_EQ(es.violating, 0);
+  EXPECT_GE(es.score(1.0), et.score(1.0));
+
+  const pb::OutlineEvidence ot = pb::outline_evidence(model, truth, depth, K, spacing, tol, 3);
+  const pb::OutlineEvidence os = pb::outline_evidence(model, sunk, depth, K, spacing, tol, 3);
+  // The front face spans 62 px at 800 mm (50 at 1000): an outline of about 4 x that.
+  EXPECT_GT(ot.probed, 150);
+  EXPECT_GT(os.probed, 150);
+  EXPECT_EQ(ot.continuous, 0);
+  EXPECT_GT(os.continuous_fraction(), 0.6);
+
+  pb::VerifySettings v;
+  v.inlier_threshold_mm = tol;
+  v.outline_weight = 1.0;
+  EXPECT_EQ(pb::visibility_score(model, truth, depth, K, v, spacing), 121.0);
+  EXPECT_LT(pb::visibility_score(model, sunk, depth, K, v, spacing), 0.5 * 121.0);
+  v.outline_weight = 0.0;  // off: depth_evidence's score alone
+  EXPECT_EQ(pb::visibility_score(model, sunk, depth, K, v, spacing), es.score(1.0));
+}
+
+TEST(VerifyOutline, ProbesOffTheImageOrWithoutDepthCountInNothing) {
+  const pb::Intrinsics K = camera();
+  pb::DepthImage depth = render(K, false);
+  const pb::PointSet model = cube_model();
+  EXPECT_EQ(pb::outline_evidence(model, at(5000, 900), depth, K, 10, 10, 3).probed, 0);
+  for (float& z : depth.z) z = 0.f;
+  EXPECT_EQ(pb::outline_evidence(model, at(0, 850), depth, K, 10, 10, 3).probed, 0);
+  depth.width = 10;
+  EXPECT_THROW(pb::outline_evidence(model, at(0, 850), depth, K, 10, 10, 3), std::invalid_argument);
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include <iomanip>
 #include <iostream>
 #include <limits>
+#include <memory>
 #include <sstream>
 
 #include "cli/command.h"
@@ -52,6 +53,7 @@ struct Options {
   int instances = -1;  // verify.max_instances (-1: the config's)
   long long seed = -1;
   bool json = false;
+  bool explain = false;
 };
 
 void add_options(CLI::App& app, Options& o) {
@@ -85,6 +87,9 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--cache", o.cache, "training cache folder ('' = no cache; default $POSEBENCH_CACHE or ~/.cache/posebench/train)");
   app.add_option("--scenario", o.scenario, "thresholds for 'correct': table (50 mm) or warehouse (100 mm)");
   app.add_flag("--json", o.json, "print one JSON object");
+  app.add_flag("--explain", o.explain, "also every ranked hypothesis (verification, inliers, view, the method's "
+               "score, errors against the nearest ground-truth instance) and the ground truth's own pose refined "
+               "and verified as one more hypothesis: where it would rank");
 }
 
 // Settings from --config, then the flags.
@@ -137,6 +142,51 @@ Evaluation evaluate(const pb::RecognitionResult& res, const pb::ImageInfo& im, i
   return ev;
 }
 
+// --explain: each ranked hypothesis against the nearest GT instance, and
+// the ground truth itself refined and verified like a hypothesis.
+struct RankedHypothesis {
+  double verification = 0, score = 0, translation_mm = -1, rotation_deg = -1;
+  int inliers = 0, view = -1;
+  pb::Pose T_cam_model;
+};
+struct Explanation {
+  std::vector<RankedHypothesis> ranked;
+  bool gt_checked = false;
+  double gt_verification = 0;
+  int gt_inliers = 0, gt_rank = 0;
+  pb::Pose gt_refined;  // gt_rank: where the refined GT would rank (0 = first)
+};
+
+Explanation explain(const pb::RecognitionResult& res, const pb::ImageInfo& im, int obj_id, const pb::ModelInfo& info,
+                    const pb::ThesisThresholds& thr, const pb::RecognitionResult* gt_res) {
+  Explanation x;
+  const auto syms = pb::symmetry_transformations(info);
+  pb::ThesisErrorOptions eo;
+  eo.thresholds = thr;
+  for (const pb::Hypothesis& h : res.hypotheses) {
+    RankedHypothesis r{h.verification, h.score, -1, -1, h.inliers, h.view, h.T_cam_model};
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& g : im.gt) {
+      if (g.obj_id != obj_id) continue;
+      const pb::ThesisErrors e = pb::thesis_errors(h.T_cam_model, g.T_cam_model, syms, eo);
+      if (e.translation_mm < best) {
+        best = e.translation_mm;
+        r.translation_mm = e.translation_mm;
+        r.rotation_deg = e.rotation_deg;
+      }
+    }
+    x.ranked.push_back(r);
+  }
+  if (gt_res && !gt_res->hypotheses.empty()) {
+    x.gt_checked = true;
+    x.gt_verification = gt_res->hypotheses.front().verification;
+    x.gt_inliers = gt_res->hypotheses.front().inliers;
+    x.gt_refined = gt_res->hypotheses.front().T_cam_model;
+    for (const pb::Hypothesis& h : res.hypotheses) x.gt_rank += h.verification > x.gt_verification;
+  }
+  return x;
+}
+
 // What the command prints, in either form.
 struct Outcome {
   const Options& o;
@@ -150,7 +200,16 @@ struct Outcome {
   int train_views;
   double train_s;
   bool from_cache;
+  const Explanation* explanation;
 };
+
+std::vector<double> pose_R(const pb::Pose& T) {
+  std::vector<double> R;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) R.push_back(T.R(r, c));
+  return R;
+}
+std::vector<double> pose_t(const pb::Pose& T) { return {T.t[0], T.t[1], T.t[2]}; }
 
 std::string json_output(const Outcome& x) {
   const bool ok = x.res.status == "ok";
@@ -200,6 +259,22 @@ std::string json_output(const Outcome& x) {
                    {"rotation_deg_plain", x.ev.err.rotation_deg_plain},
                    {"scenario", x.o.scenario},
                    {"correct", x.ev.correct}};
+  if (x.explanation) {
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const RankedHypothesis& r : x.explanation->ranked) {
+      nlohmann::ordered_json h = {{"verification", r.verification}, {"inliers", r.inliers}, {"view", r.view},
+                                  {"score", r.score}, {"R", pose_R(r.T_cam_model)}, {"t", pose_t(r.T_cam_model)}};
+      if (r.translation_mm >= 0) h["errors"] = {{"translation_mm", r.translation_mm}, {"rotation_deg", r.rotation_deg}};
+      list.push_back(h);
+    }
+    j["ranked"] = list;
+    if (x.explanation->gt_checked)
+      j["ground_truth_refined"] = {{"verification", x.explanation->gt_verification},
+                                   {"inliers", x.explanation->gt_inliers},
+                                   {"would_rank", x.explanation->gt_rank},
+                                   {"R", pose_R(x.explanation->gt_refined)},
+                                   {"t", pose_t(x.explanation->gt_refined)}};
+  }
   if (!x.o.overlay.empty()) j["overlay"] = x.o.overlay;
   return j.dump() + "\n";
 }
@@ -243,6 +318,18 @@ std::string text_output(const Outcome& x, const pb::ThesisThresholds& thr) {
     o << "ground truth: the object is not annotated in this image\n";
   else if (x.im.gt.empty())
     o << "ground truth: none for this image\n";
+  if (x.explanation) {
+    o << "ranked hypotheses (verification, inliers, view, method score; errors vs the nearest GT instance):\n";
+    for (size_t i = 0; i < x.explanation->ranked.size(); ++i) {
+      const RankedHypothesis& r = x.explanation->ranked[i];
+      o << "  " << i << ": " << r.verification << ", " << r.inliers << ", view " << r.view << ", " << r.score;
+      if (r.translation_mm >= 0) o << "; " << r.translation_mm << " mm, " << r.rotation_deg << " deg";
+      o << "\n";
+    }
+    if (x.explanation->gt_checked)
+      o << "ground truth refined and verified: verification " << x.explanation->gt_verification << ", inliers "
+        << x.explanation->gt_inliers << " (would rank " << x.explanation->gt_rank << ")\n";
+  }
   if (!x.o.overlay.empty()) o << "overlay: " << x.o.overlay << "\n";
   return o.str();
 }
@@ -290,7 +377,14 @@ static pb::cli::Command recognize_cmd(
       if (!o.overlay.empty())
         pb::write_overlay(o.overlay, depth, im.K, mesh, res.status == "ok" ? &res.T_cam_model : nullptr,
                       ev.gt_instances > 0 ? &ev.gt_pose : nullptr);
-      const Outcome x{o, s, res, ev, im, scene, obj_id, model_name, pb::trained_model_info(*model).views, train_s, from_cache};
+      std::unique_ptr<Explanation> why;
+      if (o.explain) {
+        pb::RecognitionResult gt_res;
+        if (ev.gt_instances > 0) gt_res = pb::refine_from(depth, im.K, *model, s, ev.gt_pose);
+        why = std::make_unique<Explanation>(explain(res, im, obj_id, info, thr, ev.gt_instances > 0 ? &gt_res : nullptr));
+      }
+      const Outcome x{o,        s,         res, ev, im, scene, obj_id, model_name, pb::trained_model_info(*model).views,
+                      train_s, from_cache, why.get()};
       std::cout << (o.json ? json_output(x) : text_output(x, thr));
       return 0;
     });

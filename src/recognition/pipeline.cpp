@@ -124,13 +124,12 @@ std::vector<char> tied(const std::vector<Hypothesis>& hyps) {
 // not needed; screening's ranking).
 std::vector<size_t> verification_order(std::vector<Hypothesis>& hyps, const TrainedModel& model,
                                        const PointIndex& index, const VerifySettings& v, const DepthImage& depth,
-                                       const Intrinsics& K, bool inliers_for_ties = false) {
+                                       const Intrinsics& K, double spacing_mm, bool inliers_for_ties = false) {
   const bool visibility = v.score == "visibility";
   if (!visibility) count_all(hyps, model, index, v, v.inlier_threshold_mm);
   for (Hypothesis& h : hyps)
-    h.verification = visibility ? depth_evidence(model.verify_cloud(h.view, v), h.T_cam_model, depth, K,
-                                                 v.inlier_threshold_mm)
-                                      .score(v.violation_weight)
+    h.verification = visibility ? visibility_score(model.verify_cloud(h.view, v), h.T_cam_model, depth, K, v,
+                                                   spacing_mm)
                                 : h.inliers;
   if (visibility) {
     const std::vector<char> which = inliers_for_ties ? tied(hyps) : std::vector<char>(hyps.size(), 1);
@@ -151,9 +150,9 @@ std::vector<size_t> verification_order(std::vector<Hypothesis>& hyps, const Trai
 
 std::vector<Hypothesis> verify_and_rank(std::vector<Hypothesis> hyps, const TrainedModel& model,
                                         const PointIndex& index, const VerifySettings& v, const DepthImage& depth,
-                                        const Intrinsics& K) {
+                                        const Intrinsics& K, double spacing_mm) {
   std::vector<Hypothesis> ranked;
-  for (size_t i : verification_order(hyps, model, index, v, depth, K)) ranked.push_back(hyps[i]);
+  for (size_t i : verification_order(hyps, model, index, v, depth, K, spacing_mm)) ranked.push_back(hyps[i]);
   return ranked;
 }
 
@@ -180,7 +179,8 @@ std::vector<uint64_t> keep_most_promising(std::vector<Hypothesis>& hyps, const T
     }
     refine_all(hyps, kept_at, model, scene, index, s, &sources);
   }
-  std::vector<size_t> order = verification_order(hyps, model, index, s.verify, depth, K, /*inliers_for_ties=*/true);
+  std::vector<size_t> order = verification_order(hyps, model, index, s.verify, depth, K, s.preprocess.voxel_mm,
+                                                         /*inliers_for_ties=*/true);
   order.resize(keep);
   std::sort(order.begin(), order.end());
   std::vector<Hypothesis> kept;
@@ -266,7 +266,7 @@ void refine_verify_accept(std::vector<Hypothesis> hyps, const TrainedModel& mode
   refine_all(hyps, stream, model, scene, index, s);
   res.times.refine = timer.seconds();
   timer.reset();
-  res.hypotheses = verify_and_rank(std::move(hyps), model, index, s.verify, depth, K);
+  res.hypotheses = verify_and_rank(std::move(hyps), model, index, s.verify, depth, K, s.preprocess.voxel_mm);
   res.times.verify += timer.seconds();
   accept_best(model, s.verify, res);
 }
