@@ -4,6 +4,7 @@
     scripts/real_diagnosis.py stages RUN [--variant LABEL=RUN ...] [--scenes S ...]
     scripts/real_diagnosis.py oracle --dataset DIR --method M [--posebench BIN]
                                      [--config YAML] [--cache DIR] [--targets FILE]
+    scripts/real_diagnosis.py ar RUN --dataset SCENE=DIR ... [--posebench BIN]
 
 `stages` reads the records of a `posebench run` (records.jsonl) and counts,
 per scene and method, what became of each target:
@@ -29,6 +30,12 @@ counts: targets whose refined ground truth verification would rank first,
 refinements that turned the ground truth by over 5 degrees, and the median
 distance they moved it.
 
+`ar` scores every BOP results file of a reported run (RUN/bop/*_SCENE-*.csv,
+`posebench report RUN`) with `posebench score` against the scene's
+dataset, on the test targets of the images the run took (an image_stride
+run takes some of the dataset's images), and prints BOP's AR and its parts
+per method and scene.
+
 Exit 2, naming the file, for a folder without records, a record that does
 not fit the record schema, or an answer of posebench that is not the JSON
 expected.
@@ -41,6 +48,7 @@ import os
 import statistics
 import subprocess
 import sys
+import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from thesis_report import RECORD_SCHEMA, InputError, load_records  # noqa: E402
@@ -197,6 +205,64 @@ def oracle_report(rows, method):
     return "\n".join(lines)
 
 
+def run_images(path):
+    """{scene: {(scene_id, im_id)}} of the run's records."""
+    out = collections.defaultdict(set)
+    for r in load_records(os.path.join(path, "records.jsonl"), RECORD_SCHEMA):
+        out[r["scene"]].add((r["scene_id"], r["im_id"]))
+    return out
+
+
+def average_recalls(a):
+    """[(method, scene, AR, AR_MSSD, AR_MSPD, AR_VSD, targets)] of a reported run."""
+    datasets = {}
+    for d in a.dataset:
+        scene, sep, path = d.partition("=")
+        if not sep or not scene:
+            raise InputError(f"--dataset {d}: expected SCENE=DIR")
+        datasets[scene] = path
+    images = run_images(a.run)
+    bop = os.path.join(a.run, "bop")
+    if not os.path.isdir(bop):
+        raise InputError(f"{bop}: no BOP results (run `posebench report {a.run}` first)")
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="real_diagnosis_") as work:
+        for name in sorted(os.listdir(bop)):
+            stem, ext = os.path.splitext(name)
+            method, sep, dataset_split = stem.rpartition("_")
+            scene = dataset_split.rsplit("-", 1)[0]
+            if ext != ".csv" or not sep or scene not in datasets:
+                continue
+            targets_file = os.path.join(datasets[scene], "test_targets_bop19.json")
+            try:
+                with open(targets_file) as f:
+                    targets = [t for t in json.load(f) if (t["scene_id"], t["im_id"]) in images[scene]]
+            except (OSError, KeyError, TypeError, json.JSONDecodeError) as e:
+                raise InputError(f"{targets_file}: {e}")
+            tf = os.path.join(work, f"{stem}_targets.json")
+            with open(tf, "w") as f:
+                json.dump(targets, f)
+            out = os.path.join(work, stem)
+            cmd = [a.posebench, "score", os.path.join(bop, name), "--dataset", datasets[scene], "--targets", tf,
+                   "--out", out, "--quiet"]
+            p = subprocess.run(cmd, capture_output=True, text=True)
+            try:
+                with open(os.path.join(out, "scores.json")) as f:
+                    sc = json.load(f)
+            except (OSError, json.JSONDecodeError):
+                raise InputError(f"{' '.join(cmd)}: exit {p.returncode}, no scores: {p.stderr.strip()[:300]}")
+            rows.append((method, scene, sc["bop19_average_recall"], sc["bop19_average_recall_mssd"],
+                         sc["bop19_average_recall_mspd"], sc["bop19_average_recall_vsd"], sc["targets_count"]))
+    return rows
+
+
+def ar_table(rows):
+    lines = ["| method | scene | targets | AR | AR_MSSD | AR_MSPD | AR_VSD |", "|---|---|---|---|---|---|---|"]
+    for m, scene, ar, mssd, mspd, vsd, n in rows:
+        lines.append(f"| {m} | {scene} | {n} | {ar:.3f} | {mssd:.3f} | {mspd:.3f} | {vsd:.3f} |")
+    return "\n".join(lines)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -215,6 +281,10 @@ def main(argv=None):
     orc.add_argument("--seed", type=int, default=1)
     orc.add_argument("--posebench", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "build",
                                                           "posebench"))
+    arp = sub.add_parser("ar", help="BOP's AR of every results file of a reported run")
+    arp.add_argument("run")
+    arp.add_argument("--dataset", action="append", default=[], help="SCENE=DIR: the dataset of a scene of the run")
+    arp.add_argument("--posebench", default=orc.get_default("posebench"))
     a = ap.parse_args(argv)
     try:
         if a.cmd == "stages":
@@ -228,6 +298,8 @@ def main(argv=None):
             if not base[0]:
                 raise InputError(f"{a.run}: no records of the scenes asked for")
             print(stages_table(base, variants))
+        elif a.cmd == "ar":
+            print(ar_table(average_recalls(a)))
         else:
             print(oracle_report(oracle(a), a.method))
     except InputError as e:

@@ -138,8 +138,9 @@ TEST(VerifyVisibility, PointsOffTheImageOrWithoutDepthCountInNothing) {
 // and the rest behind it (and the first row of the side face it shows the
 // camera on the wall too): it scores at least as well as the true cube (no
 // plate here). Its outline does not: around the true cube the wall lies
-// 200 mm behind the face; around the sunk one it continues the face, except
-// along that side face, whose hidden part reaches 100 mm behind the wall.
+// 200 mm behind the face (the outline stands out); around the sunk one it
+// continues the face, except along that side face, whose hidden part
+// reaches 100 mm behind the wall (the wall is nearer there).
 TEST(VerifyOutline, APoseSunkIntoAWallHasAContinuousOutlineTheTrueOneAStep) {
   const pb::Intrinsics K = camera();
   const pb::DepthImage depth = render(K, /*plate=*/false);
@@ -160,12 +161,16 @@ TEST(VerifyOutline, APoseSunkIntoAWallHasAContinuousOutlineTheTrueOneAStep) {
   EXPECT_GT(ot.probed, 150);
   EXPECT_GT(os.probed, 150);
   EXPECT_EQ(ot.continuous, 0);
-  EXPECT_GT(os.continuous_fraction(), 0.6);
+  EXPECT_EQ(ot.nearer, 0);
+  EXPECT_EQ(ot.standing_fraction(), 1.0);
+  EXPECT_GT(os.continuous, os.probed / 2);
+  EXPECT_LT(os.standing_fraction(), 0.4);
 
   pb::VerifySettings v;
   v.inlier_threshold_mm = tol;
   v.outline_weight = 1.0;
   EXPECT_EQ(pb::visibility_score(model, truth, depth, K, v, spacing), 121.0);
+  EXPECT_NEAR(pb::visibility_score(model, sunk, depth, K, v, spacing), es.score(1.0) * os.standing_fraction(), 1e-9);
   EXPECT_LT(pb::visibility_score(model, sunk, depth, K, v, spacing), 0.5 * 121.0);
   v.outline_weight = 0.0;  // off: depth_evidence's score alone
   EXPECT_EQ(pb::visibility_score(model, sunk, depth, K, v, spacing), es.score(1.0));

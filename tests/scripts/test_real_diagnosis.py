@@ -165,5 +165,59 @@ class Oracle(unittest.TestCase):
         self.assertIn("not JSON", err)
 
 
+SCORE_STUB = """#!/usr/bin/env python3
+import json, os, sys
+a = sys.argv
+out = a[a.index("--out") + 1]
+targets = json.load(open(a[a.index("--targets") + 1]))
+os.makedirs(out, exist_ok=True)
+ar = 0.5 if "ppf" in a[2] else 0.25
+json.dump({"bop19_average_recall": ar, "bop19_average_recall_mssd": ar, "bop19_average_recall_mspd": ar,
+           "bop19_average_recall_vsd": ar, "targets_count": len(targets)}, open(os.path.join(out, "scores.json"), "w"))
+"""
+
+
+class AverageRecall(unittest.TestCase):
+    """`ar` scores each results file on the targets of the images the run took."""
+
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        ok, _ = fixture_records()
+        self.run_dir = os.path.join(self.tmp.name, "run")
+        os.makedirs(os.path.join(self.run_dir, "bop"))
+        with open(os.path.join(self.run_dir, "records.jsonl"), "w") as f:
+            for im in (0, 2):  # the run took images 0 and 2 of the dataset's 0, 1, 2
+                r = copy.deepcopy(ok)
+                r.update(key=f"k{im}", scene="real", scene_id=1, im_id=im)
+                f.write(json.dumps(r) + "\n")
+        for m in ("ppf", "shot"):
+            open(os.path.join(self.run_dir, "bop", f"posebench-{m}-icp_real-test.csv"), "w").close()
+        open(os.path.join(self.run_dir, "bop", "posebench-ppf-icp_other-test.csv"), "w").close()
+        self.ds = os.path.join(self.tmp.name, "ds")
+        os.makedirs(self.ds)
+        with open(os.path.join(self.ds, "test_targets_bop19.json"), "w") as f:
+            json.dump([{"scene_id": 1, "im_id": im, "obj_id": 5, "inst_count": 1} for im in (0, 1, 2)], f)
+        self.stub = os.path.join(self.tmp.name, "posebench")
+        with open(self.stub, "w") as f:
+            f.write(SCORE_STUB)
+        os.chmod(self.stub, os.stat(self.stub).st_mode | stat.S_IEXEC)
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def test_each_file_of_a_named_scene_on_the_images_run(self):
+        code, out, err = run("ar", self.run_dir, "--dataset", f"real={self.ds}", "--posebench", self.stub)
+        self.assertEqual(code, 0, err)
+        self.assertIn("| posebench-ppf-icp | real | 2 | 0.500 |", out)
+        self.assertIn("| posebench-shot-icp | real | 2 | 0.250 |", out)
+        self.assertNotIn("other", out)  # no dataset named for that scene
+
+    def test_a_run_without_bop_results_exits_2_naming_the_folder(self):
+        os.rename(os.path.join(self.run_dir, "bop"), os.path.join(self.run_dir, "elsewhere"))
+        code, _, err = run("ar", self.run_dir, "--dataset", f"real={self.ds}", "--posebench", self.stub)
+        self.assertEqual(code, 2)
+        self.assertIn("bop", err)
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -160,7 +160,9 @@ OutlineEvidence outline_evidence(const PointSet& model, const Pose& T_cam_model,
       const float z_obs = depth.at(pu, pv);
       if (!(z_obs > 0) || !std::isfinite(z_obs)) continue;
       ++e.probed;
-      if (std::abs(static_cast<double>(z_obs) - at(u, v)) <= tolerance_mm) ++e.continuous;
+      const double step = static_cast<double>(z_obs) - at(u, v);
+      if (std::abs(step) <= tolerance_mm) ++e.continuous;
+      else if (step < 0) ++e.nearer;
     }
   return e;
 }
@@ -168,10 +170,10 @@ OutlineEvidence outline_evidence(const PointSet& model, const Pose& T_cam_model,
 double visibility_score(const PointSet& model, const Pose& T_cam_model, const DepthImage& depth, const Intrinsics& K,
                         const VerifySettings& v, double spacing_mm) {
   const double evidence = depth_evidence(model, T_cam_model, depth, K, v.inlier_threshold_mm).score(v.violation_weight);
-  if (!(v.outline_weight > 0)) return evidence;
+  if (!(v.outline_weight > 0) || !(evidence > 0)) return evidence;
   const OutlineEvidence o =
       outline_evidence(model, T_cam_model, depth, K, spacing_mm, v.inlier_threshold_mm, v.outline_gap_px);
-  return evidence * (1.0 - v.outline_weight * o.continuous_fraction());
+  return evidence * (1.0 - v.outline_weight + v.outline_weight * o.standing_fraction());
 }
 
 }  // namespace pb

@@ -53,11 +53,12 @@ struct VerifySettings {
   // 66 (configs/experiments/verification.yaml, results/verification).
   std::string score = "visibility";
   double violation_weight = 1.0;  // visibility: what one free-space violation costs, in supported points
-  // visibility: the score is also scaled by 1 - outline_weight x the share
-  // of the pose's outline that runs across an observed surface
-  // (OutlineEvidence): a pose sunk into a table, a wall or a larger object
-  // fits the surface it lies in, but its outline shows no depth step there.
-  // 0 = off.
+  // visibility: a positive score is also scaled by 1 - outline_weight +
+  // outline_weight x the share of the pose's outline that stands out against
+  // what lies behind it (OutlineEvidence). A pose sunk into a table, a wall
+  // or a larger object fits the surface it lies in (its points are on it or
+  // behind it), but its outline runs across that surface or behind nearer
+  // ones instead of standing out. 0 = off.
   double outline_weight = 0.0;
   int outline_gap_px = 3;         // the outline's probe: this many pixels outside the pose's mask
   // Several instances (BOP's inst_count): after the best, the next ranked
@@ -105,26 +106,29 @@ DepthEvidence depth_evidence(const PointSet& model, const Pose& T_cam_model, con
 
 // What the outline of a pose says. The model's camera-facing points are
 // drawn into the image as squares of spacing_mm (the cloud's point spacing),
-// nearest depth first: the pose's mask. At each pixel of the mask's outline
-// the observed depth gap_px pixels further out (away from the mask) either
-// steps away from the model's depth there (the object stands out against
-// what lies behind it, or something in front hides it), or is continuous
-// with it (within tolerance_mm): the outline runs across a surface, as it
-// does for a pose sunk into a table, a wall or another object, which
-// depth_evidence alone scores as well as a true one (its points are either
-// on that surface or behind it). Probes off the image or without depth
-// count in neither.
+// nearest depth first: the pose's mask. At each pixel of the mask's outline,
+// the observed depth gap_px pixels further out (away from the mask) is
+//   continuous  within tolerance_mm of the model's depth there: the outline
+//               runs across a surface, as for a pose sunk into a table;
+//   nearer      nearer by more than tolerance_mm: something in front hides
+//               the rim (an occluder, or the surface a sunk pose lies in);
+//   standing    farther: the object stands out against what is behind it,
+//               as a true pose's visible outline does.
+// Probes off the image or without depth count in none.
 struct OutlineEvidence {
   int probed = 0;      // outline pixels whose probe has valid depth
   int continuous = 0;  // of those, continuous with the model's depth
-  double continuous_fraction() const { return probed > 0 ? static_cast<double>(continuous) / probed : 0.0; }
+  int nearer = 0;      // of those, nearer than the model's depth
+  int standing() const { return probed - continuous - nearer; }
+  double standing_fraction() const { return probed > 0 ? static_cast<double>(standing()) / probed : 0.0; }
 };
 OutlineEvidence outline_evidence(const PointSet& model, const Pose& T_cam_model, const DepthImage& depth,
                                  const Intrinsics& K, double spacing_mm, double tolerance_mm, int gap_px);
 
 // verify.score visibility of a pose: depth_evidence's score (tolerance
-// inlier_threshold_mm) x (1 - outline_weight x the outline's continuous
-// fraction; outline_evidence with spacing_mm, the cloud's point spacing).
+// inlier_threshold_mm), when positive x (1 - outline_weight + outline_weight
+// x the outline's standing fraction; outline_evidence with spacing_mm, the
+// cloud's point spacing).
 double visibility_score(const PointSet& model, const Pose& T_cam_model, const DepthImage& depth, const Intrinsics& K,
                         const VerifySettings& v, double spacing_mm);
 
