@@ -17,7 +17,9 @@ per scene and method, what became of each target:
   elsewhere   not found, more than a diameter away (another object, the
               table, the background);
   none        no hypothesis was accepted;
-and the median seconds per target. Each --variant run (the same experiment
+and the median seconds of recognition per target (the record's
+times.total: preprocessing to verification, without loading or training).
+Each --variant run (the same experiment
 with one setting changed) adds its found / hypothesis / chosen counts with
 the change from RUN.
 
@@ -89,8 +91,8 @@ def stage_counts(path, scenes=None):
         c[f["outcome"]] += 1
         c["hypothesis"] += f["hypothesis"]
         c["chosen"] += f["chosen"]
-        if r.get("wall_s") is not None and r["status"] == "ok":
-            seconds[key].append(r["wall_s"])
+        if r.get("times") is not None and r["status"] == "ok":
+            seconds[key].append(r["times"]["total"])
     return counts, seconds
 
 
@@ -98,7 +100,7 @@ def stages_table(base, variants):
     """Markdown: one row per (scene, method) of the base run; per variant its
     found / hypothesis / chosen and the change."""
     counts, seconds = base
-    head = "| scene | method | n | found | hypothesis | chosen | near | elsewhere | none | median s |"
+    head = "| scene | method | n | found | hypothesis | chosen | near | elsewhere | none | median s (recognition) |"
     rule = "|---|---|---|---|---|---|---|---|---|---|"
     for label, _ in variants:
         head += f" {label}: found / hyp. / chosen |"

@@ -58,8 +58,12 @@ struct VerifySettings {
   // what lies behind it (OutlineEvidence). A pose sunk into a table, a wall
   // or a larger object fits the surface it lies in (its points are on it or
   // behind it), but its outline runs across that surface or behind nearer
-  // ones instead of standing out. 0 = off.
-  double outline_weight = 0.0;
+  // ones instead of standing out. 0 = off. Measured at 1 against 0, the same
+  // trials (configs/experiments/real/recognition.yaml, results/real_recognition):
+  // real YCB-Video ppf 12 -> 18 and shot 14 -> 21 of 223 found, every other
+  // method within 2; simulated clutter and occluded scenes within 4 per
+  // method, none significant.
+  double outline_weight = 1.0;
   int outline_gap_px = 3;         // the outline's probe: this many pixels outside the pose's mask
   // Several instances (BOP's inst_count): after the best, the next ranked
   // hypotheses are further instances while they are accepted like the best
