@@ -110,11 +110,17 @@ if obj == 3:
 R = [1, 0, 0, 0, 1, 0, 0, 0, 1]
 Rz = [0, -1, 0, 1, 0, 0, 0, 0, 1]
 if obj == 1:
-    ans = {"errors": {"translation_mm": 1.5, "correct": True}, "ranked": [{}, {}],
-           "ground_truth_refined": {"would_rank": 0, "R": R, "t": [0, 0, 702]}}
+    ans = {"errors": {"translation_mm": 1.5, "correct": True},
+           "ranked": [{"verification": 90, "errors": {"translation_mm": 1.5, "rotation_deg": 1}},
+                      {"verification": 50, "errors": {"translation_mm": 300, "rotation_deg": 90}}],
+           "ground_truth_refined": {"would_rank": 0, "verification": 80, "R": R, "t": [0, 0, 702]}}
 else:
-    ans = {"errors": {"translation_mm": 400.0, "correct": False}, "ranked": [{}, {}, {}],
-           "ground_truth_refined": {"would_rank": 2, "R": Rz, "t": [100, 0, 800]}}
+    # Two wrong hypotheses and a right one (2 mm, 10 deg) above the GT.
+    ans = {"errors": {"translation_mm": 400.0, "correct": False},
+           "ranked": [{"verification": 90, "errors": {"translation_mm": 400, "rotation_deg": 10}},
+                      {"verification": 85, "errors": {"translation_mm": 2, "rotation_deg": 10}},
+                      {"verification": 84, "errors": {"translation_mm": 20, "rotation_deg": 60}}],
+           "ground_truth_refined": {"would_rank": 3, "verification": 70, "R": Rz, "t": [100, 0, 800]}}
 print(json.dumps(ans))
 """
 
@@ -144,9 +150,10 @@ class Oracle(unittest.TestCase):
     def test_rows_and_counts(self):
         code, out, err = run("oracle", "--dataset", self.ds, "--method", "ppf", "--posebench", self.stub)
         self.assertEqual(code, 0, err)
-        self.assertIn("| 1 | 0 | 1 | 2 | yes | 0 of 2 | 2.0 | 0.0 |", out)
-        self.assertIn("| 1 | 0 | 2 | 400 | no | 2 of 3 | 0.0 | 90.0 |", out)
-        self.assertIn("ppf: 2 targets; chosen correct 1; the refined ground truth would rank first 1; "
+        self.assertIn("| 1 | 0 | 1 | 2 | yes | 0 of 2 | 0 | 2.0 | 0.0 |", out)
+        self.assertIn("| 1 | 0 | 2 | 400 | no | 3 of 3 | 2 | 0.0 | 90.0 |", out)
+        self.assertIn("ppf: 2 targets; chosen correct 1; the refined ground truth would rank above every wrong "
+                      "hypothesis 1; "
                       "refinement turned the ground truth by over 5 deg 1 (moved it by 1.0 mm at the median)", out)
 
     def test_image_stride_keeps_every_nth_image_of_each_scene_in_order(self):
