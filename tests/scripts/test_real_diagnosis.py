@@ -35,6 +35,15 @@ def fixture_records():
     return ok, none
 
 
+def stand_in(folder, text):
+    """An executable `posebench` in folder that runs `text` (Python)."""
+    path = os.path.join(folder, "posebench")
+    with open(path, "w") as f:
+        f.write(text)
+    os.chmod(path, os.stat(path).st_mode | stat.S_IEXEC)
+    return path
+
+
 def target(ok, key, mssd, t, rank):
     """A record of `ok`'s form: diameter 200, MSSD mssd, translation t, correct_rank rank."""
     r = copy.deepcopy(ok)
@@ -139,10 +148,7 @@ class Oracle(unittest.TestCase):
                         {"scene_id": 1, "im_id": 0, "obj_id": 2, "inst_count": 1}]
         with open(os.path.join(d, "test_targets_bop19.json"), "w") as f:
             json.dump(self.targets, f)
-        self.stub = os.path.join(self.tmp.name, "posebench")
-        with open(self.stub, "w") as f:
-            f.write(STUB)
-        os.chmod(self.stub, os.stat(self.stub).st_mode | stat.S_IEXEC)
+        self.stub = stand_in(self.tmp.name, STUB)
 
     def tearDown(self):
         self.tmp.cleanup()
@@ -204,10 +210,7 @@ class AverageRecall(unittest.TestCase):
         os.makedirs(self.ds)
         with open(os.path.join(self.ds, "test_targets_bop19.json"), "w") as f:
             json.dump([{"scene_id": 1, "im_id": im, "obj_id": 5, "inst_count": 1} for im in (0, 1, 2)], f)
-        self.stub = os.path.join(self.tmp.name, "posebench")
-        with open(self.stub, "w") as f:
-            f.write(SCORE_STUB)
-        os.chmod(self.stub, os.stat(self.stub).st_mode | stat.S_IEXEC)
+        self.stub = stand_in(self.tmp.name, SCORE_STUB)
 
     def tearDown(self):
         self.tmp.cleanup()

@@ -118,7 +118,10 @@ OutlineEvidence outline_evidence(const PointSet& model, const Pose& T_cam_model,
     if (normals && (R * model.normals[i].cast<double>()).dot(q) >= 0) continue;
     const Eigen::Vector2d uv = K.project(q);
     if (!(uv.x() > -0.5 && uv.x() < depth.width - 0.5 && uv.y() > -0.5 && uv.y() < depth.height - 0.5)) continue;
-    const int half = static_cast<int>(std::min(16.0, std::ceil(0.75 * spacing_mm * K.fx / q.z())));
+    // Squares 1.5 point spacings wide, so that neighbouring points' squares
+    // overlap and the mask has no holes; at least 3 px (an unvoxelized
+    // cloud, spacing 0), at most 33.
+    const int half = static_cast<int>(std::clamp(std::ceil(0.75 * spacing_mm * K.fx / q.z()), 1.0, 16.0));
     const Splat s{static_cast<int>(std::lround(uv.x())), static_cast<int>(std::lround(uv.y())), half,
                   static_cast<float>(q.z())};
     u0 = std::min(u0, s.u - half);
