@@ -144,7 +144,7 @@ const std::map<std::string, double>& default_relative_lengths() {
       {"preprocess.voxel_mm", 0.05},           {"preprocess.plane_threshold_mm", 0.05},
       {"preprocess.normal_radius_mm", 0.10},   {"local.keypoint_voxel_mm", 0.075},
       {"local.descriptor_radius_mm", 0.30},    {"local.lrf_radius_mm", 0.20},
-      {"local.hough_bin_mm", 0.25},            {"global.cluster_tolerance_mm", 0.10},
+      {"local.hough_bin_mm", 0.25},            {"global.cluster_tolerance_mm", 0.06},
       {"global.cvfh_cluster_tolerance_mm", 0.075}, {"global.cvfh_normal_radius_mm", 0.10},
       {"ppf.position_cluster_mm", 0.15},       {"refine.max_correspondence_mm", 0.10},
       {"refine.ndt_resolution_mm", 0.15},      {"refine.ndt_step_size_mm", 0.40},
