@@ -8,6 +8,12 @@ import unittest
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "scripts"))
 import sensor_fit_plot as sfp  # noqa: E402
 
+try:
+    import matplotlib  # noqa: F401  (the plots need it; Debian's python3-matplotlib)
+    HAVE_MATPLOTLIB = True
+except ImportError:
+    HAVE_MATPLOTLIB = False
+
 
 def bin_(lo, hi, n, missing, nearer=0, spread=1.0):
     return {"lo": lo, "hi": hi, "n": n, "missing": missing, "nearer": nearer, "farther": 0, "inliers": n - missing,
@@ -32,6 +38,7 @@ class SensorFitPlotTest(unittest.TestCase):
         xs, ys, ns = sfp.series(stats(), "by_depth", lambda b: b["spread_mm"], min_n=100)
         self.assertEqual((xs, ys, ns), ([625.0], [1.5], [600]))
 
+    @unittest.skipUnless(HAVE_MATPLOTLIB, "matplotlib is not installed (apt install python3-matplotlib)")
     def test_draws_every_set(self):
         data = {"dataset": "x", "images": 1, "loss": {"base": {"total": 2.0}, "fitted": {"total": 1.0}},
                 "real": stats(), "simulated_base": stats(), "simulated_fitted": stats()}
