@@ -16,6 +16,7 @@
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "cli/command.h"
@@ -102,8 +103,32 @@ void settings_from(const Options& o, pb::RecognitionSettings& s) {
   if (o.seed >= 0) s.seed = static_cast<uint64_t>(o.seed);
 }
 
-// The ground-truth instance of the object closest to the estimate, and the
-// thesis's errors against it.
+// The thesis's errors of a pose against the object's ground-truth instance
+// it is closest to (the larger of translation / threshold and rotation /
+// threshold); none when the image has no instance of the object.
+struct NearestGt {
+  pb::ThesisErrors err;
+  pb::Pose gt_pose;
+};
+std::optional<NearestGt> nearest_gt(const pb::Pose& T, const pb::ImageInfo& im, int obj_id,
+                                    const std::vector<pb::Pose>& syms, const pb::ThesisThresholds& thr) {
+  pb::ThesisErrorOptions eo;
+  eo.thresholds = thr;
+  std::optional<NearestGt> out;
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& g : im.gt) {
+    if (g.obj_id != obj_id) continue;
+    const pb::ThesisErrors e = pb::thesis_errors(T, g.T_cam_model, syms, eo);
+    const double key = std::max(e.translation_mm / thr.translation_mm, e.rotation / thr.rotation);
+    if (key < best) {
+      best = key;
+      out = NearestGt{e, g.T_cam_model};
+    }
+  }
+  return out;
+}
+
+// The estimate against the ground-truth instance it is closest to.
 struct Evaluation {
   bool has_gt = false, correct = false;
   pb::ThesisErrors err;
@@ -116,21 +141,9 @@ Evaluation evaluate(const pb::RecognitionResult& res, const pb::ImageInfo& im, i
   Evaluation ev;
   for (const auto& g : im.gt) ev.gt_instances += g.obj_id == obj_id;
   if (res.status == "ok" && ev.gt_instances > 0) {
-    const auto syms = pb::symmetry_transformations(info);
-    pb::ThesisErrorOptions eo;
-    eo.thresholds = thr;
-    double best = std::numeric_limits<double>::infinity();
-    for (const auto& g : im.gt) {
-      if (g.obj_id != obj_id) continue;
-      const pb::ThesisErrors e = pb::thesis_errors(res.T_cam_model, g.T_cam_model, syms, eo);
-      const double key = std::max(e.translation_mm / thr.translation_mm, e.rotation / thr.rotation);
-      if (key < best) {
-        best = key;
-        ev.err = e;
-        ev.gt_pose = g.T_cam_model;
-        ev.has_gt = true;
-      }
-    }
+    const std::optional<NearestGt> n = nearest_gt(res.T_cam_model, im, obj_id, pb::symmetry_transformations(info), thr);
+    ev.has_gt = n.has_value();
+    if (n) ev.err = n->err, ev.gt_pose = n->gt_pose;
   } else if (ev.gt_instances > 0) {
     for (const auto& g : im.gt)
       if (g.obj_id == obj_id) {
@@ -145,44 +158,26 @@ Evaluation evaluate(const pb::RecognitionResult& res, const pb::ImageInfo& im, i
 // --explain: each ranked hypothesis against the nearest GT instance, and
 // the ground truth itself refined and verified like a hypothesis.
 struct RankedHypothesis {
-  double verification = 0, score = 0, translation_mm = -1, rotation_deg = -1;
-  int inliers = 0, view = -1;
-  pb::Pose T_cam_model;
+  pb::Hypothesis h;
+  std::optional<pb::ThesisErrors> err;  // none without a GT instance of the object
 };
 struct Explanation {
   std::vector<RankedHypothesis> ranked;
-  bool gt_checked = false;
-  double gt_verification = 0;
-  int gt_inliers = 0, gt_rank = 0;
-  pb::Pose gt_refined;  // gt_rank: where the refined GT would rank (0 = first)
+  std::optional<pb::Hypothesis> gt_refined;  // the GT pose refined and verified
+  int gt_rank = 0;                           // where it would rank (0 = first)
 };
 
 Explanation explain(const pb::RecognitionResult& res, const pb::ImageInfo& im, int obj_id, const pb::ModelInfo& info,
                     const pb::ThesisThresholds& thr, const pb::RecognitionResult* gt_res) {
   Explanation x;
   const auto syms = pb::symmetry_transformations(info);
-  pb::ThesisErrorOptions eo;
-  eo.thresholds = thr;
   for (const pb::Hypothesis& h : res.hypotheses) {
-    RankedHypothesis r{h.verification, h.score, -1, -1, h.inliers, h.view, h.T_cam_model};
-    double best = std::numeric_limits<double>::infinity();
-    for (const auto& g : im.gt) {
-      if (g.obj_id != obj_id) continue;
-      const pb::ThesisErrors e = pb::thesis_errors(h.T_cam_model, g.T_cam_model, syms, eo);
-      if (e.translation_mm < best) {
-        best = e.translation_mm;
-        r.translation_mm = e.translation_mm;
-        r.rotation_deg = e.rotation_deg;
-      }
-    }
-    x.ranked.push_back(r);
+    const std::optional<NearestGt> n = nearest_gt(h.T_cam_model, im, obj_id, syms, thr);
+    x.ranked.push_back({h, n ? std::optional<pb::ThesisErrors>(n->err) : std::nullopt});
   }
   if (gt_res && !gt_res->hypotheses.empty()) {
-    x.gt_checked = true;
-    x.gt_verification = gt_res->hypotheses.front().verification;
-    x.gt_inliers = gt_res->hypotheses.front().inliers;
-    x.gt_refined = gt_res->hypotheses.front().T_cam_model;
-    for (const pb::Hypothesis& h : res.hypotheses) x.gt_rank += h.verification > x.gt_verification;
+    x.gt_refined = gt_res->hypotheses.front();
+    for (const pb::Hypothesis& h : res.hypotheses) x.gt_rank += h.verification > x.gt_refined->verification;
   }
   return x;
 }
@@ -221,12 +216,8 @@ std::string json_output(const Outcome& x) {
   j["method"] = x.s.descriptor;
   j["refinement"] = x.s.refinement;
   if (ok) {
-    std::vector<double> R, t;
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) R.push_back(x.res.T_cam_model.R(r, c));
-    for (int r = 0; r < 3; ++r) t.push_back(x.res.T_cam_model.t[r]);
-    j["R"] = R;
-    j["t"] = t;
+    j["R"] = pose_R(x.res.T_cam_model);
+    j["t"] = pose_t(x.res.T_cam_model);
   } else {
     j["R"] = nullptr;
     j["t"] = nullptr;
@@ -235,13 +226,9 @@ std::string json_output(const Outcome& x) {
   j["inliers"] = x.res.inliers;
   if (x.s.verify.max_instances != 1) {
     nlohmann::ordered_json list = nlohmann::ordered_json::array();
-    for (const auto& h : x.res.instances) {
-      std::vector<double> R, t;
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) R.push_back(h.T_cam_model.R(r, c));
-      for (int r = 0; r < 3; ++r) t.push_back(h.T_cam_model.t[r]);
-      list.push_back({{"R", R}, {"t", t}, {"verification", h.verification}, {"inliers", h.inliers}});
-    }
+    for (const auto& h : x.res.instances)
+      list.push_back({{"R", pose_R(h.T_cam_model)}, {"t", pose_t(h.T_cam_model)}, {"verification", h.verification},
+                      {"inliers", h.inliers}});
     j["instances"] = list;
   }
   j["hypotheses"] = x.res.hypotheses.size();
@@ -262,18 +249,16 @@ std::string json_output(const Outcome& x) {
   if (x.explanation) {
     nlohmann::ordered_json list = nlohmann::ordered_json::array();
     for (const RankedHypothesis& r : x.explanation->ranked) {
-      nlohmann::ordered_json h = {{"verification", r.verification}, {"inliers", r.inliers}, {"view", r.view},
-                                  {"score", r.score}, {"R", pose_R(r.T_cam_model)}, {"t", pose_t(r.T_cam_model)}};
-      if (r.translation_mm >= 0) h["errors"] = {{"translation_mm", r.translation_mm}, {"rotation_deg", r.rotation_deg}};
+      nlohmann::ordered_json h = {{"verification", r.h.verification}, {"inliers", r.h.inliers}, {"view", r.h.view},
+                                  {"score", r.h.score}, {"R", pose_R(r.h.T_cam_model)}, {"t", pose_t(r.h.T_cam_model)}};
+      if (r.err) h["errors"] = {{"translation_mm", r.err->translation_mm}, {"rotation_deg", r.err->rotation_deg}};
       list.push_back(h);
     }
     j["ranked"] = list;
-    if (x.explanation->gt_checked)
-      j["ground_truth_refined"] = {{"verification", x.explanation->gt_verification},
-                                   {"inliers", x.explanation->gt_inliers},
-                                   {"would_rank", x.explanation->gt_rank},
-                                   {"R", pose_R(x.explanation->gt_refined)},
-                                   {"t", pose_t(x.explanation->gt_refined)}};
+    if (const auto& g = x.explanation->gt_refined)
+      j["ground_truth_refined"] = {{"verification", g->verification}, {"inliers", g->inliers},
+                                   {"would_rank", x.explanation->gt_rank}, {"R", pose_R(g->T_cam_model)},
+                                   {"t", pose_t(g->T_cam_model)}};
   }
   if (!x.o.overlay.empty()) j["overlay"] = x.o.overlay;
   return j.dump() + "\n";
@@ -322,13 +307,13 @@ std::string text_output(const Outcome& x, const pb::ThesisThresholds& thr) {
     o << "ranked hypotheses (verification, inliers, view, method score; errors vs the nearest GT instance):\n";
     for (size_t i = 0; i < x.explanation->ranked.size(); ++i) {
       const RankedHypothesis& r = x.explanation->ranked[i];
-      o << "  " << i << ": " << r.verification << ", " << r.inliers << ", view " << r.view << ", " << r.score;
-      if (r.translation_mm >= 0) o << "; " << r.translation_mm << " mm, " << r.rotation_deg << " deg";
+      o << "  " << i << ": " << r.h.verification << ", " << r.h.inliers << ", view " << r.h.view << ", " << r.h.score;
+      if (r.err) o << "; " << r.err->translation_mm << " mm, " << r.err->rotation_deg << " deg";
       o << "\n";
     }
-    if (x.explanation->gt_checked)
-      o << "ground truth refined and verified: verification " << x.explanation->gt_verification << ", inliers "
-        << x.explanation->gt_inliers << " (would rank " << x.explanation->gt_rank << ")\n";
+    if (const auto& g = x.explanation->gt_refined)
+      o << "ground truth refined and verified: verification " << g->verification << ", inliers " << g->inliers
+        << " (would rank " << x.explanation->gt_rank << ")\n";
   }
   if (!x.o.overlay.empty()) o << "overlay: " << x.o.overlay << "\n";
   return o.str();
