@@ -21,7 +21,8 @@ pb::RecognitionSettings parse(const std::string& yaml, pb::RecognitionSettings b
 }
 
 // The thesis's values, except where measurement moved a default (the thesis
-// configs pin the thesis's: global.top_k 5, results/real_recognition).
+// configs pin the thesis's: global.top_k 5, local.matches_per_keypoint 1,
+// results/real_recognition).
 TEST(Settings, DefaultsAreTheDocumentedValues) {
   const pb::RecognitionSettings s;
   EXPECT_EQ(s.descriptor, "fpfh");
@@ -30,6 +31,8 @@ TEST(Settings, DefaultsAreTheDocumentedValues) {
   EXPECT_EQ(s.preprocess.voxel_mm, 10.0);
   EXPECT_EQ(s.global.top_k, 20);
   EXPECT_EQ(s.local.hough_min_votes, 5);
+  EXPECT_EQ(s.local.matches_per_keypoint, 3);
+  EXPECT_EQ(s.local.max_hypotheses, 40);
   EXPECT_EQ(s.refine.max_iterations, 40);
   EXPECT_EQ(s.verify.min_inlier_fraction, 0.0);
 }
