@@ -6,7 +6,7 @@
 # models are needed. Re-running resumes: finished trials are not redone.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-"$ROOT/scripts/setup.sh"
+"$ROOT/scripts/setup.sh" --only posebench   # the tests and benchmarks: scripts/test.sh
 cd "$ROOT"
 JOBS="${POSEBENCH_JOBS:-$(nproc)}"
 echo "demo: running configs/experiments/demo.yaml with $JOBS worker(s) (results/demo)"

@@ -1,9 +1,19 @@
 #!/usr/bin/env bash
 # Idempotent set-up: installs the Debian packages that are missing, then
 # configures and builds posebench (Release) into build/.
+#   scripts/setup.sh                  everything: the tool, tests, benchmarks
+#   scripts/setup.sh --only posebench the tool alone (what the demo runs)
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
+TARGET_ARGS=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --only) [ $# -ge 2 ] || { echo "setup.sh: --only needs a target name" >&2; exit 2; }
+            TARGET_ARGS=(--target "$2"); shift 2 ;;
+    *) echo "setup.sh: unknown argument '$1' (--only TARGET)" >&2; exit 2 ;;
+  esac
+done
 
 PACKAGES=(build-essential cmake pkg-config ccache libpcl-dev libeigen3-dev libosmesa6-dev
           libassimp-dev nlohmann-json3-dev libyaml-cpp-dev libbenchmark-dev libgtest-dev
@@ -28,7 +38,7 @@ export CCACHE_DIR="${CCACHE_DIR:-$HOME/.cache/ccache}"
 # job per core.
 JOBS="${POSEBENCH_BUILD_JOBS:-$(nproc)}"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release ${POSEBENCH_CMAKE_ARGS:-} >/dev/null
-cmake --build build -j "$JOBS"
+cmake --build build -j "$JOBS" ${TARGET_ARGS[@]+"${TARGET_ARGS[@]}"}
 
 # The project's own models, generated in code, written as meshes (mm) for
 # viewers and other tools; the registry lists every model and its state.
