@@ -12,9 +12,9 @@
 // plus the number of hypotheses, whether the chosen pose is correct by the
 // thesis's table thresholds (symmetry-aware: the LS5 counts as symmetric
 // about its axis, as in the thesis) and its errors (t_err_mm, r_err_deg).
-// Set total_s beside the thesis's Table 4.1 (THESIS.md, synthetic table:
-// CVFH 0.19, ESF 0.60, CESF 0.43, SHOT 1.95, FPFH 1.22 s per image, on a
-// 3 GHz two-core laptop CPU).
+// Set total_s beside the thesis's Table 4.1 (synthetic table: CVFH 0.19,
+// ESF 0.60, CESF 0.43, SHOT 1.95, FPFH 1.22 s per image, on a 3 GHz
+// two-core laptop CPU, thesis 1.6.1).
 //
 //   build/bench/bench_pipeline --benchmark_counters_tabular=true
 // OpenMP parts (normals, FPFH/SHOT, matching, refinement of the hypotheses)

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the thesis's tables and figures (THESIS.md) and writes
+# Regenerates the thesis's tables and figures (its chapter 4) and writes
 # results/thesis/README.md beside the thesis's numbers.
 #
 #   scripts/thesis.sh [--jobs N] [--only NAME[,NAME...]] [--ablations] [--readme-only]

@@ -1,5 +1,5 @@
 // Validation where data enters, through the binary: a BOP scene whose camera
-// matrix has fx = 0 (which used to give exit 0 and "no hypothesis") or whose
+// matrix has fx = 0 (unchecked, it gives exit 0 and "no hypothesis") or whose
 // pose is not a rotation is exit 2 naming the file and the entry, for
 // `recognize` and for `run` (before any trial, no results folder); a dataset
 // whose scene_gt_info.json lacks bbox_obj (as many converted datasets do)

@@ -228,7 +228,7 @@ TEST(MeshIo, PlyFaceIndexOutOfRangeIsAnInputErrorNotACrash) {
   expect_mesh_error([&] { load_mesh(big); }, big);
 }
 
-// The header grammar: the third fuzzing finding was a binary PLY whose
+// The header grammar: one fuzzing finding was a binary PLY whose
 // property name held NUL bytes (assimp crashed reading it). Each rule below
 // is one rejected header; the valid header beside them loads.
 TEST(MeshIo, PlyHeaderGrammarIsChecked) {

@@ -267,7 +267,7 @@ TEST(Registry, SharedModelsLoadNormalized) {
   EXPECT_NEAR(extent(reg.load_model("nefertiti")).z(), 300, 1e-2);
   EXPECT_NEAR(reg.info("armadillo", reg.load_model("armadillo")).diameter, 126 * 1.4, 126 * 0.3);
   // The armadillo squeezed to the thesis's Statue of Liberty (1500 x 450 x
-  // 380 mm in the warehouse, a tenth of that on the table, THESIS.md 4.1.1).
+  // 380 mm in the warehouse, a tenth of that on the table, thesis 4.1.1).
   const Vec3 slender = extent(reg.load_model("liberty_slender"));
   EXPECT_NEAR(slender.x(), 38, 1e-3);
   EXPECT_NEAR(slender.y(), 32, 1e-3);

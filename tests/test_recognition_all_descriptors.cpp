@@ -98,7 +98,7 @@ struct SceneSet {
   Mesh mesh;
 };
 
-// The thesis's table thresholds (THESIS.md "Evaluation").
+// The thesis's table thresholds (the introduction of its chapter 4).
 constexpr double kMaxTranslationMm = 50.0;
 constexpr double kMaxRotation = 0.05;  // 1 - |p.q|, about 36.4 deg
 

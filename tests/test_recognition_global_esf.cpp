@@ -107,9 +107,9 @@ TEST(GlobalEsf, ShapeAndNormalization) {
   for (float v : line) EXPECT_EQ(v, 0.f);
 }
 
-// The histograms of every test shape, bit for bit, as the implementation
-// that traced each line with its rounding steppers step by step computed them
-// (before the lines' minor-axis moves came from a table): a change of the
+// The histograms of every test shape, bit for bit, as tracing each line with
+// its rounding steppers step by step computes them (the code reads the
+// lines' minor-axis moves from a table instead): a change of the
 // line tracing, the binning or the draws changes the fingerprint (on this
 // toolchain: x86-64 without FMA contraction, glibc's acos).
 TEST(GlobalEsf, HistogramsAreThoseOfTheSteppedLineTracing) {
@@ -124,8 +124,8 @@ TEST(GlobalEsf, HistogramsAreThoseOfTheSteppedLineTracing) {
 
 // The same for small clouds, where each point pair is drawn many times and
 // its line's trace is looked up instead of traced again (CESF's stable
-// regions have tens to hundreds of points): the fingerprint was recorded
-// before the lookup existed, so the lookup changes no bit.
+// regions have tens to hundreds of points): the fingerprint is that of
+// tracing every line, so the lookup changes no bit.
 TEST(GlobalEsf, SmallCloudsHaveTheHistogramsOfTracingEveryLine) {
   std::string bytes;
   for (int n : {3, 12, 40, 150, 400, 700}) {

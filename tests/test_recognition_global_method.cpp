@@ -153,9 +153,9 @@ INSTANTIATE_TEST_SUITE_P(All, GlobalMethod, ::testing::Values("cvfh", "esf", "ce
 // cvfh_min_region_points) is still described, as CVFH describes it
 // (pcl::CVFHEstimation falls back to the VFH of the whole cloud): CESF falls
 // back to the ESF of the whole cloud, so its hypotheses are then ESF's, bit
-// for bit. Before, CESF gave such a cloud no signature: a target seen
-// without a stable region (the curved statue at a 5 mm voxel, half of the
-// Table 4.7 table images) could not be found at all.
+// for bit. Without the fallback CESF gives such a cloud no signature, and a
+// target seen without a stable region (the curved statue at a 5 mm voxel,
+// half of the Table 4.7 table images) cannot be found at all.
 TEST_F(GlobalMethod, CesfWithoutStableRegionsFallsBackToTheWholeCloud) {
   GlobalSettings g;
   g.cvfh_min_region_points = 1000000;
@@ -363,7 +363,7 @@ TEST(GlobalOurCvfh, CurvedSurfacesDoNotCrash) {
 
 // Clusters of generated table images (simulated Astra) with a stable region
 // that OUR-CVFH's normal refinement shrinks to 1 or 2 points; on the second
-// PCL aborted (Eigen index assertion) before the guard. Guarded: signatures
+// PCL aborts (Eigen index assertion) without the guard. Guarded: signatures
 // with finite histograms and frames.
 template <size_t N>
 PointSet cluster_from(const float (&rows)[N][7]) {

@@ -4,7 +4,7 @@
 // in their margin, plus a duplicated point and a keypoint with too few
 // neighbours. With PCL's std::rand() start axis (same std::srand) the frames
 // agree row by row; with the deterministic start axis the z axes agree, the
-// frame no longer depends on earlier std::rand() calls, and a rigid motion
+// frame does not depend on earlier std::rand() calls, and a rigid motion
 // moves the frames with the surface. A fingerprint holds the frames bit for
 // bit on dense and noisy neighbourhoods.
 #include <gtest/gtest.h>
@@ -111,10 +111,10 @@ TEST(LocalBoard, DeterministicStartAxisIsRepeatableAndMovesWithTheSurface) {
 // its border) and the same surface made a noisy slab with random normals
 // (full margins, many points per sector), radii from about 10 to about 300
 // neighbours. A faster BOARD must keep it (on this toolchain: x86-64 without
-// FMA contraction, glibc's acosf). Tried in session 20 against it: the
+// FMA contraction, glibc's acosf). Tried against it and not kept: the
 // sectors and extremes from an integer key ordered as the angles, acos only
 // for a point that may become its sector's extreme; the same bits, but no
-// fewer instructions (results/bench/README.md, thirteenth round).
+// fewer instructions (results/bench/README.md).
 TEST(LocalBoard, FramesBitForBitAsFingerprinted) {
   PointSet slab = noisy_surface(8);
   Rng rng(9);

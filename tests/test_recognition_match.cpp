@@ -5,7 +5,7 @@
 // and thresholds. The results must be equal bit for bit: rows, order and
 // distances. The approximate search (max_checks) against the same scan:
 // exact when the cap cannot bind, a recall it must reach when it does; its
-// candidate selection against the listing it replaced.
+// candidate selection against listing every candidate.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -235,7 +235,7 @@ TEST(DescriptorIndex, LongBoundsKernelGivesEachQuerysSmallestBound) {
 
 // The capped search's candidates: the cap smallest (value, index) pairs
 // under the limit, the same set as listing every pair under it and keeping
-// the cap smallest with nth_element (the way before), with ties, NaN and
+// the cap smallest with nth_element (the plain way), with ties, NaN and
 // lengths that are not a multiple of four or eight, on both paths (SSE, and
 // AVX2 where the CPU has it).
 TEST(DescriptorIndex, SmallestAtMostEqualsListingThenNthElement) {

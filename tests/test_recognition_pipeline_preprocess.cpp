@@ -107,8 +107,8 @@ TEST(Ransac, SubsetScoringSelectsThePlaneAmongAllPoints) {
 // thr, Vector3d dot product): random planes and points, thresholds equal to
 // some points' own distances as Eigen computes them and the doubles either
 // side (where another summation order would put a point on the other side),
-// and zero and huge coordinates. The candidate planes score as before, bit
-// for bit.
+// and zero and huge coordinates. The candidate planes score as with Eigen,
+// bit for bit.
 TEST(Ransac, CountWithinEqualsEigensTest) {
   using pb::Vec3;
   namespace detail = pb::detail;
@@ -127,7 +127,7 @@ TEST(Ransac, CountWithinEqualsEigensTest) {
     pts.emplace_back(0.f, 0.f, 0.f);
     pts.emplace_back(-0.f, 1e30f, -1e30f);
     const detail::PlanePoints soa(pts);
-    auto eigen_distance = [&](const Vec3f& p) {  // as RANSAC's scoring wrote it before
+    auto eigen_distance = [&](const Vec3f& p) {  // RANSAC's scoring written with Eigen
       const Vec3 pd = p.cast<double>();
       return std::abs(plane.head<3>().dot(pd) + plane[3]);
     };

@@ -280,8 +280,8 @@ TEST(Settings, NamesAreTheIssuesList) {
 }
 
 // The relative inlier threshold is capped at verify.inlier_threshold_max_voxels
-// preprocess voxels: the warehouse's 0.05 d (1.8 m LS5, 20 mm voxel) was 4.5
-// voxels and counted the LS5's 180-degree flip as inliers.
+// preprocess voxels: the warehouse's 0.05 d (1.8 m LS5, 20 mm voxel) is 4.5
+// voxels, enough to count the LS5's 180-degree flip as inliers.
 TEST(RelativeLengths, TheInlierThresholdIsAtMostTwoVoxels) {
   const auto warehouse = pb::resolve_lengths(parse("preprocess: {voxel_mm: 20}\n"), 1800);
   EXPECT_DOUBLE_EQ(warehouse.verify.inlier_threshold_mm, 40);  // not 0.05 d = 90

@@ -1,4 +1,4 @@
-// Refinement methods (THESIS.md "Registration"; issue 3 "must show"): each
+// Refinement methods (thesis 3.1.7; issue 3 "must show"): each
 // method, started from the ground truth perturbed by 10 degrees and 20 mm
 // (random axis and direction, seeded) on 20 generated table images of an
 // asymmetric object, must converge to within 5 mm and 2 degrees in at least
@@ -231,14 +231,12 @@ TEST_F(RefineCases, SameInputsGiveSamePoseBits) {
   EXPECT_NE(std::memcmp(a.T_cam_model.t.data(), b.T_cam_model.t.data(), sizeof(double) * 3), 0);
 }
 
-// Our ICP and ICP point-to-plane, bit for bit as recorded (session 27), so
-// that a change meant to find the same correspondences faster shows when it
-// does not: the 20 cases under the default settings, without reciprocity,
-// on a random 100 points, and coarse to fine from 200 points (on this
-// toolchain: x86-64 without FMA contraction, as the ESF fingerprints). The
-// bytes are the pose and the iteration count (session 35: the fitness, no
-// longer part of refine_pose's result, left the hash; the poses' code did
-// not change).
+// Our ICP and ICP point-to-plane, bit for bit as recorded, so that a change
+// meant to find the same correspondences faster shows when it does not: the
+// 20 cases under the default settings, without reciprocity, on a random 100
+// points, and coarse to fine from 200 points (on this toolchain: x86-64
+// without FMA contraction, as the ESF fingerprints). The bytes are the pose
+// and the iteration count (RefineResult carries no fitness).
 TEST_F(RefineCases, OwnIcpPosesAreTheRecordedBits) {
   RefineSettings one_way, sub, coarse;
   one_way.reciprocal_correspondences = false;

@@ -1,4 +1,4 @@
-// Scatter3 against the Eigen expressions it replaced: the lower triangle of
+// Scatter3 against the Eigen expressions of the same sums: the lower triangle of
 // the sum of d d^T (normals, BOARD) and of w d d^T (the SHOT frame), bit for
 // bit, over random neighbourhoods; the eigensolvers read only that triangle,
 // so the normals and frames stay the same.

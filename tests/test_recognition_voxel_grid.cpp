@@ -310,10 +310,10 @@ TEST(VoxelGrid, EqualsThePlainReferenceOnATableFrame) {
 }
 
 // The whole scene preprocessing (range cut, grid, RANSAC plane, normals)
-// of a rendered table frame, bit for bit as before the range cut, the grid
-// and the plane scoring were rewritten for speed (issue 8, session 25): a
-// change of any of them that moves a bit changes the fingerprint (on this
-// toolchain: x86-64 without FMA contraction). Also with the veil filter and
+// of a rendered table frame, bit for bit as recorded before the range cut,
+// the grid and the plane scoring were rewritten for speed: a change of any
+// of them that moves a bit changes the fingerprint (on this toolchain:
+// x86-64 without FMA contraction). Also with the veil filter and
 // two planes.
 TEST(VoxelGrid, ScenePreprocessingKeepsItsFingerprint) {
   const pb::Mesh mesh = pbtest::make_l_block();
@@ -341,9 +341,8 @@ TEST(VoxelGrid, ScenePreprocessingKeepsItsFingerprint) {
   const PointSet c = pb::preprocess_scene(cloud, s, 7);
   EXPECT_GT(c.size(), a.size());
   add(c);
-  // The points, normals and curvature only: since the scene's points carry
-  // no pixel (issue 8, session 45). Before that change they hashed to this
-  // value too (the pixels' bytes left out of the hash).
+  // The points, normals and curvature only: a scene's points carry no
+  // pixel (preprocess.h).
   EXPECT_EQ(pb::hex16(h.digest()), "936aac334f1c9f65");
 }
 

@@ -1,4 +1,4 @@
-// Sensor profiles and their YAML: built-in values (THESIS.md Table 2.1),
+// Sensor profiles and their YAML: built-in values (thesis Table 2.1),
 // custom intrinsics, noise settings, and bad input naming file and field.
 #include <gtest/gtest.h>
 

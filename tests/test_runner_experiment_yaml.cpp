@@ -1,6 +1,6 @@
 // Experiment YAML text, two findings of fuzz/fuzz_experiment_yaml.cpp, both
-// internal errors before: bytes that are not UTF-8 (yaml-cpp passed them on
-// and the JSON dump of the config threw) are an InputError naming the file
+// internal errors without a check: bytes that are not UTF-8 (yaml-cpp passes
+// them on and the JSON dump of the config throws) are an InputError naming the file
 // and the line, in every YAML loader (core/yaml.cpp), while UTF-8 text is
 // accepted; and a document that yaml-cpp reads into an invalid node (a '%'
 // directive line after content) is an InputError naming the file, not
@@ -87,8 +87,8 @@ TEST(ExperimentYaml, ADirectiveAfterContentIsAnInputError) {
 }  // namespace
 
 // A path component longer than the OS allows (NAME_MAX) in `generate:`: the
-// filesystem check threw std::filesystem::filesystem_error out of the loader
-// (found by fuzz_experiment_yaml); now the scene config is "not found".
+// filesystem check can throw std::filesystem::filesystem_error (found by
+// fuzz_experiment_yaml); the loader reports the scene config "not found".
 TEST(ExperimentYaml, APathTooLongForTheOsIsAnInputError) {
   const std::string long_name(300, 'x');
   const std::string path = write("too_long.yaml", "object: ls5\nscenes:\n  - generate: configs/" + long_name +

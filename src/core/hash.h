@@ -4,9 +4,9 @@
 //
 // Stream identifiers for random seeds (derive_seed) are the same function
 // with another basis, kStreamIdBasis = 1469598103934665603 (one digit short
-// of the standard basis). Releases before the structure refactor used that
-// value everywhere by mistake; the seeds of scenes and trials keep it so
-// that a config and seed give the same scenes and results as before.
+// of the standard basis). That value was a slip; the seeds of scenes and
+// trials keep it so that a config and seed give the scenes and results
+// already recorded.
 #pragma once
 
 #include <cstddef>

@@ -11,10 +11,11 @@ namespace pb {
 // large buffers (the 640x480 cloud, the voxel grid's keys, the normals) are
 // freed at its end; glibc gives them back to the kernel (blocks from 128 KiB
 // to a few MiB come from mmap, and the heap's free top beyond about twice
-// the largest such block is trimmed), so the next trial faulted every page
-// in again. What ran before then decided a method's time: PPF alone on the
-// table frames spent 13.9 ms in preprocessing, 9.0 ms after CVFH had grown
-// the heap (results/bench/README.md, twenty-fourth round). Kept as
+// the largest such block is trimmed), so the next trial would fault every
+// page in again, and what ran before would decide a method's time: without
+// this policy, PPF alone on the table frames spent 13.9 ms in
+// preprocessing, 9.0 ms after CVFH had grown the heap
+// (results/bench/README.md). Kept as
 // latency-sensitive programs do: blocks under 64 MiB from the heap, and up to
 // 1 GiB of freed heap not returned. It changes when memory goes back, never a
 // result; a worker's resident size stays near its peak. glibc only (a no-op

@@ -2,9 +2,10 @@
 // true angle, for code that needs the angle's value to double precision
 // (SHOT's votes interpolate with it) many times per frame. libm's acos and
 // atan2 are correctly rounded or close to it but took about a tenth of the
-// warehouse SHOT frame (session 43's perf record). These give the same bits
-// on every machine (no fused multiply-add: build callers with
-// -ffp-contract=off), and core/trig_avx2.h gives them for four lanes.
+// warehouse SHOT frame (perf record samples; results/bench/README.md).
+// These give the same bits on every machine (no fused multiply-add: build
+// callers with -ffp-contract=off), and core/trig_avx2.h gives them for four
+// lanes.
 // (core/atan2_bin.h's series_atan2 is the coarser sibling, within 2e-8,
 // for code that only bins the angle and lets atan2f decide near an edge.)
 //

@@ -1,5 +1,5 @@
-// The thesis's pose errors and scores (../shared/reference/THESIS.md,
-// "Evaluation"), symmetry-aware.
+// The thesis's pose errors and scores (thesis 2.5 and the introduction of
+// chapter 4), symmetry-aware.
 //
 // For an estimate T_e = (R_e, t_e) and ground truth T_g = (R_g, t_g):
 //   translation error  ||t_e - t_g||                    (mm)

@@ -159,13 +159,13 @@ namespace {
 // distance, then each bucket on its own. The bucket of distance d is
 // floor(d * scale): non-decreasing in d (a float product with a positive
 // scale and the truncation both are), so the buckets come in key order,
-// and the result is std::sort's (the keys are distinct). Before: an LSD
-// radix sort of 11-bit digits, about five passes of a count and a
-// scattered write each, where this makes one (after a pass for the largest
-// distance) and sorts buckets of about two keys. Buckets from 64 keys on
-// (FPFH's supports of up to 256: table FPFH's hypothesize stage 27.1 ->
-// 25.7 ms against std::sort from 512 on; from 24 on, no further gain;
-// results/bench/README.md, twenty-fourth round).
+// and the result is std::sort's (the keys are distinct). An LSD radix sort
+// of 11-bit digits takes about five passes of a count and a scattered
+// write each; this makes one (after a pass for the largest distance) and
+// sorts buckets of about two keys. Buckets from 64 keys on, for FPFH's
+// supports of up to 256: table FPFH's hypothesize stage took 25.7 ms,
+// against 27.1 ms with std::sort below 512 keys; a bound of 24 gained
+// nothing more (results/bench/README.md).
 // A (squared distance, index) entry as one 64-bit key: a squared distance
 // is a non-negative float, whose bits order as the values do, so the key
 // order is the pair order (one integer compare instead of two float ones).

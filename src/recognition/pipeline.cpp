@@ -1,4 +1,4 @@
-// The recognition pipeline (THESIS.md "The system"), online part:
+// The recognition pipeline (thesis 1.4, the system overview), online part:
 // recognize() preprocesses the scene, lets the descriptor method
 // hypothesize, refines every hypothesis (or the refine.max_hypotheses most
 // promising ones), counts its inliers and keeps the one

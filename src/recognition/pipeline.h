@@ -68,7 +68,7 @@ struct RecognitionResult {
 RecognitionResult recognize(const DepthImage& depth, const Intrinsics& K, const TrainedModel& model,
                             const RecognitionSettings& s);
 
-// Registration alone (THESIS.md Table 4.9, Figure 4.12): skip description
+// Registration alone (thesis Table 4.9, Figure 4.12): skip description
 // and matching, refine `init` (T_cam_model) with the configured refinement
 // method, verify and accept it as recognize() does (status no_hypothesis
 // when it has no inlier). The model view used as the registration source is

@@ -1,4 +1,4 @@
-// Sensor profiles (THESIS.md Table 2.1) and depth noise models. Every noise
+// Sensor profiles (thesis Table 2.1) and depth noise models. Every noise
 // model is seeded: the same Rng state gives the same noisy image.
 //
 // Noise models (all in mm, camera frame; `z` is the noise-free rendered depth):
@@ -58,9 +58,9 @@ struct GaussianNoise {
 // the scene). disparity_step_px keeps the steps measured on raw OpenNI
 // frames (results/sensors/fit_astra.json: 2.87e-6 z^2 per mm); the
 // ground-truth frames are registered to colour and interpolated and show
-// none. Before the fit on frames with ground truth: disparity_sigma_px 0.3,
+// none. The fit on frames without ground truth (disparity_sigma_px 0.3,
 // smoothing_radius_px 2, smoothing_edge_px 1, max_incidence_deg 80, no edge
-// effects (configs/sensors/astra_no_gt.yaml; results/sim2real/README.md).
+// effects) is configs/sensors/astra_no_gt.yaml (results/sim2real/README.md).
 struct StructuredLightNoise {
   double baseline_mm = 75.0;         // projector-camera baseline along +x
   double disparity_step_px = 0.1216; // disparity quantization (about the 1/8 px subpixel step)

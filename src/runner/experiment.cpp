@@ -327,8 +327,8 @@ Trial make_trial(const ExperimentConfig& cfg, const SceneSource& src, int sid, i
   std::snprintf(buf, sizeof buf, "%d/%d", sid, im_id);
   t.key = src.name + "/" + buf + "/" + d + "/" + r + "/" + p.dump() + "/noise=" + nlohmann::json(noise).dump();
   if (obj_id > 0) t.key += "/obj=" + std::to_string(obj_id);
-  // The trial's random stream: stream_id keeps the seeds (and so every
-  // result) of the releases before the one hash.
+  // The trial's random stream: stream_id (core/hash.h) keeps the seeds, and
+  // so every recorded result, as they are.
   t.seed = derive_seed(cfg.seed, {stream_id(t.key)});
   return t;
 }

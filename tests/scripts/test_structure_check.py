@@ -43,7 +43,7 @@ class Functions(unittest.TestCase):
         # Qualifiers and a trailing return type still make a signature; a
         # parenthesis followed by a long run of spaces (a blanked comment)
         # and then something else is no signature, and is decided at once
-        # (the earlier pattern backtracked over every split of the run:
+        # (a pattern that backtracks over every split of the run takes
         # minutes on src/recognition/local/match_kernels.cpp).
         text = ("auto f(int x) const noexcept -> int {\n"
                 "  return x;\n"

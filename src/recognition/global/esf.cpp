@@ -66,8 +66,8 @@ class PairTraces {
 // with the formula itself. The formula falls as |cos| grows (acos falls;
 // the scaling and the rounding keep order), so a |cos| has bin k or more
 // exactly when it lies below edge k: six comparisons instead of acos.
-// Checked once over every float from 0 to 1 (session 24, results/bench/
-// README.md): the table and the formula agree on all 1,065,353,217.
+// Checked once over every float from 0 to 1 (results/bench/README.md):
+// the table and the formula agree on all 1,065,353,217.
 // A |cos| in [0, 1] starts from the lowest bin of its 1/1024th of [0, 1]
 // (the bin of that interval's largest float) and steps up while it lies
 // below the next edge: the same bin as the bisection, in one or two steps

@@ -76,8 +76,8 @@ inline Line classified(int count, int occupied) {
 // Stepper takes them. One table for every |d| <= n < kG, built once from
 // the Stepper itself, so a line read from it is the Stepper's line. Per
 // step, a shift and a multiply instead of the Stepper's remainder update
-// (bench_global BM_EsfOurs in alternating runs: results/bench/README.md,
-// eleventh round), the same histograms bit for bit (test
+// (measured with bench_global BM_EsfOurs in alternating runs:
+// results/bench/README.md), the same histograms bit for bit (test
 // GlobalEsf.HistogramsAreThoseOfTheSteppedLineTracing).
 class MoveTable {
  public:

@@ -1,5 +1,5 @@
-// Global pipeline settings (CVFH, ESF, CESF, OUR-CVFH, CRH). THESIS.md
-// "Global pipeline".
+// Global pipeline settings (CVFH, ESF, CESF, OUR-CVFH, CRH). Thesis 3.2,
+// the global pipeline.
 #pragma once
 
 #include "core/settings_fields.h"
@@ -80,7 +80,7 @@ struct GlobalSettings {
                                         // fewer than this / 4 centroids in its ball (sparse: most
                                         // points of the tables' 10 mm voxels against 0.1 d) takes its
                                         // own neighbours, thinned the same way. 0 = every neighbour,
-                                        // as pcl::CVFHEstimation (the releases before)
+                                        // as pcl::CVFHEstimation
   bool cvfh_normalize_bins = false;     // CVFH bins count points (thesis, PCL default); true: percentages
   double crh_peak_distance_deg = 10.0;  // distinct CRH peaks are at least this far apart (PCL: 10)
   double ourcvfh_axis_ratio = 0.8;      // OUR-CVFH: axes this similarly hard to disambiguate -> several frames

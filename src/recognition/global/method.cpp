@@ -2,7 +2,7 @@
 // matching and initial pose. PCL-free; the PCL parts are behind
 // internal.h.
 //
-// Online, per image (THESIS.md "Global pipeline"):
+// Online, per image (thesis 3.2, the global pipeline):
 //  1. describe: Euclidean clusters of the preprocessed scene, then the
 //     method's signatures per cluster (CVFH / OUR-CVFH / CESF: one per stable
 //     region, or, without one, one of the whole cluster; ESF: one per

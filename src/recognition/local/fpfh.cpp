@@ -18,7 +18,7 @@
 // is computed once (darboux_pair's `symmetric`). Each keypoint's
 // neighbourhood is searched once and serves three times: to find the points
 // that need an SPFH, as its own SPFH's list when it needs one, and for its
-// weighted sum (before: three searches). Each row depends on its own
+// weighted sum (one search instead of three). Each row depends on its own
 // neighbourhood only and SPFH bins are integer counts: the same result for
 // any thread count.
 #ifdef _OPENMP

@@ -1,5 +1,5 @@
-// Keypoints of the local pipeline: a second, coarser voxel grid (THESIS.md
-// "Local pipeline" step 1), on the shared grid (preprocess/voxel_grid.h).
+// Keypoints of the local pipeline: a second, coarser voxel grid (thesis
+// 3.1.2, keypoint detection), on the shared grid (preprocess/voxel_grid.h).
 // PCL-free.
 #include <algorithm>
 #include <cmath>

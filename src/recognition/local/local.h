@@ -1,5 +1,5 @@
-// Local pipeline settings (FPFH, SHOT, 3D Hough voting). THESIS.md "Local
-// pipeline"; defaults are the table synthetic values of Table 4.2.
+// Local pipeline settings (FPFH, SHOT, 3D Hough voting). Thesis 3.1, the
+// local pipeline; defaults are the table synthetic values of Table 4.2.
 #pragma once
 
 #include "core/settings_fields.h"

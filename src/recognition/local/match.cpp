@@ -25,18 +25,18 @@
 // to the clusters' centroids, with the full computation's bits: the same
 // answers, exact and capped. On the warehouse's 13,278 SHOT rows a query
 // computed about 260 blocks of eight rows' bounds instead of 1,660
-// (results/bench/README.md, thirty-fifth round).
+// (results/bench/README.md).
 //
 // Why no kd-tree: for SHOT one visits nearly every leaf (measured: no faster
-// than a linear scan). FPFH used FLANN's single kd-tree (the index
-// pcl::KdTreeFLANN builds) until it measured slower than this scan: 3 times
-// on Figure 4.11's noisy table frames, where a query far from every model
+// than a linear scan). For FPFH, FLANN's single kd-tree (the index
+// pcl::KdTreeFLANN builds) measured slower than this scan: 3 times on
+// Figure 4.11's noisy table frames, where a query far from every model
 // descriptor visits most leaves, 1.3 times on its warehouse frames and 1.8
-// times on bench_local's table image (results/bench/README.md, twelfth
-// round). The kd-tree also broke exact ties by its own traversal order:
-// training views can hold identical descriptors (seen: equal distances to
-// rows 424 or 848 apart on Table 4.1's Astra images), and a scene keypoint
-// matched whichever of them the tree met first; here the lowest row wins.
+// times on bench_local's table image (results/bench/README.md). The kd-tree
+// also breaks exact ties by its own traversal order: training views can hold
+// identical descriptors (seen: equal distances to rows 424 or 848 apart on
+// Table 4.1's Astra images), and a scene keypoint matches whichever of them
+// the tree meets first; here the lowest row wins.
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <algorithm>

@@ -18,7 +18,7 @@ namespace pb::local {
 // measured recall is that of these bounds), 12 for short ones (FPFH). Fewer
 // axes make the product cheaper and the bound looser; FPFH's match stage on
 // bench_local's table image took 2.8 / 1.9 / 1.8 / 2.1 / 2.5 ms with 32 / 16 /
-// 12 / 8 / 6 axes (results/bench/README.md, twelfth round).
+// 12 / 8 / 6 axes (results/bench/README.md).
 constexpr int kProjDim = 32;
 constexpr int kProjDimShort = 12;
 
@@ -82,8 +82,8 @@ size_t next_at_most_avx2(const float* v, size_t from, size_t n, float bar);
 // dot product is summed over the axes in ascending order, a product then an
 // add, and the bound is (zn + psq) - 2 dot. One order for every path, because
 // the capped search (max_checks) ranks rows by these values: long_bounds_avx2
-// (where the CPU has AVX2) gives the same bits. (Eigen's product, used before,
-// sums the rows left over from its 12-row panels in another order.)
+// (where the CPU has AVX2) gives the same bits. (Eigen's product sums the
+// rows left over from its 12-row panels in another order.)
 void long_bounds(const float* zq, const float* zn, int nq, int pd, const float* zt, const float* psq, size_t rows,
                  float* lbs);
 // mins (not null): each query's smallest bound (every bound finite: the

@@ -1,4 +1,4 @@
-// The local pipeline as a Method (THESIS.md "Local pipeline"): keypoints by a
+// The local pipeline as a Method (thesis 3.1): keypoints by a
 // second voxel grid, FPFH or SHOT descriptors, nearest-descriptor matching
 // against the descriptors of every training view, 3D Hough voting per
 // training view with BOARD reference frames, a Procrustes (SVD) pose per

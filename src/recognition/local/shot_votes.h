@@ -5,8 +5,8 @@
 // operations in the same order (the file is built without fused
 // multiply-adds), then add to the histogram vote by vote, so both give the
 // same bits. The angles come from core/trig.h's series (within 4 ulp of
-// the true angle; libm's acos and atan2 until session 43), the same bits on
-// every machine. Internal to the local pipeline; PCL-free.
+// the true angle, not libm's acos and atan2), the same bits on every
+// machine. Internal to the local pipeline; PCL-free.
 #pragma once
 
 #include <cstddef>

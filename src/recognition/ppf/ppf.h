@@ -4,7 +4,7 @@
 // with normal clustering, neighbouring bins looked up, one vote per
 // quantized scene pair, pose clusters averaged. Setting model_points 300,
 // model_sampling_steps 0, normal_cluster_deg 0 and vote_once false gives the
-// plain method (PCL's usage) of the releases before.
+// plain method (PCL's usage).
 //
 // Defaults, as measured (the LS5 on occluded table scenes with distractors,
 // 30 images, ICP: configs/experiments/ppf.yaml, results/ppf/README.md):

@@ -39,8 +39,8 @@ struct PlanePoints {
 
 // How many points lie within `thr` of `plane`: |n . p + d| <= thr, in
 // double with n . p summed as Eigen sums an evaluated Vector3d's dot
-// product, (n0 p0 + n1 p1) + n2 p2, so the count is that of the Eigen code
-// the scoring was before (test Ransac.CountWithinEqualsEigensTest). Four
+// product, (n0 p0 + n1 p1) + n2 p2, so the count is that of the scoring
+// written with Eigen (test Ransac.CountWithinEqualsEigensTest). Four
 // points at a time with AVX2 where the CPU has it (each lane the same
 // operations in the same order), one at a time otherwise.
 size_t count_within(const PlanePoints& pts, const Eigen::Vector4d& plane, double thr);

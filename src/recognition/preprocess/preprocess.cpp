@@ -1,4 +1,4 @@
-// Preprocessing (THESIS.md "Shared preprocessing"): range cut, voxel grid,
+// Preprocessing (thesis 3.1.1 and 3.2.1): range cut, voxel grid,
 // dominant plane removal, normals. The voxel grid and the RANSAC plane fit
 // are implemented here (same cells and semantics as pcl::VoxelGrid and
 // pcl::SACSegmentation) so that each output point keeps its source pixel and

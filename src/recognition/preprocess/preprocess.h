@@ -1,4 +1,4 @@
-// Preprocessing (THESIS.md "Shared preprocessing"): depth -> cloud, range
+// Preprocessing (thesis 3.1.1 and 3.2.1): depth -> cloud, range
 // cut, voxel grid, dominant plane removal (RANSAC), normals toward the
 // viewpoint. The same steps prepare the model's training views.
 #pragma once
@@ -24,8 +24,7 @@ struct PreprocessSettings {
                                     // fewer samples per cell. For cells many pixels wide (the
                                     // warehouse's 20 mm: 4-10 pixels where its objects stand, 2-5 m
                                     // away). The veil filter and the plane's noise estimate still
-                                    // read every pixel. Measured: results/bench/README.md,
-                                    // thirty-seventh round
+                                    // read every pixel. Measured: results/bench/README.md
   double voxel_mm = 10.0;           // downsampling voxel (Table 4.2: 20 warehouse, 10 table)
   bool remove_plane = true;         // remove the dominant plane (floor / table)
   double plane_threshold_mm = 10.0; // RANSAC inlier distance for the plane
@@ -58,8 +57,7 @@ struct PreprocessSettings {
                                     // foot matters (Figure 4.6's one-view CVFH / CESF: 1951 against
                                     // 1991 of 2400; added noise: 166 against 188 of 1440). false = the
                                     // grid first, then the planes among its voxels (the thesis's
-                                    // order, section 3.1.1). Measured: results/bench/README.md,
-                                    // twenty-eighth round
+                                    // order, section 3.1.1). Measured: results/bench/README.md
   double normal_radius_mm = 20.0;   // PCA neighbourhood radius for normals
   int normal_max_points = 64;       // a normal's neighbourhood of more points than this is thinned
                                     // evenly (in kd-tree order: spatially stratified) to this many
@@ -71,8 +69,8 @@ struct PreprocessSettings {
                                     // (the warehouse's 0.1 d = 182 mm at 20 mm voxels: a 40 mm leaf;
                                     // not the table's 20 mm at 10 mm voxels); a point with fewer
                                     // than normal_max_points / 4 centroids in its ball takes its own
-                                    // neighbours. false = always the cloud's points (the releases
-                                    // before). Measured: results/bench/README.md, twenty-third round
+                                    // neighbours. false = always the cloud's points. Measured:
+                                    // results/bench/README.md
 
   template <class S, class F>
   static void fields(S& s, F& f) {
@@ -118,7 +116,7 @@ void radius_normals(PointSet& cloud, double radius_mm, int max_points = 0, doubl
 // Scene preprocessing. Every random choice (RANSAC) draws from `seed`. Its
 // points carry no pixel: no later stage reads one, and the voxel grid's pass
 // for each cell's nearest pixel cost 0.75 ms of a table frame's 5.95 and 0.9
-// of a warehouse frame's 21.0 (results/bench/README.md, thirty-sixth round).
+// of a warehouse frame's 21.0 (results/bench/README.md).
 PointSet preprocess_scene(const OrganizedCloud& cloud, const PreprocessSettings& s, uint64_t seed);
 // Training view preprocessing: no plane removal (the model is alone).
 PointSet preprocess_view(const OrganizedCloud& cloud, const PreprocessSettings& s, uint64_t seed);

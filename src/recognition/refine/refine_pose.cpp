@@ -97,7 +97,7 @@ RefineResult refine_pose(const std::string& method, const PointSet& model, const
   // scenes: crops of a fifth of the scene, about 0.02 ms to build); over
   // most of the scene they are as fast, and cutting costs a seventh of a
   // build (warehouse: crops of 7500 of 11400 points, 0.1 against 0.8 ms;
-  // results/bench/README.md, twenty-sixth round).
+  // results/bench/README.md).
   if (scene_tree && scene_tree->size() != scene.size())
     throw std::invalid_argument("refine_pose: scene_tree is not over the scene's points");
   const auto local = [&c](int axis, float x) {

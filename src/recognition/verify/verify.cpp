@@ -22,8 +22,8 @@ PointIndex::PointIndex(const std::vector<Vec3f>& points) : impl_(new Impl) {
   // 24 points per leaf, as refinement's crop trees (refine/internal.h),
   // which are cut from this one (KdTree3::restricted) and keep its leaves:
   // searches of a warehouse crop cut from a tree of 8 per leaf were 10-20%
-  // slower than those of a crop tree built (results/bench/README.md,
-  // twenty-sixth round). The answers do not depend on it.
+  // slower than those of a crop tree built (results/bench/README.md). The
+  // answers do not depend on it.
   impl_->tree = KdTree3(points, 24);
 }
 

@@ -43,7 +43,8 @@ struct VerifySettings {
   // training view the hypothesis came from, so hypotheses from views with
   // more points have an edge. "merged": every view merged in the model frame
   // (voxelized), the same cloud for every hypothesis, so counts compare
-  // fairly across views (a flipped pose from a larger view no longer wins).
+  // fairly across views (a flipped pose from a larger view does not win, as
+  // it can with "view").
   std::string inlier_model = "view";
   // How hypotheses are ranked: "visibility" (default) or "inliers" (the
   // thesis; its experiments select it). visibility: supported -
