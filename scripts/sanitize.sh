@@ -3,7 +3,7 @@
 # Sanitizer (gcc, -fsanitize=address,undefined) in build-asan/ and runs
 # ctest there. Any report fails the test that produced it.
 #
-#   scripts/sanitize.sh            # everything (see README "CI" for the time)
+#   scripts/sanitize.sh            # everything (docs/testing.md, "Sanitizers", has the time)
 #   scripts/sanitize.sh --reduced  # the unit tests of io, eval and runner (.ci/run runs it)
 #   scripts/sanitize.sh -- -R Bop  # extra ctest arguments after --
 set -euo pipefail

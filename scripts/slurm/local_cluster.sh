@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # A one-node Slurm on this machine, for testing the sweep scripts without a
-# cluster (README.md, "Sweeps on a cluster"): Debian's slurm-wlm and munge, daemons
+# cluster (docs/user-guide.md, "Running on a cluster"): Debian's slurm-wlm and munge, daemons
 # run as root, no systemd, no cgroups, no accounting; configuration, state
 # and logs under STATE_DIR.
 #

@@ -347,7 +347,7 @@ RunSummary run_experiment(ExperimentConfig cfg, const RunOptions& opt) {
 
 namespace {
 
-// For testing the runner only (documented in README, section CI):
+// For testing the runner only (documented in docs/testing.md, "Kills and injected faults"):
 // POSEBENCH_INJECT_FAULT="KIND:TEXT[;KIND:TEXT...]" makes a worker fail on
 // every trial whose key contains TEXT: segfault (SIGSEGV), abort, exit (exit
 // code 3), hang (sleeps until the trial's time-out) or oom (allocates until

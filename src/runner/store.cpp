@@ -204,7 +204,7 @@ bool ResultStore::has(const std::string& key) const { return index_.count(key) >
 
 namespace {
 
-// For testing the runner only (README, section CI):
+// For testing the runner only (docs/testing.md, "Kills and injected faults"):
 // POSEBENCH_TESTING_SLOW_APPEND_MS=N writes each record in two halves with N
 // ms between them, so a test can kill the runner in the middle of an append.
 long slow_append_ms() {

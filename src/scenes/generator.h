@@ -115,7 +115,7 @@ struct GenerateSummary {
 // kinect_one sensor calibrated on real frames (results/sensors/fit_kinect_one.json).
 constexpr int kSceneSetVersion = 4;
 
-// Generates the whole scene set into `out_dir` (BOP layout, see README):
+// Generates the whole scene set into `out_dir` (BOP layout, see docs/user-guide.md):
 // written to `out_dir.partial` and renamed into place at the end, so an
 // interrupted or failed run never leaves `out_dir` looking complete (a failed
 // run removes its partial output). An existing `out_dir` is replaced only if
