@@ -30,7 +30,16 @@ ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 FIXTURES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fixtures")
 SCRIPT = os.path.join(ROOT, "scripts", "thesis_report.py")
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
-import thesis_report  # noqa: E402
+from thesis_report.ablations import ABLATIONS as COMMITTED_ABLATIONS, load_ablations  # noqa: E402
+from thesis_report.cells import CSV_COLUMNS, Cell, carton_counts, thesis_protocol  # noqa: E402
+from thesis_report.cli import main  # noqa: E402
+from thesis_report.readme import section_intro  # noqa: E402
+from thesis_report.results import Experiment  # noqa: E402
+from thesis_report.runs import load_run_seconds, load_runs  # noqa: E402
+from thesis_report.schema import (RECORD_SCHEMA, InputError, KeyProblem, check_fields, load_records,  # noqa: E402
+                                  schema_from_binary)
+from thesis_report.scorecard import best_agrees, direction_text, tau_positive  # noqa: E402
+from thesis_report.tables import registration_accuracy  # noqa: E402
 
 EXPERIMENTS = ("table_4_1", "table_4_5", "fig_4_12")
 ABLATIONS = os.path.join(FIXTURES, "ablations.yaml")
@@ -53,7 +62,7 @@ class Run:
                 a.replace("{tmp}", tmp) for a in args]
             with mock.patch.dict(os.environ, {"POSEBENCH": posebench, "JOBS": "2"}), \
                     contextlib.redirect_stderr(err), contextlib.redirect_stdout(std):
-                self.code = thesis_report.main(argv)
+                self.code = main(argv)
             self.err, self.out = err.getvalue(), std.getvalue()
             self.lines = read_lines(os.path.join(out, "README.md"))
             self.cells = read_csv_rows(os.path.join(out, "cells.csv"))
@@ -137,7 +146,7 @@ class Readme(unittest.TestCase):
                 return 60.0, 4
 
         host = {"date": "today", "cores": 2, "cpu": "cpu", "jobs": "2"}
-        text = "\n".join(thesis_report.section_intro(Res(), host))
+        text = "\n".join(section_intro(Res(), host))
         self.assertIn("The machine was shared with other jobs while it ran", text)
         self.assertIn("ranged from 1.9 to 3.4 on 2 cores, more than the run's own workers", text)
 
@@ -197,7 +206,7 @@ class Readme(unittest.TestCase):
 
     def test_cells_csv(self):
         cells = self.run_.cells
-        self.assertEqual(list(cells[0]), thesis_report.CSV_COLUMNS)
+        self.assertEqual(list(cells[0]), CSV_COLUMNS)
         self.assertEqual([(c["experiment"], c["scenario"], c["measure"], c["method"]) for c in cells], [
             ("table_4_1", "table_synthetic", "robustness", "cvfh"),
             ("table_4_1", "table_synthetic", "robustness", "fpfh"),
@@ -365,7 +374,7 @@ class AblationsFile(unittest.TestCase):
             path = os.path.join(d, "abl.yaml")
             with open(path, "w") as f:
                 f.write(text)
-            return thesis_report.load_ablations(path)
+            return load_ablations(path)
 
     def test_the_pairs(self):
         a = self.load('ablations:\n  - name: views\n    cause: "a # b, c"\n    switched: \'x: 1\'\n'
@@ -378,11 +387,11 @@ class AblationsFile(unittest.TestCase):
             ("plane", "p", "q", [["table_4_7", "ablation_plane_table_4_7"]])])
 
     def test_the_committed_file_reads(self):
-        a = thesis_report.load_ablations(thesis_report.ABLATIONS)
+        a = load_ablations(COMMITTED_ABLATIONS)
         self.assertTrue(a and all(x["pairs"] for x in a))
 
     def test_errors_name_file_and_field(self):
-        with self.assertRaises(thesis_report.InputError) as c:
+        with self.assertRaises(InputError) as c:
             self.load("ablations:\n  - name: a\n    cause: c\n    experiments: [x]\n    settings: {}\n")
         self.assertIn("abl.yaml: ablations[0].switched", str(c.exception))
 
@@ -432,15 +441,15 @@ class Scorecard(unittest.TestCase):
 
     def test_best_agrees_and_tau_rules(self):
         def cell(ours, thesis):
-            return thesis_report.Cell("4.1", "e", "main", "s", "robustness", "m", round(10 * ours), 10, thesis=thesis,
-                                      thesis_n=30)
+            return Cell("4.1", "e", "main", "s", "robustness", "m", round(10 * ours), 10, thesis=thesis,
+                        thesis_n=30)
         tie = [cell(0.5, 0.9), cell(0.5, 0.2), cell(0.1, 0.1)]
-        self.assertTrue(thesis_report.best_agrees(tie))  # ours tie includes the thesis's best
-        self.assertTrue(thesis_report.tau_positive(tie))
+        self.assertTrue(best_agrees(tie))  # ours tie includes the thesis's best
+        self.assertTrue(tau_positive(tie))
         flat = [cell(1.0, 0.9), cell(1.0, 0.8)]
-        self.assertTrue(thesis_report.best_agrees(flat))
-        self.assertFalse(thesis_report.tau_positive(flat))  # all tied: tau undefined, not counted
-        self.assertFalse(thesis_report.best_agrees([cell(0.9, 0.1), cell(0.1, 0.9)]))
+        self.assertTrue(best_agrees(flat))
+        self.assertFalse(tau_positive(flat))  # all tied: tau undefined, not counted
+        self.assertFalse(best_agrees([cell(0.9, 0.1), cell(0.1, 0.9)]))
 
 
 class ScorecardBefore(unittest.TestCase):
@@ -461,14 +470,14 @@ class ScorecardBefore(unittest.TestCase):
 class Direction(unittest.TestCase):
     def test_cells_outside_15_points_are_counted_above_and_below(self):
         def cell(method, k, thesis):
-            return thesis_report.Cell("4.1", "table_4_1", "main", "s", "robustness", method, k, 10, thesis=thesis,
-                                      thesis_n=30)
-        text = thesis_report.direction_text([cell("esf", 9, 0.0), cell("shot", 10, 0.1), cell("cvfh", 1, 0.73),
-                                             cell("cesf", 5, 0.55)])
+            return Cell("4.1", "table_4_1", "main", "s", "robustness", method, k, 10, thesis=thesis,
+                        thesis_n=30)
+        text = direction_text([cell("esf", 9, 0.0), cell("shot", 10, 0.1), cell("cvfh", 1, 0.73),
+                               cell("cesf", 5, 0.55)])
         self.assertEqual(text, "Which way the gaps go: of the 3 cells outside 15 points, 2 are above the thesis's "
                                "value (ours more robust) and 1 below; per method (above / below): esf 1 / 0, shot 1 "
                                "/ 0, cvfh 0 / 1.")
-        self.assertEqual(thesis_report.direction_text([cell("cesf", 5, 0.55)]), "")
+        self.assertEqual(direction_text([cell("cesf", 5, 0.55)]), "")
 
 
 class BadInput(unittest.TestCase):
@@ -511,19 +520,19 @@ class Runs(unittest.TestCase):
         return path
 
     def test_sums_invocations_that_ran_trials(self):
-        runs = thesis_report.load_runs(self.write(
+        runs = load_runs(self.write(
             '{"wall_s": 10.5, "ran": 3, "load15_end": 1.25}\n\n{"wall_s": 2.0, "ran": 0, "load15_end": 9}\n'
             '{"wall_s": 4.0, "ran": 2, "load15_end": null}\n'))
         self.assertEqual((runs.seconds, runs.loads, runs.ran, runs.known), (14.5, [1.25], 5, True))
 
     def test_no_file_is_unknown(self):
-        runs = thesis_report.load_runs("/nonexistent/runs.jsonl")
+        runs = load_runs("/nonexistent/runs.jsonl")
         self.assertEqual((runs.seconds, runs.loads, runs.known), (0.0, [], False))
 
     def test_a_line_without_wall_s_names_file_and_line(self):
         path = self.write('{"wall_s": 1, "ran": 1}\n{"ran": 1}\n')
-        with self.assertRaises(thesis_report.InputError) as c:
-            thesis_report.load_runs(path)
+        with self.assertRaises(InputError) as c:
+            load_runs(path)
         self.assertIn("%s: line 2: not a run summary" % path, str(c.exception))
 
     def test_folder_without_runs_jsonl_shows_no_time_and_says_why(self):
@@ -556,14 +565,14 @@ class Runs(unittest.TestCase):
 
     def test_run_seconds_txt_sums_seconds_trials_and_loads(self):
         path = self.write("2026-11-22 10:00:00 3420.8 5 2 3.7\n\n2026-11-22 12:00:00 10.2 2 2 0.5\n")
-        runs = thesis_report.load_run_seconds(path)
+        runs = load_run_seconds(path)
         self.assertEqual((round(runs.seconds, 6), runs.loads, runs.ran, runs.source),
                          (3431.0, [3.7, 0.5], 7, "run_seconds.txt"))
 
     def test_a_garbled_run_seconds_line_names_file_and_line(self):
         path = self.write("2026-11-22 10:00:00 3420.8 5 2 3.7\nhalf a line\n")
-        with self.assertRaises(thesis_report.InputError) as c:
-            thesis_report.load_run_seconds(path)
+        with self.assertRaises(InputError) as c:
+            load_run_seconds(path)
         self.assertIn("%s: line 2: not `DATE TIME WALL_SECONDS RAN JOBS LOAD15`" % path, str(c.exception))
 
 
@@ -579,16 +588,16 @@ class Table49(unittest.TestCase):
     def test_images_no_method_solves_are_left_out_elsewhere_kept(self):
         recs = [self.rec(0, "icp", True), self.rec(0, "ndt", False), self.rec(1, "icp", False),
                 self.rec(1, "ndt", False)]
-        self.assertEqual([(r["im_id"], r["refinement"]) for r in thesis_report.thesis_protocol("4.9", recs)],
+        self.assertEqual([(r["im_id"], r["refinement"]) for r in thesis_protocol("4.9", recs)],
                          [(0, "icp"), (0, "ndt")])
-        self.assertEqual(thesis_report.thesis_protocol("4.1", recs), recs)
+        self.assertEqual(thesis_protocol("4.1", recs), recs)
 
     def test_accuracy_is_the_std_over_correct_trials(self):
         recs = [self.rec(0, "icp", True, 2.0), self.rec(1, "icp", True, 4.0), self.rec(2, "icp", False, 90.0),
                 self.rec(0, "icp_plane", True, 1.0), self.rec(1, "icp_plane", True, 1.0),
                 self.rec(2, "icp_plane", False), self.rec(3, "icp", False), self.rec(3, "icp_plane", False)]
-        x = thesis_report.Experiment("table_4_9", {"refinements": ["icp", "icp_plane"]}, recs)
-        text = thesis_report.registration_accuracy({"table_4_9": x}, "table_4_9")[0]
+        x = Experiment("table_4_9", {"refinements": ["icp", "icp_plane"]}, recs)
+        text = registration_accuracy({"table_4_9": x}, "table_4_9")[0]
         self.assertIn("Over the 2 images where at least one method is correct", text)
         self.assertIn("icp (2 correct): translation std 1.00 mm (mean 3.00, max 4.00)", text)
         self.assertIn("icp_plane (2 correct): translation std 0.00 mm (mean 1.00, max 1.00)", text)
@@ -612,7 +621,7 @@ class Carton(unittest.TestCase):
 
     def test_a_record_without_a_pose_needs_no_judgement(self):
         # The fixture's no_hypothesis record has no judgements: the row is still judged.
-        counts, judged = thesis_report.carton_counts(
+        counts, judged = carton_counts(
             [{"scene": "s", "descriptor": "d", "correct": False, "status": "no_hypothesis"},
              {"scene": "s", "descriptor": "d", "correct": False, "status": "ok", "estimate": {}, "gt": {},
               "judgements": {"faces": {"correct": True}}}])
@@ -664,8 +673,8 @@ class StrictRecords(unittest.TestCase):
 
         def problem(record):
             try:
-                thesis_report.check_fields(record, fields, record)
-            except thesis_report.KeyProblem as p:
+                check_fields(record, fields, record)
+            except KeyProblem as p:
                 return str(p)
             return None
 
@@ -696,8 +705,7 @@ class StrictRecords(unittest.TestCase):
     def test_records_of_the_binary_read_back(self):
         # Three records as `posebench run` wrote them before the typed record
         # (fixtures/binary: the ci and demo experiments), so older raw folders still load.
-        records = thesis_report.load_records(os.path.join(FIXTURES, "binary", "records.jsonl"),
-                                             thesis_report.RECORD_SCHEMA)
+        records = load_records(os.path.join(FIXTURES, "binary", "records.jsonl"), RECORD_SCHEMA)
         self.assertEqual([r["descriptor"] for r in records], ["cvfh", "esf", "cvfh"])
 
 def fake_binary(directory, stdout, code=0):
@@ -721,14 +729,14 @@ class Schema(unittest.TestCase):
             self.skipTest("`%s schema record` failed (exit %d: %s): a binary from before `posebench schema`, "
                           "nothing to compare the copy with (rebuild it)" % (binary, r.returncode, r.stderr.strip()))
         printed = json.loads(r.stdout)["fields"]
-        copy = thesis_report.RECORD_SCHEMA["fields"]
+        copy = RECORD_SCHEMA["fields"]
         differing = sorted(k for k in set(printed) | set(copy) if printed.get(k) != copy.get(k))
-        self.assertEqual(differing, [], "RECORD_SCHEMA in scripts/thesis_report.py differs from `posebench schema "
-                                        "record` in these keys; update the copy")
+        self.assertEqual(differing, [], "RECORD_SCHEMA in scripts/thesis_report/schema.py differs from `posebench "
+                                        "schema record` in these keys; update the copy")
 
     def test_the_binarys_schema_is_used_when_there_is_one(self):
         with tempfile.TemporaryDirectory() as d:
-            fields = dict(thesis_report.RECORD_SCHEMA["fields"], extra={"type": "string", "required": False})
+            fields = dict(RECORD_SCHEMA["fields"], extra={"type": "string", "required": False})
             binary = fake_binary(d, json.dumps({"type": "object", "fields": fields, "notes": []}))
             run = Run(edit_record("table_4_1", 0, lambda r: r.update(extra="x")), posebench=binary)
         self.assertEqual(run.code, 0, run.err)
@@ -736,7 +744,7 @@ class Schema(unittest.TestCase):
     def test_the_copy_is_used_when_the_binary_knows_no_schema(self):
         with tempfile.TemporaryDirectory() as d:
             binary = fake_binary(d, "", code=1)  # a binary from before `posebench schema`
-            self.assertIsNone(thesis_report.schema_from_binary(binary))
+            self.assertIsNone(schema_from_binary(binary))
             run = Run(edit_record("table_4_1", 0, lambda r: r.update(extra="x")), posebench=binary)
         self.assertEqual(run.code, 2)
         self.assertIn("schema record` gave no schema (a binary from before it?); using the copy", run.err)
@@ -761,7 +769,7 @@ class CommandLine(unittest.TestCase):
                 f.write("committed\n")
             err = io.StringIO()
             with mock.patch.dict(os.environ, {"POSEBENCH": ""}), contextlib.redirect_stderr(err):
-                code = thesis_report.main([tmp] + list(EXPERIMENTS))
+                code = main([tmp] + list(EXPERIMENTS))
             self.assertEqual(code, 0, err.getvalue())
             self.assertEqual(read_lines(os.path.join(tmp, "README.md")), ["committed"])
             self.assertIn("no experiment's records.jsonl in %s" % os.path.join(tmp, "raw"), err.getvalue())
