@@ -83,78 +83,83 @@ def explains(m, cell):
 
 EXPLAIN_RULE = (
     "A cell of the %d outside 15 points of the thesis is explained by a cause when an ablation of that cause covers "
-    "it (a pair whose first experiment is the cell's, with the same scene set and method) and switching the cause "
-    "closes at least half the gap: the switched value lies within half the gap (thesis - ours) of the thesis's "
-    "value, on either side, the two counts differing at p < 0.05 (Fisher's exact test). A cell that moves toward "
-    "the thesis and far past it is not explained.")
+    "it (same experiment, scene set and method) and switching the cause closes at least half the gap: the switched "
+    "value lies within half the gap of the thesis's value, on either side, the two counts differing at p < 0.05 "
+    "(Fisher's exact test). No correction is made for the %d %s tried, and an ablation that explains one cell can "
+    "move others away (the table's last two columns): an explanation shows a set-up choice that can close the gap, "
+    "not that the thesis made it.")
 
 
-def section_ablations(res, ablations, cells, path):
-    o = ["## Ablations: what each change of the set-up does\n"]
-    if not ablations:
-        return o + ["No ablations (`%s` is missing or lists none).\n" % shown_path(path)]
-    o.append("Each ablation runs an experiment again with one cause switched back (`%s`): back to the set-up before "
-             "issue 10, or to another reading of what the thesis leaves open (the column says which). Per ablation: "
-             "the cells "
-             "compared, those that move by more than 15 points, those whose two counts differ at p < 0.05 (Fisher's "
-             "exact test), the mean robustness both ways and how many cells are within 15 points of the thesis both "
-             "ways.\n" % shown_path(path))
+def ablation_row(a, compared, skipped):
+    """A row of the ablations table: pairs run, cells compared and moved, means and cells near the thesis."""
+    with_t = [m for m in compared if m.thesis is not None]
+
+    def near(value):
+        return "%d of %d" % (sum(within_points(value(m), m.thesis, POINTS) for m in with_t), len(with_t))
+    return "| %s | %d of %d | %d | %d | %d | %s | %s | %s | %s |" % (
+        a["name"], len(a["pairs"]) - len(skipped), len(a["pairs"]), len(compared), sum(m.moved for m in compared),
+        sum(m.p < 0.05 for m in compared), pct(mean([m.a for m in compared])), pct(mean([m.b for m in compared])),
+        near(lambda m: m.a) if with_t else "-", near(lambda m: m.b) if with_t else "-")
+
+
+def ablations_table(res, ablations, cells):
+    """(the table's lines, the line on pairs not run, [(ablation, its compared cells)])."""
     thesis = {(c.experiment, c.scenario, c.method): c.thesis for c in cells if c.measure == "robustness"
               and c.kind != "ablation"}
-    by_ablation = []
-    rows = ["| ablation | cause | switched back | pairs run | cells | moved > 15 points | p < 0.05 | mean, as reported "
-            "| mean, switched back | within 15 of the thesis, as reported | switched back |",
-            "|---|---|---|---|---|---|---|---|---|---|---|"]
-    notes = []
+    rows = ["| ablation | pairs run | cells | moved > 15 points | p < 0.05 | mean, as reported | mean, switched back "
+            "| within 15 of the thesis, as reported | switched back |", "|---|---|---|---|---|---|---|---|---|"]
+    by_ablation, not_run = [], []
     for a in ablations:
         compared, skipped = ablation_cells(res, a, thesis)
         by_ablation.append((a, compared))
-        with_t = [m for m in compared if m.thesis is not None]
-        rows.append("| %s | %s | %s | %d of %d | %d | %d | %d | %s | %s | %s | %s |" % (
-            a["name"], a["cause"], a["switched"], len(a["pairs"]) - len(skipped), len(a["pairs"]), len(compared),
-            sum(m.moved for m in compared), sum(m.p < 0.05 for m in compared),
-            pct(mean([m.a for m in compared])), pct(mean([m.b for m in compared])),
-            "%d of %d" % (sum(within_points(m.a, m.thesis, POINTS) for m in with_t), len(with_t)) if with_t else "-",
-            "%d of %d" % (sum(within_points(m.b, m.thesis, POINTS) for m in with_t), len(with_t)) if with_t else "-"))
-        for e, e2, missing in skipped:
-            notes.append("- %s: pair %s / %s skipped, no records for %s (`results/thesis/raw/NAME/records.jsonl`)." % (
-                a["name"], e, e2, ", ".join(missing)))
-        moved = [m for m in compared if m.moved]
-        if moved:
-            notes.append("- %s, cells moved by more than 15 points (scene set, method: as reported -> switched back, "
-                         "thesis): %s." % (a["name"], "; ".join(
-                             "%s %s %s%s: %d/%d -> %d/%d (%s -> %s, p = %.2g), thesis %s" % (
-                                 m.e, m.scenario, m.method, " (%s)" % m.cond if m.cond else "", m.k, m.n, m.k2,
-                                 m.n2, pct(m.a), pct(m.b), m.p, pct(m.thesis)) for m in moved)))
-    o += rows + [""] + (notes + [""] if notes else [])
+        if len(skipped) < len(a["pairs"]):
+            rows.append(ablation_row(a, compared, skipped))
+        if skipped:
+            not_run.append("%s (%s)" % (a["name"], ", ".join(x for _e, _e2, missing in skipped for x in missing)))
+    line = "Not run, no `results/thesis/raw/NAME/records.jsonl`: %s.\n" % "; ".join(not_run) if not_run else ""
+    return rows, line, by_ablation
+
+
+def gaps_text(cells, by_ablation):
+    """Which main cells outside 15 points the ablations explain, and of the others which differ at p < 0.05."""
     gaps = [c for c in cells if c.main and not c.within]
-    o.append("**Which gaps to the thesis the ablations explain.** " + EXPLAIN_RULE % len(gaps) + "\n")
     explained, unexplained = [], []
     for c in gaps:
         by = [a["name"] for a, compared in by_ablation for m in compared
               if (m.e, m.scenario, m.method, m.cond) == (c.experiment, c.scenario, c.method, "") and explains(m, c)]
         (explained if by else unexplained).append((c, by))
-    o.append("Of the %d main cells outside 15 points, %d explained (%s), %d unexplained.\n" % (
+    o = ["Of the %d main cells outside 15 points, %d explained (%s), %d unexplained.\n" % (
         len(gaps), len(explained), "; ".join("%s %s %s by %s" % (short_title(c.experiment), c.scenario, c.method,
                                                                  ", ".join(by)) for c, by in explained) or "none",
-        len(unexplained)))
-    o.append("No correction is made for the %d %s tried: each is judged by the rule on its own, so a cell can pass "
-             "it by chance. An ablation that explains one cell can also move others away from the thesis (the "
-             "table's cells within 15 points, as reported and switched back). So an explanation shows a set-up "
-             "choice that can close the gap, not that the thesis made that choice.\n" % (
-                 len(ablations), "ablation" if len(ablations) == 1 else "ablations"))
+        len(unexplained))]
     if unexplained:
         o.append("Unexplained (ours vs the thesis): " + "; ".join(
             "%s %s %s %s vs %s" % (short_title(c.experiment), c.scenario, c.method, pct(c.ours), pct(c.thesis))
-            for c, _ in unexplained) + ".\n")
+            for c, _ in unexplained) + ".")
         chance = [c for c, _ in unexplained if c.p is not None and c.p >= 0.05]
         sig = len(unexplained) - len(chance)
-        o.append("Of the %d unexplained, %d %s from the thesis's count at p < 0.05 (Fisher's exact test at the "
-                 "thesis's n, as the scorecard) and %d %s not: %s. A gap of the second kind can be chance at these "
-                 "sample sizes; it still counts as unexplained.\n" % (
+        o[-1] += (" Of the %d unexplained, %d %s from the thesis's count at p < 0.05 (Fisher's exact test at the "
+                 "thesis's n, as the scorecard) and %d %s not, so may be chance at these sample sizes: %s.\n" % (
                      len(unexplained), sig, "differs" if sig == 1 else "differ", len(chance),
                      "does" if len(chance) == 1 else "do",
                      "; ".join("%s %s %s %d/%d vs %s (p = %.2g)" % (short_title(c.experiment), c.scenario, c.method,
                                                                     c.k, c.n, pct(c.thesis), c.p)
                                for c in chance) or "none"))
     return o
+
+
+def section_ablations(res, ablations, cells, path):
+    o = ["## Ablations: what each change of the set-up does\n"]
+    if not ablations:
+        return o + ["No ablations (`%s` is missing or lists none).\n" % shown_path(path)]
+    o.append("Command: `scripts/thesis.sh --ablations`. Each ablation runs experiments again with one cause switched "
+             "back (`%s` says which and how). Per ablation: the cells compared, those that move by more than 15 "
+             "points, those whose two counts differ at p < 0.05 (Fisher's exact test), the mean robustness and the "
+             "cells within 15 points of the thesis, as reported and switched back. Each table cell: `cells.csv`, "
+             "kind `ablation`.\n" % shown_path(path))
+    rows, not_run, by_ablation = ablations_table(res, ablations, cells)
+    o += rows + [""] + ([not_run] if not_run else [])
+    gaps = [c for c in cells if c.main and not c.within]
+    o.append("**Which gaps to the thesis the ablations explain.** " + EXPLAIN_RULE % (
+        len(gaps), len(ablations), "ablation" if len(ablations) == 1 else "ablations") + "\n")
+    return o + gaps_text(cells, by_ablation)

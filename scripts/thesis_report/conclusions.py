@@ -79,19 +79,22 @@ def verdicts(res, cells):
     return [(cid, title, rule, v, theirs[cid]) for cid, title, rule, v in evaluate(verdict_data(res, cells))]
 
 
+def cell_text(text):
+    """Text as one markdown table cell."""
+    return text.replace("|", "\\|")
+
+
 def section_conclusions(res, cells):
     found = [v for v in verdicts(res, cells) if v[3] is not None]
     if not found:
         return []
     o = ["## The thesis's conclusions against these numbers\n",
-         "Each verdict is computed by `scripts/thesis_verdicts.py` from the records, by a rule written down before "
-         "the run; the rule is printed before its evidence. The same rule applied to the thesis's own table values "
-         "(k = round(value x n) at its n; it printed no numbers for its figures) is given after it, as a check of "
-         "the rule.\n"]
-    for cid, title, rule, v, theirs in found:
-        o.append("**%s. %s: %s.**\n" % (cid, title, v.word))
-        o.append("- Rule: %s" % rule)
-        o.append("- Here: %s" % v.evidence)
-        o.append("- On the thesis's own numbers: %s\n" % (
-            "%s. %s" % (theirs.word, theirs.evidence) if theirs else "no numbers (figures only)."))
-    return o
+         "Command: `scripts/thesis.sh --readme-only`; as JSON: the `--scorecard-json` line above. Each verdict applies "
+         "a rule of `scripts/thesis_verdicts.py`, fixed before the run, to the records; the same rule applied to the "
+         "thesis's own table values (k = round(value x n)) checks the rule.\n",
+         "| | conclusion | here | on the thesis's numbers | evidence here |", "|---|---|---|---|---|"]
+    for cid, title, _rule, v, theirs in found:
+        o.append("| %s | %s | **%s** | %s | %s |" % (cid, cell_text(title), v.word,
+                                                      theirs.word if theirs else "no numbers (figures only)",
+                                                      cell_text(v.evidence)))
+    return o + [""]

@@ -1,5 +1,4 @@
 """Number formats and the experiments' titles, shared by the README's sections."""
-import json
 
 
 def pct(v):
@@ -14,10 +13,6 @@ def mean(v):
 def fmt_dur(s):
     s = int(round(s))
     return "%dh%02dm%02ds" % (s // 3600, s // 60 % 60, s % 60) if s >= 3600 else "%dm%02ds" % (s // 60, s % 60)
-
-
-def compact(v):
-    return json.dumps(v, separators=(", ", ": "))
 
 
 TITLES = {

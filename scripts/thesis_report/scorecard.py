@@ -77,16 +77,14 @@ def scorecard(cells):
 
 
 SCORECARD_BEFORE = "scorecard_before.json"
-
-
 BEFORE_TEXT = (
-    "The line \"before issue 10\" is the same scorecard of the run before the set-up changes (`%s` beside this "
-    "README: 10 images per cell, training views at 0 and 20 degrees, a floor and a wall in the warehouse, the "
-    "Astra before its calibration, occluded targets 40-90%% visible, CESF without its fallback).")
+    "The earlier set-up's row is this scorecard of a run with 10 images per cell, training views at 0 and 20 degrees, "
+    "a floor and a wall in the warehouse, the Astra before its calibration, occluded targets 40-90%% visible and CESF "
+    "without its fallback (`%s` beside this README).")
 
 
 def scorecard_before(res):
-    """The totals of OUT/scorecard_before.json (the run before issue 10's set-up changes), or None."""
+    """The totals of OUT/scorecard_before.json (a run of the earlier set-up, BEFORE_TEXT), or None."""
     path = os.path.join(os.path.dirname(res.raw.rstrip(os.sep)), SCORECARD_BEFORE)
     try:
         with open(path) as f:
@@ -133,40 +131,35 @@ def direction_text(cells):
                 ", ".join("%s %d / %d" % (m, a, b) for m, (a, b) in per.items())))
 
 
+def scorecard_line(name, s):
+    return "| %s | %d | %d | %d | %d | %d | %d | %d | %s | %s |" % (
+        name, s["cells"], s["within_15"], s["significant_05"], s["significant_01"], s["rows"], s["best_agrees"],
+        s["tau_positive"], pct(s["mean_ours"]), pct(s["mean_thesis"]))
+
+
 def section_agreement(res, cells, card):
     if not card["tables"] and not card["variants"]:
         return []
     o = ["## Agreement with the thesis\n",
-         "Robustness cells of the thesis's Tables 4.1, 4.3, 4.4, 4.5, 4.7 and 4.9 (%d values; the milk carton judged "
-         "with the model's symmetries, as its table above), computed from the records. Within 15: |ours - thesis| "
-         "<= 15 points. p: Fisher's exact test (two-sided) of our k/n against the thesis's k/n (its n: %s; k = "
-         "round(value x n)). Best agrees: some method is the most robust, ties included, both here and in the "
-         "thesis's row. tau > 0: Kendall's tau-b of the row's values against the thesis's is positive (a row all "
-         "tied on one side has none and does not count). `--scorecard-json FILE` prints these numbers as JSON.\n" %
-         (MAIN_CELLS, THESIS_N_TEXT),
+         "Command: `scripts/thesis.sh --readme-only`; as JSON: the `--scorecard-json` line above. Robustness cells of "
+         "the thesis's Tables 4.1-4.9 (%d values; the milk carton judged with the model's symmetries). Within 15: "
+         "|ours - thesis| <= 15 points. p: Fisher's exact test (two-sided), our k/n against the thesis's round(value "
+         "x n)/n. Best agrees: a method is the most robust (ties included) both here and in the thesis's row. "
+         "tau > 0: Kendall's tau-b of the row against the thesis's is positive (a row all tied does not count).\n" %
+         MAIN_CELLS,
          "| table | cells | within 15 points | p < 0.05 | p < 0.01 | rows | best agrees | tau > 0 | mean, ours | "
          "mean, thesis |", "|---|---|---|---|---|---|---|---|---|---|"]
-
-    def line(name, s):
-        return "| %s | %d | %d | %d | %d | %d | %d | %d | %s | %s |" % (
-            name, s["cells"], s["within_15"], s["significant_05"], s["significant_01"], s["rows"], s["best_agrees"],
-            s["tau_positive"], pct(s["mean_ours"]), pct(s["mean_thesis"]))
-    o += [line("Table " + t["table"], t) for t in card["tables"]]
+    o += [scorecard_line("Table " + t["table"], t) for t in card["tables"]]
     t = card["total"]
     if t["cells"]:
-        o.append(line("**total** (of the thesis's %d)" % t["of"], t))
-    before = scorecard_before(res)
-    if before and t["cells"]:
-        o.append(line("total before issue 10 (`%s`)" % os.path.basename(SCORECARD_BEFORE), before))
-    if card["variants"]:
-        o += ["", "Not counted above (the same comparison, against the thesis's values of the table named):\n",
-              "| variant | cells | within 15 points | p < 0.05 | p < 0.01 | rows | best agrees | tau > 0 | mean, ours "
-              "| mean, thesis |", "|---|---|---|---|---|---|---|---|---|---|"]
-        o += [line("Table %s: %s%s" % (v["table"], v["experiment"], ", judged faces on faces (the thesis's "
-                                       "judgement)" if v["measure"] == FACES else ""), v) for v in card["variants"]]
-    o += ["", inexact_text(cells), ""]
-    if direction_text(cells):
-        o += [direction_text(cells), ""]
-    if scorecard_before(res) and t["cells"]:
+        o.append(scorecard_line("**total** (of the thesis's %d)" % t["of"], t))
+    before = scorecard_before(res) if t["cells"] else None
+    if before:
+        o.append(scorecard_line("total, earlier set-up (`%s`)" % SCORECARD_BEFORE, before))
+    o += [scorecard_line("not counted: Table %s %s%s" % (v["table"], v["experiment"], ", faces on faces (the "
+                                                           "thesis's judgement)" if v["measure"] == FACES else ""), v)
+          for v in card["variants"]]
+    o += ["", " ".join(t for t in (inexact_text(cells), direction_text(cells)) if t), ""]
+    if before:
         o += [BEFORE_TEXT % SCORECARD_BEFORE, ""]
     return o

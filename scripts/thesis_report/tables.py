@@ -1,12 +1,11 @@
-"""The README's tables: each table experiment's report.md with its robustness
-cells rewritten from the counted cells, its settings, and the milk carton's
-and Table 4.9's extra rows."""
+"""The README's tables: the rows of each table experiment's report.md that
+the thesis printed, the robustness cells rewritten from the counted cells,
+and the milk carton's and Table 4.9's extra lines."""
 import collections
-import json
 import statistics
 
-from .cells import THESIS_N_TEXT, carton_counts, thesis_protocol
-from .formatting import TABLES, TITLES, compact, mean, pct
+from .cells import FACES, THESIS_N_TEXT, carton_counts, thesis_protocol
+from .formatting import TABLES, TITLES, mean, pct
 
 
 def fmt_rob(c):
@@ -22,98 +21,70 @@ def legend(cells):
 
 
 def sample_sizes_text(cells):
-    """Our trials per cell, per experiment (from the records)."""
+    """Our trials per cell, per experiment shown (from the records; the ablations' are in cells.csv)."""
     per = collections.OrderedDict()
     for c in cells:
-        if c.counted and c.measure == "robustness":
+        if c.counted and c.measure == "robustness" and c.kind != "ablation":
             per.setdefault(c.experiment, set()).add(c.n)
     return "Our n per cell (trials, from the records): " + "; ".join(
         "%s %s" % (e, "-".join(str(v) for v in sorted({min(ns), max(ns)}))) for e, ns in per.items()) + "."
 
 
-def settings_lines(res, e):
-    """The settings of an experiment, one markdown list item per scene set and one for the rest."""
-    ex = res[e].exp
-    lines = []
-    if ex.get("settings", {}):
-        lines.append("- all scenes: `%s`" % compact(ex["settings"]))
-    for s in ex["scenes"]:
-        extra = ", ".join("%s %s" % (k, json.dumps(v)) for k, v in s.get("generator", {}).items() if k != "images")
-        lines.append("- **%s** (%s, `%s`%s): refinement %s%s" % (
-            s["name"], s["scenario"], s["generate"] or s["dataset"], ", " + extra if extra else "",
-            "/".join(s.get("refinements") or ex.get("refinements", [])),
-            ("; `%s`" % compact(s["settings"])) if s.get("settings") else ""))
-    if ex.get("registration_only"):
-        info = "registration only from the ground truth perturbed by %g deg and %g mm" % tuple(ex.get("perturb", [0, 0]))
-    else:
-        info = "descriptors %s" % ", ".join(ex.get("descriptors", []))
-    lines.append("- %s; refinements %s; added noise %s mm; grid %s; thresholds (table, warehouse, rotation) %s" % (
-        info, ", ".join(ex.get("refinements", [])), ex.get("added_noise_mm"), json.dumps(ex.get("grid", [])),
-        ex.get("thresholds")))
-    return lines
+FACES_LABEL = "faces on faces (the thesis's judgement)"
 
 
-def settings_block(res, e):
-    return ["Settings (`configs/thesis/%s.yaml`):\n" % e, "\n".join(settings_lines(res, e)) + "\n"]
+def md_row(cells):
+    return "| " + " | ".join(cells) + " |"
 
 
-ROBUSTNESS_ROWS = {"robustness": "robustness", "robustness, judged by faces": "robustness_faces"}
+def has_faces(e, cells):
+    """Whether a table shows the faces-on-faces row: the milk carton's, or any with such cells."""
+    return e == "table_4_5" or any(c.experiment == e and c.measure == FACES for c in cells)
 
 
-def table_md(res, e, cells=()):
-    """report.md without its title, its table headings one level down, each
-    robustness cell rewritten from `cells` (count, interval, the thesis's value, mark)."""
+def table_rows(res, e, cells=()):
+    """The first table of report.md, with the rows the thesis printed a value in: each robustness
+    row rewritten from `cells` (count, interval, the thesis's value, mark) and, for the milk carton,
+    a faces-on-faces row after it ("-" without judged records); then the rows with a thesis value in
+    parentheses (time; Table 4.9's errors). The other rows (ours only) stay in report.md."""
     lookup = {(c.scenario, c.measure, c.method): c for c in cells if c.experiment == e and c.counted}
-    out, methods, scene = [], [], ""
-    md = res[e].md.splitlines()
-    if md and md[0].startswith("# "):
-        md = md[1:]
-    for line in md:
+    faces = has_faces(e, cells)
+    out, methods, scene = [], None, ""
+    for line in res[e].md.splitlines():
         parts = line.split("|")
-        if line.startswith("| scenario | measure |"):
-            methods, scene = [p.strip() for p in parts[3:-1]], ""
-        elif line.startswith("|") and methods and len(parts) == len(methods) + 4 and not line.startswith("|---"):
-            scene = parts[1].strip() or scene
-            measure = ROBUSTNESS_ROWS.get(parts[2].strip())
-            if measure:
-                new = [lookup.get((scene, measure, m)) for m in methods]
-                line = "|".join(parts[:3] + [" %s " % fmt_rob(c) if c else p for c, p in zip(new, parts[3:-1])] +
-                                [parts[-1]])
-        elif not line.startswith("|"):
-            methods = []
-        out.append(line.replace("### ", "#### ", 1) if line.startswith("### ") else line)
-    return "\n".join(out).strip() + "\n"
+        if methods is None:
+            if line.startswith("| scenario | measure |"):
+                methods = [p.strip() for p in parts[3:-1]]
+                out.append(line)
+            continue
+        if not line.startswith("|"):
+            break
+        if line.startswith("|---") or len(parts) < len(methods) + 4:
+            out.append(line)
+            continue
+        values = [p.strip() for p in parts[-1 - len(methods):-1]]
+        label = "|".join(parts[2:-1 - len(methods)]).strip()  # "rotation error (1-|p.q|)" holds a "|"
+        scene = parts[1].strip() or scene
+        if label == "robustness":
+            new = [lookup.get((scene, "robustness", m)) for m in methods]
+            out.append(md_row([parts[1].strip(), label] + [fmt_rob(c) if c else v for c, v in zip(new, values)]))
+            if faces:
+                new = [lookup.get((scene, FACES, m)) for m in methods]
+                out.append(md_row(["", FACES_LABEL] + [fmt_rob(c) if c else "-" for c in new]))
+        elif label != "robustness, judged by faces" and any("(" in v for v in values):
+            out.append(line)
+    return out
 
 
-def carton_rows(res, e):
-    """The carton's table judged both ways, two rows per scene set."""
-    counts, judged = carton_counts(res[e].records)
-    descs = res[e].exp["descriptors"]
-
-    def share(s, d, i):
-        return "%.0f%%" % (100 * counts[(s, d)][i] / counts[(s, d)][0])
-
-    o = ["| scenario | judgment | " + " | ".join(descs) + " |", "|---|---|" + "---|" * len(descs)]
-    for s in res.scenes_of(e):
-        o.append("| %s | half turn only | " % s + " | ".join(
-            share(s, d, 1) if (s, d) in counts else "-" for d in descs) + " |")
-        o.append("|  | faces on faces (thesis) | " + " | ".join(
-            "%s (%s)" % (share(s, d, 2), pct(res.thesis(e, s, "robustness", d))) if (s, d) in counts and judged
-            else "-" for d in descs) + " |")
-    return o, judged
-
-
-def carton_section(res, e):
-    rows, judged = carton_rows(res, e)
-    o = ["\nThe carton's symmetries in `models/models.yaml` are only the half turn about its vertical axis (the "
-         "gable ridge), and the table above is judged with them: a carton found upside down or turned by 90 "
-         "degrees is wrong. The thesis counted the carton correct \"when its faces lie on the true object's "
-         "faces, even upside down\". Judged that way (any of the 8 rotations mapping the 70 x 70 x 195 mm body "
-         "onto itself, about the body's centre; same 50 mm / 0.05 thresholds), from the same records:\n"] + rows
-    if not judged:
-        o.append("\nThese records carry no `judgements.faces` (made before that judgement existed): re-run table_4_5 "
-                 "(remove `results/thesis/raw/table_4_5`, then `scripts/thesis.sh --only table_4_5`).")
-    return o + [""]
+def carton_note(res, e):
+    """What the milk carton's two judgements are, and a note when its records predate the faces one."""
+    o = ["The carton is judged with its model's symmetries (the half turn about its vertical axis, "
+         "`models/models.yaml`); the faces-on-faces row judges it as the thesis did, correct \"when its faces lie on "
+         "the true object's faces, even upside down\" (any of the 8 rotations of the 70 x 70 x 195 mm body).\n"]
+    if not carton_counts(res[e].records)[1]:
+        o.append("These records carry no `judgements.faces` (made before that judgement existed): re-run table_4_5 "
+                 "(remove `results/thesis/raw/table_4_5`, then `scripts/thesis.sh --only table_4_5`).\n")
+    return o
 
 
 def spread(values):
@@ -135,40 +106,38 @@ def registration_accuracy(res, e):
         if t and q:
             parts.append("%s (%d correct): translation std %.2f mm (mean %.2f, max %.2f), rotation std %.2g (mean "
                          "%.2g, max %.2g)" % (m, len(ok), t[0], t[1], t[2], q[0], q[1], q[2]))
-    return ["\nAccuracy as the thesis defines it: the standard deviation of the errors over the correct trials "
-            "(its section 4.1.2; section 4.2.2 calls the table's values averages, so the mean and the largest error "
-            "are given too; one trial near the threshold can set the std). Over the %d images where at least one "
-            "method is correct, as the thesis counted (its robustness cells above use the same images): %s. Why "
-            "ICP point-to-plane is the most accurate here and the least in the thesis: `results/thesis/FINDINGS.md` "
-            "(reciprocal correspondences).\n" % (len(images), "; ".join(parts))]
+    return ["Accuracy as the thesis defines it (section 4.1.2: the standard deviation of the errors over the correct "
+            "trials; the mean and the largest beside it). Over the %d images where at least one method is correct, "
+            "as the thesis counted: %s. Why ICP point-to-plane is the most accurate here and the least in the thesis: "
+            "`results/thesis/FINDINGS.md`, Table 4.9 (reciprocal correspondences)." % (
+                len(images), "; ".join(parts))]
 
 
 def registration_times(res, e):
     meth = res[e].exp["refinements"]
     rt = {m: mean([r.get("times", {}).get("refine") for r in res[e].records if r["refinement"] == m]) for m in meth}
-    return ["\nThe time row above is the whole call (scene preprocessing included); the registration alone took "
-            "on average: " + ", ".join("%s %.3f s" % (m, rt[m]) for m in meth if rt[m] is not None) +
-            " (the thesis: 0.02 to 0.09 s).\n"]
+    return ["The time row is the whole call; the registration alone took on average: " +
+            ", ".join("%s %.3f s" % (m, rt[m]) for m in meth if rt[m] is not None) + " (the thesis: 0.02 to 0.09 s).\n"]
 
 
 def table_section(res, e, cells):
-    o = ["### %s\n" % TITLES[e]]
-    o += settings_block(res, e) + [table_md(res, e, cells)]
-    if e == "table_4_5":
-        o += carton_section(res, e)
+    o = ["### %s" % TITLES[e],
+         "Command: `scripts/thesis.sh --only %s`; config: `configs/thesis/%s.yaml`.\n" % (e, e),
+         "\n".join(table_rows(res, e, cells)) + "\n"]
+    if has_faces(e, cells):
+        o += carton_note(res, e)
     if e == "table_4_9":
-        o += registration_accuracy(res, e) + registration_times(res, e)
-    return o + [""]
+        o.append(registration_accuracy(res, e)[0] + " " + registration_times(res, e)[0])
+    return o
 
 
 def section_tables(res, cells):
     o = ["## Tables\n",
-         "Rows: scene set x measure; columns: descriptor (refinement for Table 4.9). Robustness = fraction of images "
-         "where the chosen pose is correct (translation error < 50 mm on tables, < 100 mm in the warehouse, and "
-         "1 - |p.q| < 0.05, symmetry-aware); errors are means over the correct trials; time is the mean online time "
-         "per image (s). BOP AR is the BOP average recall (VSD, MSSD, MSPD) of the same poses. Scene sets named "
-         "`table_astra` / `table_kinect_one` use the simulated Astra / Kinect One sensors (the thesis's real "
-         "sensors).\n", legend(cells)]
+         "Rows: scene set and measure, the rows the thesis printed (the others are in each experiment's `report.md`); "
+         "columns: descriptor (refinement in Table 4.9). Robustness: the fraction of images whose chosen pose is "
+         "correct (translation error < 50 mm on tables, < 100 mm in the warehouse, 1 - |p.q| < 0.05, "
+         "symmetry-aware); time: mean online seconds per image; errors: means over the correct trials. "
+         "`table_astra` and `table_kinect_one` use the simulated sensors. " + legend(cells)]
     for e in TABLES:
         if e in res:
             o += table_section(res, e, cells)
