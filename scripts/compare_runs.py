@@ -14,9 +14,9 @@ the worker seconds (records' wall_s) per experiment, and the trials paired
 across the runs by experiment and trial key (the same image and seed):
 how many are correct in one run only, with McNemar's exact test of the two
 runs' robustness over all cells. Records are read with
-thesis_report.py's loader (checked against the trial record's schema). Exit
-2, naming the file, line and key, for a record that does not fit, and for a
-folder without records. Cells found in one run only are counted as
+thesis_report/schema.py's loader (checked against the trial record's
+schema). Exit 2, naming the file, line and key, for a record that does not
+fit, and for a folder without records. Cells found in one run only are counted as
 unmatched.
 """
 import argparse
@@ -27,7 +27,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from thesis_report import RECORD_SCHEMA, InputError, load_records  # noqa: E402
+from thesis_report.schema import RECORD_SCHEMA, InputError, load_records  # noqa: E402
 from thesis_stats import fisher_exact, mcnemar_exact  # noqa: E402
 
 

@@ -55,7 +55,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from thesis_report import RECORD_SCHEMA, InputError, load_records  # noqa: E402
+from thesis_report.schema import RECORD_SCHEMA, InputError, load_records  # noqa: E402
 
 
 def fate(r):

@@ -10,7 +10,7 @@ count_of(value, n)      the count k = round(value * n) behind a printed fraction
 printable_as_count(value, n)  whether a printed percentage can be some k/n
 fitting_n(values, n)    the largest n' <= n at which all of a row's percentages are k/n'
 
-Used by scripts/thesis_report.py and scripts/thesis_verdicts.py.
+Used by scripts/thesis_report/ and scripts/thesis_verdicts.py.
 """
 import math
 

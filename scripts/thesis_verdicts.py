@@ -5,7 +5,7 @@ cell, mean times, accuracies, curves; no files) and returns a Verdict: the
 verdict word, the evidence text with the counts it used, and those counts as
 numbers. RULES[cid] is the rule as the README prints it, verbatim, before the
 evidence. The same functions run on the thesis's own numbers (thesis_data()
-in scripts/thesis_report.py) as a check of the rules.
+in scripts/thesis_report/conclusions.py) as a check of the rules.
 
 Verdict words: "supported", "partly supported", "not supported"; each rule
 says when which. A function returns None when the experiments it needs are
