@@ -18,7 +18,12 @@ pb::TrialRecord rec(const std::string& scene, const std::string& scenario, const
   r.refinement = "icp";
   r.status = correct ? "ok" : "no_hypothesis";
   r.correct = correct;
-  r.times = pb::StageTimesRecord{pre, describe, 0, 0, 0, refine, verify, pre + describe + refine + verify};
+  pb::StageTimes t;
+  t.preprocess = pre;
+  t.describe = describe;
+  t.refine = refine;
+  t.verify = verify;
+  r.times = pb::StageTimesRecord::from(t);
   r.hypotheses = 4;
   return r;
 }

@@ -23,6 +23,7 @@
 #include "core/error.h"
 #include "core/timer.h"
 #include "eval/errors.h"
+#include "eval/judge.h"
 #include "eval/symmetry.h"
 #include "io/bop.h"
 #include "io/png.h"
@@ -42,9 +43,23 @@ std::string default_cache_dir() {
 }
 
 nlohmann::ordered_json times_json(const pb::StageTimes& t) {
-  return {{"preprocess", t.preprocess}, {"describe", t.describe}, {"match", t.match},
-          {"group", t.group},           {"initial_pose", t.initial_pose}, {"refine", t.refine},
-          {"verify", t.verify},         {"total", t.total()}};
+  nlohmann::ordered_json j;
+  pb::StageTimes::each([&](const char* name, double pb::StageTimes::*stage) { j[name] = t.*stage; });
+  j["total"] = t.total();
+  return j;
+}
+
+// "preprocess 0.01, describe 0.02, ..., initial pose 0, ...; total 0.1"
+std::string times_text(const pb::StageTimes& t) {
+  std::ostringstream o;
+  const char* sep = "";
+  pb::StageTimes::each([&](std::string name, double pb::StageTimes::*stage) {
+    std::replace(name.begin(), name.end(), '_', ' ');
+    o << sep << name << " " << t.*stage;
+    sep = ", ";
+  });
+  o << "; total " << t.total();
+  return o.str();
 }
 
 struct Options {
@@ -104,28 +119,20 @@ void settings_from(const Options& o, pb::RecognitionSettings& s) {
 }
 
 // The thesis's errors of a pose against the object's ground-truth instance
-// it is closest to (the larger of translation / threshold and rotation /
-// threshold); none when the image has no instance of the object.
+// it fits best (eval/judge.h, the runner's judge); none when the image has no
+// instance of the object.
 struct NearestGt {
   pb::ThesisErrors err;
   pb::Pose gt_pose;
 };
 std::optional<NearestGt> nearest_gt(const pb::Pose& T, const pb::ImageInfo& im, int obj_id,
                                     const std::vector<pb::Pose>& syms, const pb::ThesisThresholds& thr) {
-  pb::ThesisErrorOptions eo;
-  eo.thresholds = thr;
-  std::optional<NearestGt> out;
-  double best = std::numeric_limits<double>::infinity();
-  for (const auto& g : im.gt) {
-    if (g.obj_id != obj_id) continue;
-    const pb::ThesisErrors e = pb::thesis_errors(T, g.T_cam_model, syms, eo);
-    const double key = std::max(e.translation_mm / thr.translation_mm, e.rotation / thr.rotation);
-    if (key < best) {
-      best = key;
-      out = NearestGt{e, g.T_cam_model};
-    }
-  }
-  return out;
+  std::vector<pb::Pose> gts;
+  for (const auto& g : im.gt)
+    if (g.obj_id == obj_id) gts.push_back(g.T_cam_model);
+  const pb::InstanceJudgement j = pb::judge(T, gts, syms, thr);
+  if (j.gt < 0) return std::nullopt;
+  return NearestGt{j.judged.errors, gts[static_cast<size_t>(j.gt)]};
 }
 
 // The estimate against the ground-truth instance it is closest to.
@@ -290,10 +297,7 @@ std::string text_output(const Outcome& x, const pb::ThesisThresholds& thr) {
           << res.instances[i].verification << ", inliers " << res.instances[i].inliers << "\n";
     }
   }
-  o << "times (s): preprocess " << res.times.preprocess << ", describe " << res.times.describe << ", match "
-    << res.times.match << ", group " << res.times.group << ", initial pose " << res.times.initial_pose
-    << ", refine " << res.times.refine << ", verify " << res.times.verify << "; total " << res.times.total()
-    << "\n";
+  o << "times (s): " << times_text(res.times) << "\n";
   if (x.ev.has_gt)
     o << "errors vs ground truth (symmetry-aware): translation " << x.ev.err.translation_mm << " mm, 1-|p.q| "
       << x.ev.err.rotation << ", angle " << x.ev.err.rotation_deg << " deg -> "

@@ -44,13 +44,7 @@ void fields(S& r, F& f, PoseRecord*) {
 }
 template <typename S, typename F>
 void fields(S& r, F& f, StageTimesRecord*) {
-  f("preprocess", r.preprocess, kAlways);
-  f("describe", r.describe, kAlways);
-  f("match", r.match, kAlways);
-  f("group", r.group, kAlways);
-  f("initial_pose", r.initial_pose, kAlways);
-  f("refine", r.refine, kAlways);
-  f("verify", r.verify, kAlways);
+  StageTimes::each([&](const char* name, double StageTimes::*stage) { f(name, r.stages.*stage, kAlways); });
   f("total", r.total, kAlways);
 }
 template <typename S, typename F>

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "core/stage_times.h"
 #include "core/types.h"
 
 namespace pb {
@@ -25,8 +26,10 @@ struct PoseRecord {            // {"R": [9, row-major], "t": [3, mm]}
   Pose pose() const;
 };
 
-struct StageTimesRecord {      // seconds per stage of the online computation
-  double preprocess = 0, describe = 0, match = 0, group = 0, initial_pose = 0, refine = 0, verify = 0, total = 0;
+struct StageTimesRecord {      // seconds per stage of the online computation (StageTimes::each), and their sum
+  StageTimes stages;
+  double total = 0;
+  static StageTimesRecord from(const StageTimes& t) { return {t, t.total()}; }
 };
 
 struct ThesisErrorsRecord {    // eval/errors.h, symmetry-aware, and against the GT itself ("plain")

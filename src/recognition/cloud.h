@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "core/stage_times.h"  // StageTimes
 #include "core/types.h"
 
 namespace pb {
@@ -38,10 +39,5 @@ struct Hypothesis {
   bool refined = false;
 };
 
-// Seconds per stage of one recognition call.
-struct StageTimes {
-  double preprocess = 0, describe = 0, match = 0, group = 0, initial_pose = 0, refine = 0, verify = 0;
-  double total() const { return preprocess + describe + match + group + initial_pose + refine + verify; }
-};
 
 }  // namespace pb

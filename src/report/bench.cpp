@@ -50,12 +50,12 @@ BenchTable bench_table(const std::vector<TrialRecord>& records, const std::map<s
       if (*r.correct) ++g.correct_k;
     }
     if (r.times) {
-      const StageTimesRecord& t = *r.times;
+      const StageTimes& t = r.times->stages;
       g.pre.push_back(t.preprocess);
       g.hyp.push_back(t.describe + t.match + t.group + t.initial_pose);
       g.ref.push_back(t.refine);
       g.ver.push_back(t.verify);
-      g.tot.push_back(t.total);
+      g.tot.push_back(r.times->total);
     }
     if (r.hypotheses) g.nh.push_back(*r.hypotheses);
   }

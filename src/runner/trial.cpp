@@ -12,6 +12,7 @@
 #include "core/timer.h"
 #include "eval/bop_metrics.h"
 #include "eval/errors.h"
+#include "eval/judge.h"
 #include "eval/symmetry.h"
 #include "io/bop.h"
 #include "recognition/pipeline.h"
@@ -102,9 +103,7 @@ Pose perturbed(const Pose& gt, const TrialContext& ctx, uint64_t seed) {
 void record_result(const RecognitionResult& res, TrialRecord& rec) {
   rec.status = res.status;
   if (!res.message.empty()) rec.message = res.message;
-  const StageTimes& t = res.times;
-  rec.times = StageTimesRecord{t.preprocess, t.describe, t.match, t.group, t.initial_pose, t.refine, t.verify,
-                               t.total()};
+  rec.times = StageTimesRecord::from(res.times);
   rec.hypotheses = static_cast<int>(res.hypotheses.size());
   if (res.status == "ok") {
     rec.estimate = PoseRecord::from(res.T_cam_model);
@@ -149,41 +148,46 @@ void evaluate(const Pose& est, const GtObject& gt, const BopDataset& ds, const I
   rec.bop = BopErrorsRecord{be.mssd_mm, be.mspd_px, be.vsd, bm.diameter, im.K.width};
 }
 
-// The rank of the first correct hypothesis (the thesis's judgement with the
-// model's symmetries), -1 if none.
-int first_correct_rank(const std::vector<Hypothesis>& ranked, const GtObject& gt, const BopDataset& ds, int obj_id,
-                       const std::string& scenario, const TrialContext& ctx) {
-  const ThesisThresholds thr = thresholds_for(scenario, ctx);
-  const auto syms = symmetry_transformations(ds.model_info(obj_id));
+// The object's ground-truth instances in the image: their poses (the
+// judge's candidates) and their indices in im.gt.
+struct Instances {
+  std::vector<Pose> poses;
+  std::vector<size_t> index;
+};
+Instances instances_of(const ImageInfo& im, int obj_id) {
+  Instances out;
+  for (size_t g = 0; g < im.gt.size(); ++g)
+    if (im.gt[g].obj_id == obj_id) {
+      out.poses.push_back(im.gt[g].T_cam_model);
+      out.index.push_back(g);
+    }
+  return out;
+}
+
+// The rank of the first hypothesis correct against some instance (the
+// thesis's judgement with the model's symmetries), -1 if none.
+int first_correct_rank(const std::vector<Hypothesis>& ranked, const Instances& gts, const std::vector<Pose>& syms,
+                       const ThesisThresholds& thr) {
   for (size_t i = 0; i < ranked.size(); ++i)
-    if (thesis_judge(ranked[i].T_cam_model, gt.T_cam_model, syms, thr).correct) return static_cast<int>(i);
+    if (judge(ranked[i].T_cam_model, gts.poses, syms, thr).judged.correct) return static_cast<int>(i);
   return -1;
 }
 
 // Every instance of a multi-instance trial (inst_count), judged in rank
 // order against the object's GT instances, each GT taken by at most one.
-void record_instances(const RecognitionResult& res, const ImageInfo& im, const BopDataset& ds, int obj_id,
-                      const TrialContext& ctx, TrialRecord& rec) {
+void record_instances(const RecognitionResult& res, const Instances& gts, const std::vector<Pose>& syms,
+                      const ThesisThresholds& thr, TrialRecord& rec) {
   rec.instances.emplace();
-  const ThesisThresholds thr = thresholds_for(rec.scenario, ctx);
-  const auto syms = symmetry_transformations(ds.model_info(obj_id));
-  std::vector<bool> taken(im.gt.size(), false);
-  bool any_gt = false;
-  for (const auto& g : im.gt) any_gt = any_gt || g.obj_id == obj_id;
-  for (const Hypothesis& h : res.instances) {
+  std::vector<Pose> estimates;
+  for (const Hypothesis& h : res.instances) estimates.push_back(h.T_cam_model);
+  const std::vector<InstanceJudgement> judged = judge_in_order(estimates, gts.poses, syms, thr);
+  for (size_t i = 0; i < res.instances.size(); ++i) {
+    const Hypothesis& h = res.instances[i];
     InstanceRecord inst;
     inst.estimate = PoseRecord::from(h.T_cam_model);
     inst.score = h.verification;
     inst.inliers = h.inliers;
-    if (any_gt) {
-      inst.correct = false;
-      for (size_t g = 0; g < im.gt.size() && !*inst.correct; ++g)
-        if (im.gt[g].obj_id == obj_id && !taken[g] &&
-            thesis_judge(h.T_cam_model, im.gt[g].T_cam_model, syms, thr).correct) {
-          taken[g] = true;
-          inst.correct = true;
-        }
-    }
+    if (!gts.poses.empty()) inst.correct = judged[i].judged.correct;
     rec.instances->push_back(inst);
   }
 }
@@ -231,13 +235,9 @@ void run(TrialRecord& rec, const TrialContext& ctx) {
 
   auto& mesh = cache().meshes[ds.root() + "#" + std::to_string(obj_id)];
   if (!mesh) mesh = std::make_unique<Mesh>(ds.load_model(obj_id));
-  // Ground truth: the first instance of the object in the image.
-  const GtObject* gt = nullptr;
-  for (const auto& g : im.gt)
-    if (g.obj_id == obj_id) {
-      gt = &g;
-      break;
-    }
+  // Ground truth: the object's instances; registration starts from the first.
+  const Instances gts = instances_of(im, obj_id);
+  const GtObject* gt = gts.index.empty() ? nullptr : &im.gt[gts.index.front()];
   const auto model = trained(ds, obj_id, *mesh, st, ctx, rec);
 
   RecognitionResult res;
@@ -250,11 +250,15 @@ void run(TrialRecord& rec, const TrialContext& ctx) {
     res = recognize(depth, im.K, *model, s);
   }
   record_result(res, rec);
-  if (rec.inst_count) record_instances(res, im, ds, obj_id, ctx, rec);
+  const ThesisThresholds thr = thresholds_for(rec.scenario, ctx);
+  const auto syms = symmetry_transformations(ds.model_info(obj_id));
+  if (rec.inst_count) record_instances(res, gts, syms, thr, rec);
   if (!gt) return;  // nothing to judge against: no `correct` (as the records always had it)
+  // The estimate is judged against the instance it fits best (eval/judge.h);
+  // without an estimate the record names the first instance.
+  if (res.status == "ok") gt = &im.gt[gts.index[static_cast<size_t>(judge(res.T_cam_model, gts.poses, syms, thr).gt)]];
   rec.gt = PoseRecord::from(gt->T_cam_model);
-  if (!res.hypotheses.empty())
-    rec.correct_rank = first_correct_rank(res.hypotheses, *gt, ds, obj_id, rec.scenario, ctx);
+  if (!res.hypotheses.empty()) rec.correct_rank = first_correct_rank(res.hypotheses, gts, syms, thr);
   const size_t gi = static_cast<size_t>(gt - &im.gt[0]);
   if (gi < im.gt_info.size() && std::isfinite(im.gt_info[gi].visib_fract))  // NaN: not given
     rec.visib_fract = im.gt_info[gi].visib_fract;
