@@ -37,6 +37,24 @@ void check(const YamlNode& node, double v, const Rule& r) {
   if (r.max > 0 && v > r.max) node.fail("must be at most " + num(r.max) + r.unit + ", got " + num(v));
 }
 
+std::string rule_text(const Rule& r) {
+  std::string t;
+  switch (r.kind) {
+    case Rule::kAny: break;
+    case Rule::kPositive: t = "> 0"; break;
+    case Rule::kNonnegative: t = ">= 0"; break;
+    case Rule::kAtLeast: t = ">= " + num(r.lo); break;
+    case Rule::kRange: t = "in [" + num(r.lo) + ", " + num(r.hi) + "]"; break;
+    case Rule::kOneOf:
+      t = "one of:";
+      for (size_t i = 0; i < r.names.size(); ++i) t += (i ? ", " : " ") + r.names[i];
+      break;
+  }
+  if (r.max > 0) t += (t.empty() ? "" : ", ") + std::string("<= ") + num(r.max) + r.unit;
+  if (r.length) t += (t.empty() ? "" : " ") + std::string("(mm, or a fraction of the diameter: 0.05d)");
+  return t;
+}
+
 bool parse_relative(const YamlNode& node, const std::string& text, double* fraction) {
   if (text.size() < 2 || text.back() != 'd') return false;
   const std::string number = text.substr(0, text.size() - 1);

@@ -67,6 +67,11 @@ bool parse_relative(const YamlNode& node, const std::string& text, double* fract
 // 0.05 -> "0.05d" (shortest round-trip form).
 std::string relative_text(double fraction);
 
+// What a rule accepts, in words: "> 0", ">= 0 and <= 90 degrees", "in [0, 1]",
+// "one of: view, merged"; a length adds "(mm, or a fraction of the
+// diameter: 0.05d)". Empty for any value.
+std::string rule_text(const Rule& r);
+
 // Checks a read value; fails at `node` (the field's node).
 void check(const YamlNode& node, double v, const Rule& r);
 void check(const YamlNode& node, const std::string& v, const Rule& r);
@@ -128,6 +133,28 @@ struct JsonWriter {
       }
     }
     j[key] = v;
+  }
+};
+
+// Every field's key, type, default and rule_text: the settings reference
+// (`posebench schema settings`, docs/settings.md).
+struct SchemaWriter {
+  nlohmann::ordered_json fields = nlohmann::ordered_json::array();
+  const std::map<std::string, double>* relative = nullptr;  // defaults given as fractions
+  std::string prefix;
+  template <typename T>
+  void operator()(const char* key, const T& v, const Rule& r = {}) {
+    nlohmann::ordered_json f;
+    f["key"] = key;
+    if constexpr (std::is_same_v<T, bool>) f["type"] = "bool";
+    else if constexpr (std::is_same_v<T, std::string>) f["type"] = "string";
+    else if constexpr (std::is_integral_v<T>) f["type"] = "integer";
+    else f["type"] = "number";
+    const auto it = relative ? relative->find(prefix + key) : std::map<std::string, double>::const_iterator();
+    if (relative && it != relative->end()) f["default"] = relative_text(it->second);
+    else f["default"] = v;
+    f["accepts"] = rule_text(r);
+    fields.push_back(std::move(f));
   }
 };
 

@@ -139,6 +139,31 @@ nlohmann::ordered_json recognition_settings_json(const RecognitionSettings& sett
   return j;
 }
 
+nlohmann::ordered_json recognition_settings_schema() {
+  RecognitionSettings s;
+  nlohmann::ordered_json j;
+  j["descriptor"] = {{"type", "string"}, {"default", s.descriptor}, {"accepts", "one of: " + [] {
+                       std::string t;
+                       for (const auto& n : descriptor_names()) t += (t.empty() ? "" : ", ") + n;
+                       return t;
+                     }()}};
+  j["refinement"] = {{"type", "string"}, {"default", s.refinement}, {"accepts", "one of: " + [] {
+                       std::string t;
+                       for (const auto& n : refinement_names()) t += (t.empty() ? "" : ", ") + n;
+                       return t;
+                     }()}};
+  j["seed"] = {{"type", "integer"}, {"default", s.seed}, {"accepts", ">= 0"}};
+  j["sections"] = nlohmann::ordered_json::array();
+  for_each_section(s, [&](const char* name, const auto& section) {
+    fields::SchemaWriter w;
+    w.relative = &s.relative;
+    w.prefix = std::string(name) + ".";
+    std::decay_t<decltype(section)>::fields(section, w);
+    j["sections"].push_back({{"name", name}, {"fields", std::move(w.fields)}});
+  });
+  return j;
+}
+
 const std::map<std::string, double>& default_relative_lengths() {
   static const std::map<std::string, double> m{
       {"preprocess.voxel_mm", 0.05},           {"preprocess.plane_threshold_mm", 0.05},

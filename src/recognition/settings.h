@@ -126,6 +126,11 @@ double depth_noise_sigma_mm(const DepthImage& image);
 RecognitionSettings resolve_lengths_for_sensor(const RecognitionSettings& s, double model_diameter_mm,
                                                const DepthImage& image, const Intrinsics& K);
 
+// Every setting's type, default (relative lengths as "0.05d") and what it
+// accepts, section by section: `posebench schema settings`, from which
+// scripts/settings_reference.py writes docs/settings.md.
+nlohmann::ordered_json recognition_settings_schema();
+
 // The stage sections, in order (and `scale`).
 const std::vector<std::string>& recognition_sections();
 

@@ -10,7 +10,7 @@ struct GlobalSettings {
   double cluster_tolerance_mm = 12.0;   // Euclidean cluster extraction distance (0.06 d; the thesis's
                                         // configs pin 0.1 d, 20 mm at 200 mm; see top_k)
   int cluster_min_points = 50;          // smaller scene clusters are ignored
-  int cluster_max_points = 100000;
+  int cluster_max_points = 100000;      // larger scene clusters are ignored
   double cvfh_eps_angle_deg = 7.5;      // smooth region growing: normal angle threshold (t_n)
   double cvfh_curvature_threshold = 0.025;  // high-curvature points removed before growing
   double cvfh_cluster_tolerance_mm = 15.0;  // region growing distance threshold (t_d)
@@ -24,7 +24,9 @@ struct GlobalSettings {
   int top_k = 20;                       // matches passed on to the initial poses, each with its CRH
                                         // roll peaks (the thesis: "the top five hypotheses"; its
                                         // configs pin 5). With cluster_tolerance 0.06 d instead of
-                                        // 0.1 d and 5, the same trials (results/real_recognition):
+                                        // 0.1 d and 5, the same trials, verify.outline_weight 1
+                                        // already on (results/real_recognition measures it from
+                                        // the defaults before either change):
                                         // real YCB-Video cvfh 27 -> 39, esf 27 -> 42, ourcvfh
                                         // 24 -> 37, cesf 14 -> 13 of 223; simulated clutter cesf
                                         // 8 -> 23, esf 21 -> 31, ourcvfh 16 -> 27, cvfh 20 -> 28 of
