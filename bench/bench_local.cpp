@@ -21,6 +21,7 @@
 #include "recognition/verify/verify.h"
 #include "scenes/generator.h"
 #include "scenes/views.h"
+#include "pcl_reference.h"  // PCL's implementation, the reference
 
 namespace {
 

@@ -1,5 +1,5 @@
 // Our Euclidean clusters (global/euclidean.cpp, a grid of cells) against
-// pcl::EuclideanClusterExtraction (clusters.cpp, the reference) on clouds
+// pcl::EuclideanClusterExtraction (tests/pcl_reference/clusters_pcl.cpp, the reference) on clouds
 // whose components are close to the tolerance apart: the same clusters, in
 // the same order, for tolerances from under a point spacing to many spacings,
 // with the size limits applied as PCL applies them. The neighbour lookups go
@@ -14,6 +14,7 @@
 
 #include "core/random.h"
 #include "recognition/global/internal.h"
+#include "pcl_reference.h"  // PCL's implementation, the reference
 
 namespace pb {
 namespace {

@@ -15,6 +15,7 @@
 #include "recognition/global/esf.h"
 #include "recognition/global/esf_lines.h"
 #include "recognition/global/internal.h"
+#include "pcl_reference.h"  // PCL's implementation, the reference
 
 namespace pb {
 namespace {

@@ -1,5 +1,5 @@
 // Our BOARD frames (local/board.cpp) against PCL's
-// BOARDLocalReferenceFrameEstimation (board_pcl.cpp) on the same keypoints,
+// BOARDLocalReferenceFrameEstimation (tests/pcl_reference/board_pcl.cpp) on the same keypoints,
 // cloud and normals: a noisy curved surface whose border keypoints have holes
 // in their margin, plus a duplicated point and a keypoint with too few
 // neighbours. With PCL's std::rand() start axis (same std::srand) the frames
@@ -19,6 +19,7 @@
 #include "core/rotation.h"
 #include "recognition/local/internal.h"
 #include "test_recognition_local_util.h"
+#include "pcl_reference.h"  // PCL's implementation, the reference
 
 namespace pb {
 namespace {

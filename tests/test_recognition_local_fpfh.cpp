@@ -1,4 +1,4 @@
-// Our FPFH (local/fpfh.cpp) against PCL's FPFHEstimationOMP (fpfh_pcl.cpp)
+// Our FPFH (local/fpfh.cpp) against PCL's FPFHEstimationOMP (tests/pcl_reference/fpfh_pcl.cpp)
 // on the same keypoints, cloud and normals: a noisy, curved surface with
 // jittered sample positions (so no pair sits exactly on a radius or bin
 // boundary by construction), plus a NaN point and a duplicated point. Also:
@@ -12,6 +12,7 @@
 #include "core/rotation.h"
 #include "recognition/local/internal.h"
 #include "test_recognition_local_util.h"
+#include "pcl_reference.h"  // PCL's implementation, the reference
 
 namespace pb {
 namespace {

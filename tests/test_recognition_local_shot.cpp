@@ -1,4 +1,4 @@
-// Our SHOT (local/shot.cpp) against PCL's SHOTEstimationOMP (shot_pcl.cpp) on
+// Our SHOT (local/shot.cpp) against PCL's SHOTEstimationOMP (tests/pcl_reference/shot_pcl.cpp) on
 // the same keypoints, cloud and normals: a noisy, curved surface with
 // jittered sample positions, plus a duplicated point, a NaN point and a
 // keypoint with too few neighbours. Also: one and two threads give the same
@@ -13,6 +13,7 @@
 #include "core/rotation.h"
 #include "recognition/local/internal.h"
 #include "test_recognition_local_util.h"
+#include "pcl_reference.h"  // PCL's implementation, the reference
 
 namespace pb {
 namespace {

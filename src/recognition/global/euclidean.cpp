@@ -3,7 +3,7 @@
 // float, as FLANN's strict radius search that pcl::EuclideanClusterExtraction
 // runs from every point), clusters outside [min, max] points dropped whole,
 // as PCL drops them. Components do not depend on the order of a search, so
-// the clusters are PCL's (clusters.cpp keeps PCL's as the reference,
+// the clusters are PCL's (tests/pcl_reference/clusters_pcl.cpp keeps PCL's as the reference,
 // `GlobalClusters.SameAsPcl`).
 //
 // Instead of a radius search per point (hundreds of neighbours each when the

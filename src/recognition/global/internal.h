@@ -1,7 +1,8 @@
 // Internal pieces of the global pipeline (CVFH, ESF, CESF, OUR-CVFH, CRH),
 // shared by the src/recognition/global/*.cpp files. PCL-free: PCL stays in
-// the .cpp files that use it (clusters.cpp, cvfh_pcl.cpp, ourcvfh.cpp,
-// crh.cpp, esf_pcl.cpp), so the others compile without PCL.
+// the .cpp files that use it (cvfh_pcl.cpp, ourcvfh.cpp, crh.cpp), so the
+// others compile without PCL. PCL's ESF and Euclidean clusters, the
+// references of ours, are in tests/pcl_reference.
 #pragma once
 
 #include <cstdint>
@@ -40,11 +41,6 @@ struct Signature {
 // ascending. Non-finite points are in no cluster.
 std::vector<std::vector<int>> euclidean_clusters(const std::vector<Vec3f>& points, double tolerance_mm,
                                                  int min_points, int max_points);
-// --- clusters.cpp (PCL) ---
-// pcl::EuclideanClusterExtraction itself, in the same order: the reference of
-// euclidean_clusters (tests and benchmarks only).
-std::vector<std::vector<int>> euclidean_clusters_pcl(const std::vector<Vec3f>& points, double tolerance_mm,
-                                                     int min_points, int max_points);
 
 // A stable region: CVFH's smooth region growing after removing high-
 // curvature points (pcl::CVFHEstimation's algorithm and parameters): points
@@ -124,11 +120,6 @@ std::vector<double> crh_roll_peaks(const std::vector<float>& scene_crh, const st
 // spectra, converted to our convention (radians): for tests.
 std::vector<double> pcl_crh_roll_peaks(const std::vector<float>& scene_crh, const std::vector<float>& view_crh);
 
-// --- global_esf_pcl.cpp (PCL) ---
-// pcl::ESFEstimation of the same points, the reference our compute_esf is
-// checked against (tests only: PCL's ESF seeds rand() from the clock, so it
-// is neither reproducible nor thread-safe).
-std::vector<float> pcl_esf(const std::vector<Vec3f>& points);
 
 // --- global_method.cpp ---
 // The number of ESF triples drawn for a cloud of `points` points:

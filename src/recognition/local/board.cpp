@@ -2,7 +2,7 @@
 // pcl::BOARDLocalReferenceFrameEstimation computes them with holes filled and
 // its default tangent radius (0: every neighbour but the keypoint itself is
 // a "margin" point), the set-up of PCL's correspondence grouping tutorial
-// (board_pcl.cpp keeps PCL's as the reference):
+// (tests/pcl_reference/board_pcl.cpp keeps PCL's as the reference):
 //   - neighbourhood: every cloud point with squared distance below r^2, in
 //     kd-tree order (KdTree3; PCL's is in order of distance, which only
 //     changes the rounding of the sums below and which of two equal

@@ -1,5 +1,5 @@
 // Our FPFH (Rusu et al. 2009) at keypoints, PCL-free, as PCL's
-// FPFHEstimation defines it (fpfh_pcl.cpp keeps PCL's as the reference):
+// FPFHEstimation defines it (tests/pcl_reference/fpfh_pcl.cpp keeps PCL's as the reference):
 //   - neighbourhoods: every cloud point with squared distance below r^2
 //     (FLANN's strict radius), found on the project's kd-tree (KdTree3);
 //   - SPFH of every point that is a neighbour of a keypoint: over its

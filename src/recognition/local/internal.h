@@ -2,12 +2,12 @@
 // voting). PCL-free: each function converts to PCL types inside its own .cpp
 // file, so the PCL compile cost is spread over several small units:
 //   keypoints.cpp  keypoints (the shared voxel grid, PCL-free)
-//   fpfh.cpp       FPFH (our own, on KdTree3; fpfh_pcl.cpp: PCL's, the reference)
-//   shot.cpp       SHOT (our own, on KdTree3; shot_pcl.cpp: PCL's, the reference;
+//   fpfh.cpp       FPFH (on KdTree3; PCL's, the reference: tests/pcl_reference)
+//   shot.cpp       SHOT (on KdTree3; PCL's, the reference: tests/pcl_reference;
 //                  shot_votes.cpp: its histogram's votes)
 //   match.cpp      descriptor search: a scan with a projected lower bound
 //                  (exact for FPFH, SHOT capped by match_max_checks)
-//   board.cpp      BOARD reference frames (our own; board_pcl.cpp: PCL's, the reference)
+//   board.cpp      BOARD reference frames (PCL's, the reference: tests/pcl_reference)
 //   hough.cpp      pcl::Hough3DGrouping
 //   method.cpp     the Method (train, save/load, hypothesize)
 #pragma once
@@ -56,13 +56,6 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
                                 double radius_mm, int threads, int max_support = 0);
 std::vector<float> compute_shot(const PointSet& cloud, const std::vector<int>& keypoints,
                                 double radius_mm, int threads, int max_support = 0);
-// PCL's FPFHEstimationOMP with the same inputs: the reference of our FPFH
-// (tests and the stock-PCL benchmark only).
-std::vector<float> compute_fpfh_pcl(const PointSet& cloud, const std::vector<int>& keypoints,
-                                    double radius_mm, int threads);
-// PCL's SHOTEstimationOMP with the same inputs: the reference of our SHOT.
-std::vector<float> compute_shot_pcl(const PointSet& cloud, const std::vector<int>& keypoints,
-                                    double radius_mm, int threads);
 
 // OpenMP threads for a `threads` setting: 0 = OMP_NUM_THREADS (as `run`
 // gives its workers), 1 without OpenMP.
@@ -84,10 +77,6 @@ enum class BoardStartAxis {
 // tests' noisy surface), so it is not thinned.
 std::vector<float> compute_board_lrf(const PointSet& cloud, const std::vector<int>& keypoints, double radius_mm,
                                      BoardStartAxis start = BoardStartAxis::kFixed);
-// PCL's estimator with the same inputs (board_pcl.cpp): the reference of
-// ours (tests and benchmarks only).
-std::vector<float> compute_board_lrf_pcl(const PointSet& cloud, const std::vector<int>& keypoints,
-                                         double radius_mm);
 // A frame row (x, y, z axes) the voting can use: finite and orthonormal
 // within 1e-3.
 bool usable_frame(const float* row);

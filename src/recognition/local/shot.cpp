@@ -1,5 +1,5 @@
 // Our SHOT (Tombari et al. 2010) at keypoints, PCL-free, as PCL's
-// SHOTEstimation defines it (shot_pcl.cpp keeps PCL's as the reference):
+// SHOTEstimation defines it (tests/pcl_reference/shot_pcl.cpp keeps PCL's as the reference):
 //   - one neighbourhood per keypoint: every cloud point with squared
 //     distance below r^2 (FLANN's strict radius) in order of distance, found
 //     once on the project's kd-tree and used for both the frame and the

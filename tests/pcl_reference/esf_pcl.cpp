@@ -5,6 +5,7 @@
 #include <pcl/point_types.h>
 
 #include "recognition/global/internal.h"
+#include "pcl_reference.h"
 
 namespace pb::global {
 

@@ -10,6 +10,7 @@
 
 #include "recognition/local/internal.h"
 #include "recognition/local/pcl_features.h"
+#include "pcl_reference.h"
 
 namespace pb::local {
 

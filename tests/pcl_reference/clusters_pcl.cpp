@@ -10,6 +10,7 @@
 
 #include "recognition/pcl_adapter.h"
 #include "recognition/global/internal.h"
+#include "pcl_reference.h"
 
 namespace pb::global {
 
