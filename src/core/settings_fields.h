@@ -150,8 +150,7 @@ struct SchemaWriter {
     else if constexpr (std::is_same_v<T, std::string>) f["type"] = "string";
     else if constexpr (std::is_integral_v<T>) f["type"] = "integer";
     else f["type"] = "number";
-    const auto it = relative ? relative->find(prefix + key) : std::map<std::string, double>::const_iterator();
-    if (relative && it != relative->end()) f["default"] = relative_text(it->second);
+    if (relative && relative->count(prefix + key)) f["default"] = relative_text(relative->at(prefix + key));
     else f["default"] = v;
     f["accepts"] = rule_text(r);
     fields.push_back(std::move(f));

@@ -142,16 +142,10 @@ nlohmann::ordered_json recognition_settings_json(const RecognitionSettings& sett
 nlohmann::ordered_json recognition_settings_schema() {
   RecognitionSettings s;
   nlohmann::ordered_json j;
-  j["descriptor"] = {{"type", "string"}, {"default", s.descriptor}, {"accepts", "one of: " + [] {
-                       std::string t;
-                       for (const auto& n : descriptor_names()) t += (t.empty() ? "" : ", ") + n;
-                       return t;
-                     }()}};
-  j["refinement"] = {{"type", "string"}, {"default", s.refinement}, {"accepts", "one of: " + [] {
-                       std::string t;
-                       for (const auto& n : refinement_names()) t += (t.empty() ? "" : ", ") + n;
-                       return t;
-                     }()}};
+  j["descriptor"] = {{"type", "string"}, {"default", s.descriptor},
+                     {"accepts", fields::rule_text(fields::one_of(descriptor_names()))}};
+  j["refinement"] = {{"type", "string"}, {"default", s.refinement},
+                     {"accepts", fields::rule_text(fields::one_of(refinement_names()))}};
   j["seed"] = {{"type", "integer"}, {"default", s.seed}, {"accepts", ">= 0"}};
   j["sections"] = nlohmann::ordered_json::array();
   for_each_section(s, [&](const char* name, const auto& section) {
