@@ -153,6 +153,45 @@ TEST(Settings, JsonRoundTripsThroughTheParsers) {
   EXPECT_NE(pb::settings_to_json(s), pb::settings_to_json(pb::RecognitionSettings{}));
 }
 
+// A grid point's override goes through the section parsers: rules, relative
+// lengths and unknown keys as in a YAML section, the error at the value's
+// own line.
+TEST(Settings, ApplySettingReadsOneFieldByItsPath) {
+  const pb::YamlNode grid = pb::YamlNode::load_string("a: 7\nb: 0.04d\nc: -1\nd: shot\ne: 3\n", "exp.yaml");
+  pb::RecognitionSettings s = pb::apply_setting({}, "global.top_k", grid["a"]);
+  EXPECT_EQ(s.global.top_k, 7);
+  s = pb::apply_setting(s, "preprocess.voxel_mm", grid["b"]);
+  EXPECT_DOUBLE_EQ(s.relative.at("preprocess.voxel_mm"), 0.04);
+  s = pb::apply_setting(s, "preprocess.voxel_mm", grid["e"]);
+  EXPECT_EQ(s.relative.count("preprocess.voxel_mm"), 0u);
+  EXPECT_EQ(s.preprocess.voxel_mm, 3);
+  EXPECT_EQ(pb::apply_setting(s, "descriptor", grid["d"]).descriptor, "shot");
+  try {
+    pb::apply_setting(s, "global.top_k", grid["c"]);
+    FAIL() << "a negative top_k was accepted";
+  } catch (const pb::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("exp.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("top_k"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("line 3"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(pb::apply_setting(s, "global.no_such_key", grid["a"]), pb::InputError);
+  EXPECT_THROW(pb::apply_setting(s, "nosection.top_k", grid["a"]), pb::InputError);
+}
+
+// A trial's settings cross the process boundary as their changes from the
+// defaults; read back over the defaults they are the same settings.
+TEST(Settings, ChangesFromTheDefaultsReadBackToTheSameSettings) {
+  const pb::RecognitionSettings none;
+  EXPECT_EQ(pb::settings_changes_json(none).dump(), R"({"descriptor":"fpfh","refinement":"icp"})");
+  const pb::RecognitionSettings s =
+      parse("descriptor: ppf\npreprocess: {voxel_mm: 7, normal_radius_mm: 0.2d}\nglobal: {top_k: 3}\n"
+            "verify: {max_instances: 2}\nseed: 9\n");
+  const nlohmann::ordered_json c = pb::settings_changes_json(s);
+  EXPECT_EQ(c["preprocess"].dump(), R"({"voxel_mm":7.0,"normal_radius_mm":"0.2d"})");
+  EXPECT_FALSE(c.contains("local"));
+  EXPECT_EQ(pb::settings_to_json(parse(c.dump())), pb::settings_to_json(s));
+}
+
 // Lengths relative to the object's diameter (issue 9): "0.05d" in YAML, the
 // default profile, resolution with the sensor's floor.
 TEST(RelativeLengths, TheDefaultProfileGivesTheHeaderValuesAt200mm) {
@@ -210,7 +249,7 @@ TEST(RelativeLengths, TheSensorsFloorAndTheCasesThatCannotResolve) {
   im.height = 1;
   im.z = {900, 1000, 0, 1100};
   EXPECT_DOUBLE_EQ(pb::sensor_length_floor_mm(s.scale, im, K), 4.0);
-  const auto f = pb::resolve_lengths_for_sensor(pb::RecognitionSettings{}, 50, im, K);
+  const auto f = pb::resolve_for_scene(pb::RecognitionSettings{}, 50, im, K);
   EXPECT_DOUBLE_EQ(f.scale.min_length_mm, 4.0);
   EXPECT_DOUBLE_EQ(f.preprocess.voxel_mm, 4.0);
   // No diameter: an input error naming scale.diameter_mm.

@@ -228,7 +228,7 @@ TEST(TestTargets, ObjectAllRunsEveryTargetWithItsInstanceCount) {
   std::set<std::tuple<int, int, int, int>> got;
   for (const auto& t : trials) {
     got.insert({t.scene_id, t.im_id, t.obj_id, t.inst_count});
-    EXPECT_EQ(t.settings["verify"]["max_instances"], t.inst_count) << t.key;
+    EXPECT_EQ(t.settings.verify.max_instances, t.inst_count) << t.key;
     EXPECT_NE(t.key.find("/obj=" + std::to_string(t.obj_id)), std::string::npos) << t.key;
     const pb::TrialRecord r = pb::trial_record(t);  // what the worker gets
     EXPECT_EQ(r.obj_id.value_or(0), t.obj_id);

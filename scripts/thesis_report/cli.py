@@ -10,8 +10,8 @@ OUT is results/thesis: each experiment's folder OUT/raw/NAME holds what
 `posebench run` and `posebench report` wrote (experiment.json, records.jsonl,
 runs.jsonl, report.md, report.csv, plots.json); merged plots go to OUT/plots.
 Every record is checked against the trial record's schema (`posebench schema
-record` of the binary in POSEBENCH, default build/posebench, or the copy
-RECORD_SCHEMA in thesis_report/schema.py without a binary): an unknown key or
+record` of the binary in POSEBENCH, default build/posebench, or its copy
+thesis_report/record_schema.json without a binary): an unknown key or
 a missing required key is an error naming the file, the line and the key
 (exit code 2).
 The README's numbers all come from those files: each robustness cell of a
@@ -89,7 +89,7 @@ def main(argv=None):
     schema = schema_from_binary(binary)
     if schema is None and binary and os.path.exists(binary):
         print("thesis_report.py: `%s schema record` gave no schema (a binary from before it?); using the copy in "
-              "thesis_report/schema.py" % binary, file=sys.stderr)
+              "thesis_report/record_schema.json" % binary, file=sys.stderr)
     ablations_path = opts.get("--ablations", ABLATIONS)
     try:
         ablations = load_ablations(ablations_path)

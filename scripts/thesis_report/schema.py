@@ -1,7 +1,7 @@
 """The trial record's schema and the strict reader of records.jsonl.
 
 Every record is checked against `posebench schema record` of the binary
-(POSEBENCH) or, without one, against the copy RECORD_SCHEMA below: an unknown
+(POSEBENCH) or, without one, against its copy in record_schema.json: an unknown
 key or a missing required key is an InputError naming the file, the line and
 the key.
 """
@@ -10,61 +10,14 @@ import json
 import os
 import subprocess
 
-# A copy of `posebench schema record` ("fields"; src/eval/record.cpp), used
-# when no binary is at hand; tests/scripts compare it with the binary's.
-
-
-def _struct(*fields):
-    """An object schema from (key, schema, required) triples."""
-    return {"type": "object", "fields": {k: dict(s, required=req) for k, s, req in fields}}
-
-
-STRING, INTEGER, NUMBER, BOOLEAN, ARRAY = ({"type": t} for t in ("string", "integer", "number", "boolean", "array"))
-
-
-FREE = {"type": "object", "free": True}
-
-
-POSE = _struct(("R", ARRAY, True), ("t", ARRAY, True))
-
-
-TIMES = _struct(*((k, NUMBER, True) for k in ("preprocess", "describe", "match", "group", "initial_pose", "refine",
-                                              "verify", "total")))
-
-
-ERRORS = _struct(("translation_mm", NUMBER, True), ("rotation_1mpq", NUMBER, True), ("rotation_deg", NUMBER, True),
-                 ("symmetry", INTEGER, True), ("translation_mm_plain", NUMBER, True),
-                 ("rotation_1mpq_plain", NUMBER, True))
-
-
-BOP = _struct(("mssd_mm", NUMBER, True), ("mspd_px", NUMBER, True), ("vsd", ARRAY, True), ("diameter", NUMBER, True),
-              ("image_width", INTEGER, True))
-
-
-JUDGEMENT = _struct(("correct", BOOLEAN, True), ("translation_mm", NUMBER, True), ("rotation_1mpq", NUMBER, True))
-
-
-INSTANCE = _struct(("estimate", POSE, True), ("score", NUMBER, True), ("inliers", INTEGER, True),
-                   ("correct", BOOLEAN, False))
-
-
-# "required": True = in every record, False = when the trial got that far,
-# "when_ok" = in every record with status ok, "when_gt" = in every record with
-# status ok and a ground truth (`gt`): the judged ones.
-OK, GT = "when_ok", "when_gt"
-
-
-RECORD_SCHEMA = _struct(
-    ("key", STRING, True), ("scene", STRING, True), ("scenario", STRING, True), ("dataset", STRING, True),
-    ("split", STRING, True), ("scene_id", INTEGER, True), ("im_id", INTEGER, True), ("descriptor", STRING, True),
-    ("refinement", STRING, True), ("inst_count", INTEGER, False), ("params", FREE, True), ("added_noise_mm", NUMBER, True), ("settings", FREE, True),
-    ("seed", INTEGER, True), ("status", STRING, True), ("correct", BOOLEAN, GT), ("wall_s", NUMBER, OK),
-    ("message", STRING, False), ("obj_id", INTEGER, OK), ("settings_resolved", FREE, OK), ("train_s", NUMBER, OK),
-    ("train_from_cache", BOOLEAN, OK), ("times", TIMES, OK), ("hypotheses", INTEGER, OK), ("correct_rank", INTEGER, False),
-    ("init", POSE, False),
-    ("estimate", POSE, OK), ("instances", {"type": "array", "items": INSTANCE}, False), ("score", NUMBER, OK), ("inliers", INTEGER, OK), ("gt", POSE, False),
-    ("visib_fract", NUMBER, False), ("errors", ERRORS, GT), ("bop", BOP, GT),
-    ("judgements", {"type": "object", "values": JUDGEMENT}, False))
+# `posebench schema record` as the binary prints it (src/eval/record.cpp is
+# the one definition), written to record_schema.json beside this file for
+# when no binary is at hand:
+#   build/posebench schema record > scripts/thesis_report/record_schema.json
+# tests/scripts compare the file with the binary's schema.
+SCHEMA_FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "record_schema.json")
+with open(SCHEMA_FILE) as _f:
+    RECORD_SCHEMA = {"type": "object", "fields": json.load(_f)["fields"]}
 
 
 PY_TYPES = {"string": (str,), "integer": (int,), "number": (int, float), "boolean": (bool,), "array": (list,),

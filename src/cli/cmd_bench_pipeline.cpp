@@ -87,9 +87,10 @@ static pb::cli::Command bench_cmd(
                 {"experiment", cfg.name},
                 {"experiment_hash", cfg.hash},
                 {"records", out + "/records.jsonl"}};
-      if (!cfg.settings.empty()) t.settings["all"] = cfg.settings;
-      for (const pb::SceneSource& src : cfg.scenes)
-        if (!src.settings.empty()) t.settings[src.name] = src.settings;
+      // The settings as the config writes them (its canonical form).
+      if (!cfg.canonical["settings"].empty()) t.settings["all"] = cfg.canonical["settings"];
+      for (const nlohmann::json& src : cfg.canonical["scenes"])
+        if (!src["settings"].empty()) t.settings[src["name"].get<std::string>()] = src["settings"];
       pb::atomic_write_text(out + "/bench.json", pb::bench_json(t).dump(2) + "\n");
       const std::string md = "# bench-pipeline: " + cfg.name + "\n\n" + pb::bench_markdown(t);
       pb::atomic_write_text(out + "/bench.md", md);

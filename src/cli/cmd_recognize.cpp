@@ -67,7 +67,7 @@ struct Options {
   std::string method, refine, config, overlay, cache = default_cache_dir(), scenario = "table";
   int views = 0;
   int instances = -1;  // verify.max_instances (-1: the config's)
-  long long seed = -1;
+  std::optional<uint64_t> seed;  // a record's seed is any 64-bit number
   bool json = false;
   bool explain = false;
 };
@@ -98,7 +98,9 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--instances", o.instances, "recognize up to N instances of the object (0 = every one that "
                                              "verification accepts; default: the config's verify.max_instances, 1)")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--seed", o.seed, "seed of every random choice (overrides the config)")->check(CLI::NonNegativeNumber);
+  app.add_option("--seed", o.seed, "seed of the recognition's random choices (overrides the config's seed; training "
+                                   "keeps the config's, as in `posebench run`: a record's seed repeats its trial)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--overlay", o.overlay, "write a PNG: the model at the estimated pose over the colour-mapped depth");
   app.add_option("--cache", o.cache, "training cache folder ('' = no cache; default $POSEBENCH_CACHE or ~/.cache/posebench/train)");
   app.add_option("--scenario", o.scenario, "thresholds for 'correct': table (50 mm) or warehouse (100 mm)");
@@ -115,7 +117,6 @@ void settings_from(const Options& o, pb::RecognitionSettings& s) {
   if (!o.refine.empty()) s.refinement = pb::refinement_entry(o.refine, "", "--refine").name;
   if (o.views > 0) s.views.views = o.views;
   if (o.instances >= 0) s.verify.max_instances = o.instances;
-  if (o.seed >= 0) s.seed = static_cast<uint64_t>(o.seed);
 }
 
 // The thesis's errors of a pose against the object's ground-truth instance
@@ -231,6 +232,7 @@ std::string json_output(const Outcome& x) {
   }
   j["score"] = x.res.score;
   j["inliers"] = x.res.inliers;
+  j["settings_resolved"] = pb::recognition_settings_json(x.s);  // every field in mm, as a run's record has them
   if (x.s.verify.max_instances != 1) {
     nlohmann::ordered_json list = nlohmann::ordered_json::array();
     for (const auto& h : x.res.instances)
@@ -357,9 +359,16 @@ static pb::cli::Command recognize_cmd(
       }
       const pb::TrainingViews views = obj.cloud.empty() ? pb::training_views(mesh, s.views, model_name)
                                                         : pb::cloud_training_views(obj.cloud, model_name);
-      // Relative lengths in mm: the model's diameter, the sensor's floor at this image.
-      if (!views.views.empty()) s = pb::resolve_lengths_for_sensor(s, pb::training_views_diameter(views), depth, im.K);
+      // Relative lengths in mm as `posebench run` resolves them: the model's
+      // diameter (models_info, else the training views' extent), the
+      // sensor's floor at the scene's first image.
+      if (!views.views.empty())
+        s = pb::resolve_for_scene(s, info.diameter > 0 ? info.diameter : pb::training_views_diameter(views),
+                                  scene.first_depth, scene.first_K);
+      // Training is seeded by the settings' seed, the recognition by --seed
+      // (the runner's trial seed), as `posebench run` does.
       const auto model = pb::train_model(views, s, topt, &from_cache);
+      if (o.seed) s.seed = *o.seed;
       const double train_s = train_timer.seconds();
       const pb::RecognitionResult res = pb::recognize(depth, im.K, *model, s);
       const Evaluation ev = evaluate(res, im, obj_id, info, thr);

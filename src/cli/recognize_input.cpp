@@ -73,6 +73,9 @@ RecognizeScene dataset_scene(RecognizeSource& o) {
     s.im.K.width = s.depth.width;
     s.im.K.height = s.depth.height;
   }
+  const pb::ImageInfo& first = sc.images.begin()->second;
+  s.first_depth = first.im_id == s.im.im_id ? s.depth : ds.load_depth(o.split, o.scene, first);
+  s.first_K = first.K;
   s.source = {{"dataset", o.dataset_dir}, {"split", o.split}, {"scene", o.scene}, {"image", o.image}};
   s.description = o.split + " scene " + std::to_string(o.scene) + " image " + std::to_string(o.image);
   return s;
@@ -85,6 +88,8 @@ RecognizeScene cloud_scene(const RecognizeSource& o) {
   s.depth = std::move(cs.depth);
   s.im.K = cs.K;
   const pb::Intrinsics& K = s.im.K;
+  s.first_depth = s.depth;
+  s.first_K = K;
   const std::string how = cs.source == "fitted"    ? "fitted to the organized cloud"
                           : cs.source == "virtual" ? "virtual (the cloud's angular extent in 640x480)"
                                                    : cs.source;

@@ -30,6 +30,10 @@ struct RecognizeSource {
 struct RecognizeScene {
   pb::DepthImage depth;
   pb::ImageInfo im;                // K with its size; ground truth (none for clouds)
+  // The scene's first image, where relative lengths take the sensor's floor
+  // as in `posebench run` (resolve_for_scene); a point cloud is its own.
+  pb::DepthImage first_depth;
+  pb::Intrinsics first_K;
   nlohmann::ordered_json source;   // what the JSON output says of the input
   std::string description;         // the same in words
 };

@@ -69,7 +69,10 @@ struct TrialRecord {
   std::optional<int> inst_count;
   nlohmann::json params = nlohmann::json::object();    // grid point: dotted path -> value
   double added_noise_mm = 0;
-  nlohmann::json settings = nlohmann::json::object();  // the trial's settings sections, as configured
+  // The trial's settings: the fields that differ from the defaults, section
+  // by section, with the descriptor and refinement (settings_changes_json);
+  // relative lengths as "0.05d".
+  nlohmann::json settings = nlohmann::json::object();
   uint64_t seed = 0;
   // The outcome. `status` is always present; the rest when the trial got
   // that far (record_schema(): "when_ok" = present in every record with

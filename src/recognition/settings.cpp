@@ -233,13 +233,54 @@ bool needs_sensor_floor(const RecognitionSettings& s) {
   return !s.relative.empty() && !(s.scale.min_length_mm > 0);
 }
 
-RecognitionSettings resolve_lengths_for_sensor(const RecognitionSettings& in, double model_diameter_mm,
-                                               const DepthImage& image, const Intrinsics& K) {
+RecognitionSettings resolve_for_scene(const RecognitionSettings& in, double model_diameter_mm, const DepthImage& first,
+                                      const Intrinsics& first_K) {
   RecognitionSettings s = in;
-  if (needs_sensor_floor(s)) s.scale.min_length_mm = sensor_length_floor_mm(s.scale, image, K);
+  if (needs_sensor_floor(s)) s.scale.min_length_mm = sensor_length_floor_mm(s.scale, first, first_K);
   return resolve_lengths(s, model_diameter_mm);
 }
 
 std::string settings_to_json(const RecognitionSettings& s) { return recognition_settings_json(s).dump(); }
+
+RecognitionSettings apply_setting(const RecognitionSettings& s, const std::string& path, const YamlNode& value) {
+  // {section: {key: value}} around the config's own node, so that errors
+  // name its file and line.
+  YAML::Node root(YAML::NodeType::Map);
+  YAML::Node at = root;
+  size_t start = 0;
+  for (size_t dot = path.find('.'); dot != std::string::npos; start = dot + 1, dot = path.find('.', start)) {
+    YAML::Node next(YAML::NodeType::Map);
+    at[path.substr(start, dot - start)] = next;
+    at.reset(next);
+  }
+  at[path.substr(start)] = value.raw();
+  return parse_recognition_settings(YamlNode(root, value.file()), s);
+}
+
+namespace {
+
+// The entries of `j` that differ from `base`, objects compared key by key.
+nlohmann::ordered_json changes(const nlohmann::ordered_json& j, const nlohmann::ordered_json& base) {
+  nlohmann::ordered_json out = nlohmann::ordered_json::object();
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const auto b = base.find(it.key());
+    if (b == base.end() || !it.value().is_object() || !b->is_object()) {
+      if (b == base.end() || *b != it.value()) out[it.key()] = it.value();
+      continue;
+    }
+    nlohmann::ordered_json sub = changes(it.value(), *b);
+    if (!sub.empty()) out[it.key()] = std::move(sub);
+  }
+  return out;
+}
+
+}  // namespace
+
+nlohmann::ordered_json settings_changes_json(const RecognitionSettings& s) {
+  const nlohmann::ordered_json all = recognition_settings_json(s);
+  nlohmann::ordered_json out = {{"descriptor", s.descriptor}, {"refinement", s.refinement}};
+  out.update(changes(all, recognition_settings_json(RecognitionSettings{})));
+  return out;
+}
 
 }  // namespace pb

@@ -118,13 +118,16 @@ bool needs_sensor_floor(const RecognitionSettings& s);
 // its own, median-based estimate: preprocess/internal.h's depth_noise_sigma.)
 double depth_noise_sigma_mm(const DepthImage& image);
 
-// resolve_lengths with the sensor's floor: when scale.min_length_mm is 0 it
-// becomes sensor_length_floor_mm(scale, image, K) first. The runner does
-// the same with the floor of the trial's scene's first image (computed once
-// per scene and scale setting), so every image of a scene resolves alike
-// (and shares one trained model).
-RecognitionSettings resolve_lengths_for_sensor(const RecognitionSettings& s, double model_diameter_mm,
-                                               const DepthImage& image, const Intrinsics& K);
+// Relative lengths in mm for one image of a scene: the one resolution that
+// `posebench run` (and so `advise`) and `recognize` share, so an image gives
+// the same settings, trained model and pose in both. d = scale.diameter_mm,
+// else `model_diameter_mm` (the models_info diameter, else the extent of the
+// training views); the floor = scale.min_length_mm, else the sensor's floor
+// (sensor_length_floor_mm) on the scene's first image (`first`, `first_K`),
+// so every image of a scene resolves alike and shares one trained model. A
+// lone image (a point cloud) is its own first image.
+RecognitionSettings resolve_for_scene(const RecognitionSettings& s, double model_diameter_mm, const DepthImage& first,
+                                      const Intrinsics& first_K);
 
 // Every setting's type, default (relative lengths as "0.05d") and what it
 // accepts, section by section: `posebench schema settings`, from which
@@ -140,8 +143,20 @@ const std::vector<std::string>& recognition_sections();
 // runner's `views`) and are skipped here.
 RecognitionSettings parse_recognition_settings(const YamlNode& node, RecognitionSettings base = {},
                                                const std::set<std::string>& other_sections = {});
+// One setting by its dotted path ("global.top_k", "descriptor"), read from
+// `value` over `s` by the same parser and field lists as a YAML section
+// (rules, relative lengths "0.05d"): an experiment grid point's override.
+// InputError at `value` for an unknown path or a bad value.
+RecognitionSettings apply_setting(const RecognitionSettings& s, const std::string& path, const YamlNode& value);
+
 // Every field, in declaration order (trial records).
 nlohmann::ordered_json recognition_settings_json(const RecognitionSettings& s);
 std::string settings_to_json(const RecognitionSettings& s);
+
+// The fields of `s` that differ from the defaults, section by section, with
+// the descriptor and refinement always: the settings a trial record keeps
+// and the runner sends its worker, which reads them back over the defaults
+// (parse_recognition_settings gives `s` again, relative lengths included).
+nlohmann::ordered_json settings_changes_json(const RecognitionSettings& s);
 
 }  // namespace pb

@@ -25,32 +25,6 @@ namespace pb {
 
 using namespace experiment_detail;
 
-// Sets a dotted path ("global.top_k") in a settings JSON object.
-static void set_path(nlohmann::json& j, const std::string& path, const nlohmann::json& v) {
-  nlohmann::json* cur = &j;
-  size_t start = 0;
-  while (true) {
-    const size_t dot = path.find('.', start);
-    const std::string part = path.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
-    if (dot == std::string::npos) {
-      (*cur)[part] = v;
-      return;
-    }
-    if (!cur->contains(part) || !(*cur)[part].is_object()) (*cur)[part] = nlohmann::json::object();
-    cur = &(*cur)[part];
-    start = dot + 1;
-  }
-}
-
-static void merge(nlohmann::json& base, const nlohmann::json& over) {
-  for (auto it = over.begin(); it != over.end(); ++it) {
-    if (it.value().is_object() && base.contains(it.key()) && base[it.key()].is_object())
-      merge(base[it.key()], it.value());
-    else
-      base[it.key()] = it.value();
-  }
-}
-
 namespace {
 
 // name, seed, object, descriptors, refinements, noise, time limit, registration_only.
@@ -94,35 +68,37 @@ void parse_thresholds(const YamlNode& root, ExperimentConfig& c) {
 
 }
 
-// Base settings and the grid: validated through the recognition settings
-// parser on the original node, so errors carry the right line.
-void parse_settings_and_grid(const YamlNode& root, const std::string& path, ExperimentConfig& c) {
-  if (root.has("settings")) {
-    parse_recognition_settings(root["settings"]);
-    c.settings = root["settings"].json();
-  }
-
-  if (root.has("grid")) {
-    const YamlNode g = root["grid"];
-    if (!g.is_map()) g.fail("expected a mapping of setting path -> list of values");
-    for (const auto& key : g.keys()) {
-      const YamlNode v = g[key];
-      if (!v.is_sequence() || v.size() == 0) v.fail("expected a non-empty list of values");
-      std::vector<nlohmann::json> vals;
-      for (size_t i = 0; i < v.size(); ++i) {
-        vals.push_back(v.at(i).json());
-        nlohmann::json probe = c.settings;
-        set_path(probe, key, vals.back());
-        try {
-          parse_recognition_settings(YamlNode::load_string(probe.dump(), path));
-        } catch (const InputError& e) {
-          throw InputError(path, "grid." + key, "line " + std::to_string(v.line()) + ": " + e.what());
-        }
-      }
-      c.grid.emplace_back(key, vals);
+// The grid point's settings: `base` with each (path, value) applied;
+// errors name the grid entry and its line.
+RecognitionSettings with_grid_point(RecognitionSettings s, const std::vector<std::pair<std::string, YamlNode>>& point,
+                                    const std::string& file) {
+  for (const auto& [path, value] : point) {
+    try {
+      s = apply_setting(s, path, value);
+    } catch (const InputError& e) {
+      throw InputError(file, "grid." + path, "line " + std::to_string(value.line()) + ": " + e.what());
     }
   }
+  return s;
+}
 
+// Base settings and the grid, read from the config's own nodes, so errors
+// carry the right line; each grid value is checked over the base settings.
+void parse_settings_and_grid(const YamlNode& root, const std::string& path, ExperimentConfig& c) {
+  c.settings = parse_recognition_settings(root["settings"]);
+  if (!root.has("grid")) return;
+  const YamlNode g = root["grid"];
+  if (!g.is_map()) g.fail("expected a mapping of setting path -> list of values");
+  for (const auto& key : g.keys()) {
+    const YamlNode v = g[key];
+    if (!v.is_sequence() || v.size() == 0) v.fail("expected a non-empty list of values");
+    GridAxis axis{key, {}};
+    for (size_t i = 0; i < v.size(); ++i) {
+      axis.values.push_back(v.at(i));
+      with_grid_point(c.settings, {{key, v.at(i)}}, path);
+    }
+    c.grid.push_back(std::move(axis));
+  }
 }
 
 }  // namespace
@@ -163,8 +139,10 @@ nlohmann::json judgements_json(const std::vector<Judgement>& js) {
 
 namespace {
 
-// The parsed config as JSON: what experiment.json keeps and the hash covers.
-nlohmann::json canonical(const ExperimentConfig& c) {
+// The parsed config as JSON: what experiment.json keeps and the hash covers
+// (the settings sections as written in `root`).
+nlohmann::json canonical(const ExperimentConfig& c, const YamlNode& root) {
+  const auto as_written = [](const YamlNode& n) { return n.has("settings") ? n["settings"].json() : nlohmann::json::object(); };
   nlohmann::json canon;
   canon["name"] = c.name;
   canon["seed"] = c.seed;
@@ -172,19 +150,25 @@ nlohmann::json canonical(const ExperimentConfig& c) {
   canon["descriptors"] = c.descriptors;
   canon["refinements"] = c.refinements;
   canon["added_noise_mm"] = c.added_noise_mm;
-  canon["settings"] = c.settings;
+  canon["settings"] = as_written(root);
   canon["registration_only"] = c.registration_only;
   canon["timeout_s"] = c.timeout_s;
   canon["perturb"] = {c.perturb_deg, c.perturb_mm};
   canon["thresholds"] = {c.thresholds.table_translation_mm, c.thresholds.warehouse_translation_mm,
                          c.thresholds.rotation_1mpq};
-  for (const auto& [k, v] : c.grid) canon["grid"].push_back({k, v});
-  for (const auto& s : c.scenes)
+  for (const GridAxis& axis : c.grid) {
+    nlohmann::json values = nlohmann::json::array();
+    for (const YamlNode& v : axis.values) values.push_back(v.json());
+    canon["grid"].push_back({axis.path, values});
+  }
+  for (size_t i = 0; i < c.scenes.size(); ++i) {
+    const SceneSource& s = c.scenes[i];
     canon["scenes"].push_back({{"name", s.name}, {"generate", s.generate}, {"dataset", s.dataset},
                                {"split", s.split}, {"scene_ids", s.scene_ids}, {"images", s.images},
                                {"scenario", s.scenario}, {"generator", s.generator_overrides},
                                {"refinements", s.refinements},
-                               {"settings", s.settings}});
+                               {"settings", as_written(root["scenes"].at(i))}});
+  }
   for (size_t i = 0; i < c.scenes.size(); ++i) {  // only when given: older hashes stay
     if (!c.scenes[i].targets.empty()) canon["scenes"][i]["targets"] = c.scenes[i].targets;
     if (!c.scenes[i].clouds.empty()) canon["scenes"][i]["clouds"] = {c.scenes[i].clouds, c.scenes[i].cloud};
@@ -221,7 +205,7 @@ ExperimentConfig load_experiment(const std::string& path) {
   const YamlNode scenes = root["scenes"];
   if (!scenes.is_sequence() || scenes.size() == 0) scenes.fail("expected a non-empty list of scenes");
   std::set<std::string> names;
-  for (size_t i = 0; i < scenes.size(); ++i) c.scenes.push_back(parse_scene(scenes.at(i), path, names));
+  for (size_t i = 0; i < scenes.size(); ++i) c.scenes.push_back(parse_scene(scenes.at(i), path, c.settings, names));
   resolve_twins(scenes, c.scenes);
   if (c.object == kEveryTargetObject) {
     for (size_t i = 0; i < scenes.size(); ++i) {
@@ -236,7 +220,7 @@ ExperimentConfig load_experiment(const std::string& path) {
     if (c.registration_only) root["registration_only"].fail("not with 'object: all'");
   }
   c.judgements = parse_judgements(root["judgements"]);
-  c.canonical = canonical(c);
+  c.canonical = canonical(c, root);
   c.hash = hash_hex(c.canonical.dump());
   return c;
 }
@@ -296,12 +280,19 @@ void check_target_images(const Targets& targets, const SceneInfo& scene) {
                        "image " + std::to_string(it->first.second) + " is not in scene " + std::to_string(scene.scene_id));
 }
 
+// A grid point: each axis's path with one of its values.
+struct GridPoint {
+  std::vector<std::pair<std::string, YamlNode>> values;
+  nlohmann::json params = nlohmann::json::object();  // path -> value (trial keys and records)
+};
+
 // One trial: the scene source's image, object (obj_id 0: the experiment's;
 // with an inst_count, verify.max_instances is set to it), method, grid
 // point and noise, its settings, key and seed.
 Trial make_trial(const ExperimentConfig& cfg, const SceneSource& src, int sid, int im_id,
                  std::pair<int, int> target, const std::string& d, const std::string& r,
-                 const nlohmann::json& p, double noise) {
+                 const GridPoint& point, double noise) {
+  const nlohmann::json& p = point.params;
   const auto [obj_id, inst_count] = target;
   Trial t;
   t.scene_name = src.name;
@@ -316,12 +307,10 @@ Trial make_trial(const ExperimentConfig& cfg, const SceneSource& src, int sid, i
   t.refinement = r;
   t.params = p;
   t.added_noise_mm = noise;
-  nlohmann::json s = cfg.settings;
-  merge(s, src.settings);
-  for (auto it = p.begin(); it != p.end(); ++it) set_path(s, it.key(), it.value());
-  s["descriptor"] = d == "none" ? "fpfh" : d;
-  s["refinement"] = r;
-  if (inst_count > 0) set_path(s, "verify.max_instances", inst_count);
+  RecognitionSettings s = with_grid_point(src.settings, point.values, cfg.file);
+  s.descriptor = d == "none" ? "fpfh" : d;
+  s.refinement = r;
+  if (inst_count > 0) s.verify.max_instances = inst_count;
   t.settings = s;
   char buf[64];
   std::snprintf(buf, sizeof buf, "%d/%d", sid, im_id);
@@ -337,16 +326,17 @@ Trial make_trial(const ExperimentConfig& cfg, const SceneSource& src, int sid, i
 
 std::vector<Trial> expand_trials(const ExperimentConfig& cfg) {
   // Grid points: cartesian product in declaration order.
-  std::vector<nlohmann::json> points{nlohmann::json::object()};
-  for (const auto& [key, vals] : cfg.grid) {
-    std::vector<nlohmann::json> next;
-    for (const auto& p : points)
-      for (const auto& v : vals) {
-        nlohmann::json q = p;
-        q[key] = v;
-        next.push_back(q);
+  std::vector<GridPoint> points(1);
+  for (const GridAxis& axis : cfg.grid) {
+    std::vector<GridPoint> next;
+    for (const GridPoint& p : points)
+      for (const YamlNode& v : axis.values) {
+        GridPoint q = p;
+        q.values.emplace_back(axis.path, v);
+        q.params[axis.path] = v.json();
+        next.push_back(std::move(q));
       }
-    points = next;
+    points = std::move(next);
   }
 
   std::vector<Trial> trials;
@@ -385,8 +375,7 @@ std::vector<Trial> expand_trials(const ExperimentConfig& cfg) {
     // views.follow_scene needs the scene set's camera elevations: a set
     // without them fails here, before any trial runs, not in every trial.
     for (size_t i = first; i < trials.size(); ++i) {
-      const auto& v = trials[i].settings;
-      if (v.contains("views") && v["views"].is_object() && v["views"].value("follow_scene", false)) {
+      if (trials[i].settings.views.follow_scene) {
         scene_set_elevation_deg(src.dataset);  // InputError naming the file and the field
         break;
       }

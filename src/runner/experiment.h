@@ -15,6 +15,7 @@
 #include "core/hash.h"
 #include "core/yaml.h"
 #include "io/bop.h"
+#include "recognition/settings.h"
 
 namespace pb {
 
@@ -54,9 +55,10 @@ struct SceneSource {
   // Overrides of the scene config (`generator:`), merged into it section by
   // section (JSON merge patch): {images: 60}, {warehouse: {wall: true}}.
   nlohmann::json generator_overrides = nlohmann::json::object();
-  // Recognition settings overrides for this scene (YAML sections, as in
-  // `settings`), as in the thesis's per-scenario Tables 4.2 and 4.8.
-  nlohmann::json settings = nlohmann::json::object();
+  // The recognition settings of this scene's trials: the experiment's
+  // `settings` with the scene's own `settings` read over them (as in the
+  // thesis's per-scenario Tables 4.2 and 4.8).
+  RecognitionSettings settings;
 };
 
 struct Thresholds {
@@ -83,6 +85,14 @@ inline constexpr const char* kEveryTargetObject = "all";
 // `object: all` a generated scene takes them).
 inline constexpr const char* kGeneratedTargets = "test_targets_bop19.json";
 
+// One axis of the parameter grid: a setting's dotted path (e.g.
+// "global.top_k") and its values, each applied over a scene's settings by
+// apply_setting (recognition/settings.h).
+struct GridAxis {
+  std::string path;
+  std::vector<YamlNode> values;  // the config's own nodes (errors name their line)
+};
+
 struct ExperimentConfig {
   std::string file;                 // the YAML it came from
   std::string name;                 // experiment name (default: file stem)
@@ -91,10 +101,9 @@ struct ExperimentConfig {
   std::vector<SceneSource> scenes;
   std::vector<std::string> descriptors;
   std::vector<std::string> refinements{"icp"};
-  // Parameter grid: dotted setting path (e.g. "global.top_k") -> values.
-  std::vector<std::pair<std::string, std::vector<nlohmann::json>>> grid;
+  std::vector<GridAxis> grid;       // the parameter grid, in declaration order
   std::vector<double> added_noise_mm{0.0};  // extra Gaussian depth noise per trial
-  nlohmann::json settings = nlohmann::json::object();  // base recognition settings sections
+  RecognitionSettings settings;     // the recognition settings of `settings:` (each scene's start from them)
   Thresholds thresholds;
   double timeout_s = 300;           // a trial running longer is recorded as "timeout"
   bool registration_only = false;   // Table 4.9: refine from perturbed ground truth
@@ -127,7 +136,7 @@ struct Trial {
   std::string descriptor, refinement;
   nlohmann::json params;  // grid point: dotted path -> value
   double added_noise_mm = 0;
-  nlohmann::json settings;  // full recognition settings sections for this trial
+  RecognitionSettings settings;  // the trial's settings, lengths still relative (resolve_for_scene)
   uint64_t seed = 0;
 };
 

@@ -17,8 +17,10 @@ namespace pb::experiment_detail {
 std::string resolve(const std::string& base_file, const std::string& p);
 // InputError at `node` for a refinement name the registry does not know.
 void check_refinements(const YamlNode& node, const std::vector<std::string>& names);
-// One entry of `scenes:`; `names` collects the names seen (duplicates fail).
-SceneSource parse_scene(const YamlNode& s, const std::string& path, std::set<std::string>& names);
+// One entry of `scenes:`, its settings read over `settings` (the
+// experiment's); `names` collects the names seen (duplicates fail).
+SceneSource parse_scene(const YamlNode& s, const std::string& path, const RecognitionSettings& settings,
+                        std::set<std::string>& names);
 // Each twin_of names a real set of the experiment; a generated twin takes
 // its real set's split, scene_ids, images, image_stride, targets and
 // scenario.

@@ -65,7 +65,8 @@ void parse_twin(const YamlNode& t, const std::string& path, SceneSource& src) {
 
 }  // namespace
 
-SceneSource parse_scene(const YamlNode& s, const std::string& path, std::set<std::string>& names) {
+SceneSource parse_scene(const YamlNode& s, const std::string& path, const RecognitionSettings& settings,
+                        std::set<std::string>& names) {
   s.check_keys({"name", "generate", "dataset", "clouds", "cloud", "split", "scene_ids", "images", "targets",
                 "scenario", "generator", "settings", "refinements", "twin_of", "twin", "image_stride"});
   SceneSource src;
@@ -114,10 +115,7 @@ SceneSource parse_scene(const YamlNode& s, const std::string& path, std::set<std
     if (src.generate.empty()) s["generator"].fail("only valid with 'generate'");
     src.generator_overrides = s["generator"].json();
   }
-  if (s.has("settings")) {
-    parse_recognition_settings(s["settings"]);
-    src.settings = s["settings"].json();
-  }
+  src.settings = parse_recognition_settings(s["settings"], settings);
   return src;
 }
 

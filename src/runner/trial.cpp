@@ -31,8 +31,8 @@ struct WorkerCache {
   std::map<std::string, std::unique_ptr<Mesh>> meshes;
   std::map<std::string, std::unique_ptr<DepthRenderer>> renderers;  // by intrinsics, for VSD
   std::map<std::string, SceneInfo> scenes;        // each scene's JSON files, read once
-  std::map<std::string, double> sensor_floors;     // each scene's sensor floor (from its first image),
-                                                   // by scene and scale settings
+  std::map<std::string, DepthImage> first_depths;  // each scene's first image (the sensor floor of
+                                                   // relative lengths: resolve_for_scene)
   std::map<std::string, double> view_elevations;   // views.follow_scene: each scene set's, read once
 };
 WorkerCache& cache() {
@@ -208,27 +208,18 @@ void run(TrialRecord& rec, const TrialContext& ctx) {
   DepthImage depth = depth_clean;
   add_noise(depth, rec.added_noise_mm, rec.seed);
 
-  // Relative lengths in mm, for the object's diameter and the sensor's floor
-  // at the scene's first image (the same for every image of the scene; once
-  // per scene and scale settings).
-  RecognitionSettings parsed =
+  // The trial's settings (the changes from the defaults the runner sent),
+  // lengths in mm for the object and the scene (resolve_for_scene).
+  const RecognitionSettings configured =
       parse_recognition_settings(YamlNode::load_string(rec.settings.dump(), "trial " + rec.key));
   const ImageInfo& first = scene.images.begin()->second;
-  if (needs_sensor_floor(parsed)) {
-    char scale_key[96];
-    std::snprintf(scale_key, sizeof scale_key, "#%.17g#%.17g#%.17g", parsed.scale.sensor_floor_px,
-                  parsed.scale.sensor_floor_sigmas, parsed.scale.working_distance_mm);
-    const std::string floor_key = scene_key + scale_key;
-    auto floor_it = cache().sensor_floors.find(floor_key);
-    if (floor_it == cache().sensor_floors.end()) {
-      const double floor = sensor_length_floor_mm(
-          parsed.scale, first.im_id == im.im_id ? depth_clean : ds.load_depth(rec.split, rec.scene_id, first),
-          first.K);
-      floor_it = cache().sensor_floors.emplace(floor_key, floor).first;
-    }
-    parsed.scale.min_length_mm = floor_it->second;
-  }
-  RecognitionSettings s = resolve_lengths(parsed, ds.model_info(obj_id).diameter);
+  auto first_it = cache().first_depths.find(scene_key);
+  if (first_it == cache().first_depths.end())
+    first_it = cache()
+                   .first_depths
+                   .emplace(scene_key, first.im_id == im.im_id ? depth_clean : ds.load_depth(rec.split, rec.scene_id, first))
+                   .first;
+  RecognitionSettings s = resolve_for_scene(configured, ds.model_info(obj_id).diameter, first_it->second, first.K);
   RecognitionSettings st = s;  // training keeps the settings' seed
   s.seed = rec.seed;
   rec.settings_resolved = nlohmann::json::parse(settings_to_json(s));
@@ -320,7 +311,7 @@ TrialRecord trial_record(const Trial& t) {
   if (t.inst_count > 0) r.inst_count = t.inst_count;
   r.params = t.params;
   r.added_noise_mm = t.added_noise_mm;
-  r.settings = t.settings;
+  r.settings = settings_changes_json(t.settings);
   r.seed = t.seed;
   r.status = "pending";  // the worker sets the outcome
   return r;

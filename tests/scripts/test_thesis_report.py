@@ -721,8 +721,9 @@ class Schema(unittest.TestCase):
         printed = json.loads(r.stdout)["fields"]
         copy = RECORD_SCHEMA["fields"]
         differing = sorted(k for k in set(printed) | set(copy) if printed.get(k) != copy.get(k))
-        self.assertEqual(differing, [], "RECORD_SCHEMA in scripts/thesis_report/schema.py differs from `posebench "
-                                        "schema record` in these keys; update the copy")
+        self.assertEqual(differing, [], "scripts/thesis_report/record_schema.json differs from `posebench schema "
+                                        "record` in these keys; rewrite it: build/posebench schema record > "
+                                        "scripts/thesis_report/record_schema.json")
 
     def test_the_binarys_schema_is_used_when_there_is_one(self):
         with tempfile.TemporaryDirectory() as d:
