@@ -8,6 +8,7 @@
 
 #include "eval/bop_metrics.h"
 #include "eval/bop_metrics_internal.h"
+#include "eval/judge.h"
 
 namespace pb {
 
@@ -15,30 +16,23 @@ using bop_detail::top_estimates;
 
 namespace {
 
-// The toolkit's match_poses for one image and object: the number of matches.
-// err(e, p) gives the normalized error of estimate e's pair p.
+// The toolkit's match_poses for one image and object (match_in_order,
+// eval/judge.h): the number of matches. err(e, p) gives the normalized
+// error of estimate e's pair p; an estimate matches below `th`.
 template <class ErrFn>
 int count_matches(const BopImageErrors& im, const std::vector<int>& ests, double th, ErrFn err) {
-  std::vector<char> matched(im.gts.size(), 0);
-  int n = 0;
-  for (int e : ests) {
-    const BopEstimateErrors& est = im.estimates[e];
-    int best_gt = -1;
-    double best = th;
-    for (size_t p = 0; p < est.pairs.size(); ++p) {
-      const int g = est.pairs[p].gt;
-      if (!im.gts[g].valid || matched[g]) continue;
-      const double x = err(est, est.pairs[p]);
-      if (x < best) {
-        best = x;
-        best_gt = g;
-      }
-    }
-    if (best_gt >= 0) {
-      matched[best_gt] = 1;
-      ++n;
-    }
+  // Each estimate's error against each valid instance (infinite: no pair).
+  std::vector<std::vector<double>> x(ests.size(),
+                                     std::vector<double>(im.gts.size(), std::numeric_limits<double>::infinity()));
+  for (size_t i = 0; i < ests.size(); ++i) {
+    const BopEstimateErrors& est = im.estimates[ests[i]];
+    for (const BopPairErrors& p : est.pairs)
+      if (im.gts[p.gt].valid) x[i][p.gt] = err(est, p);
   }
+  int n = 0;
+  for (const InstanceMatch& m : match_in_order(ests.size(), im.gts.size(), [&](size_t e, size_t g) { return x[e][g]; },
+                                               [&](size_t e, size_t g) { return x[e][g] < th; }))
+    n += m.taken;
   return n;
 }
 
