@@ -27,7 +27,7 @@ def struct_docs(text):
     """{frozenset of fields() keys: {key: doc}} for each struct with a fields() list."""
     out = {}
     lines = text.split("\n")
-    for m in re.finditer(r"\bstruct\s+\w+\s*{", text):
+    for m in re.finditer(r"\bstruct\s+\w+\s*(?::[^{;]*)?{", text):
         start = text.count("\n", 0, m.start())
         depth, end = 0, None
         for i in range(start, len(lines)):
@@ -89,6 +89,19 @@ def collect_docs(src):
     return docs
 
 
+def section_docs(keys, docs):
+    """The docs of the struct whose fields() keys are the section's, else
+    those of the structs whose keys together make it up (a struct with a
+    base, as RefineSettings lists RegistrationSettings' fields first)."""
+    if keys in docs:
+        return docs[keys]
+    out = {}
+    for struct_keys, d in docs.items():
+        if struct_keys <= keys:
+            out.update(d)
+    return out
+
+
 def fmt(v):
     return json.dumps(v) if not isinstance(v, str) else v
 
@@ -108,8 +121,7 @@ def render(schema, docs):
         out.append(f"- `{key}`: {e['type']}, default `{fmt(e['default'])}`; {e['accepts']}")
     out.append("")
     for sec in schema["sections"]:
-        keys = frozenset(f["key"] for f in sec["fields"])
-        doc = docs.get(keys, {})
+        doc = section_docs(frozenset(f["key"] for f in sec["fields"]), docs)
         out += [f"## {sec['name']}", ""]
         for f in sec["fields"]:
             accepts = f"; {f['accepts']}" if f["accepts"] else ""

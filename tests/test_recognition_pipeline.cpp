@@ -125,7 +125,7 @@ TEST_F(Pipeline, FindsTheLBlockWithFpfhAndIcp) {
 // answer is the same pose bit for bit.
 TEST_F(Pipeline, MaxHypothesesRefinesTheMostPromisingExactlyAsBefore) {
   pb::RecognitionSettings s = small_settings("fpfh");
-  s.refine.icp_sample_points = 150;
+  s.refine.icp.sample_points = 150;
   pb::RecognitionResult all;
   const auto model = trained_and_all_refined(s, &all);
   ASSERT_GT(all.hypotheses.size(), 3u) << all.message;

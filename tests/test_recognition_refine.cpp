@@ -4,7 +4,8 @@
 // asymmetric object, must converge to within 5 mm and 2 degrees in at least
 // 90% of them; NDT is held to what it was measured to reach, minus a margin.
 // Also: determinism (same inputs -> same pose bits), unknown names, empty
-// inputs, YAML parsing.
+// inputs, YAML parsing, the methods built by name with their own settings
+// subsection.
 #include <gtest/gtest.h>
 
 #include <tuple>
@@ -20,6 +21,8 @@
 #include "core/yaml.h"
 #include "recognition/kdtree.h"
 #include "recognition/refine/refine.h"
+#include "recognition/registry.h"
+#include "recognition/settings.h"
 #include "test_recognition_refine_scenes.h"
 
 namespace pb {
@@ -89,7 +92,7 @@ TEST_F(RefineCases, IcpConverges) { EXPECT_GE(run_method(cases_, "icp", RefineSe
 // as sparse as the scene: 100 points gave 9 of 20, 300 gave 16 to 19).
 TEST_F(RefineCases, IcpOnRandomSubsetConverges) {
   RefineSettings s;
-  s.icp_sample_points = 500;
+  s.icp.sample_points = 500;
   EXPECT_GE(run_method(cases_, "icp", s).ok, 17);
 }
 
@@ -98,7 +101,7 @@ TEST_F(RefineCases, IcpOnRandomSubsetConverges) {
 // (0.25 mm on every point).
 TEST_F(RefineCases, IcpPlaneOnRandomSubsetConverges) {
   RefineSettings s;
-  s.icp_sample_points = 200;
+  s.icp.sample_points = 200;
   const Rate sub = run_method(cases_, "icp_plane", s), all = run_method(cases_, "icp_plane", RefineSettings{});
   EXPECT_GE(sub.ok, all.ok - 1);
   EXPECT_LT(sub.sum_t / cases_.size(), all.sum_t / cases_.size() + 0.5);
@@ -109,16 +112,16 @@ TEST_F(RefineCases, IcpPlaneOnRandomSubsetConverges) {
   EXPECT_NE(a.T_cam_model.t, b.T_cam_model.t);
 }
 
-// Coarse to fine (icp_coarse_points): a third of the ~1000 model points
+// Coarse to fine (icp.coarse_points): a third of the ~1000 model points
 // first, then all of them. Held to the one-stage run on every point: at most
 // one case fewer within 5 mm / 2 deg and mean errors within 0.3 mm and 0.3
 // degrees; never more than max_iterations in total. A coarse subset at least
 // as large as the source is the one-stage run, bit for bit.
 TEST_F(RefineCases, CoarseToFineKeepsTheOneStageAccuracy) {
   RefineSettings one, two, big;
-  one.icp_coarse_points = 0;
-  two.icp_coarse_points = 300;
-  big.icp_coarse_points = 100000;
+  one.icp.coarse_points = 0;
+  two.icp.coarse_points = 300;
+  big.icp.coarse_points = 100000;
   for (const std::string method : {"icp", "icp_plane"}) {
     SCOPED_TRACE(method);
     const Rate a = run_method(cases_, method, one), b = run_method(cases_, method, two);
@@ -146,7 +149,7 @@ TEST_F(RefineCases, GicpConverges) { EXPECT_GE(run_method(cases_, "gicp", Refine
 
 TEST_F(RefineCases, GicpWithPclCovariancesConverges) {
   RefineSettings s;
-  s.gicp_covariances_from_normals = false;
+  s.gicp.covariances_from_normals = false;
   EXPECT_GE(run_method(cases_, "gicp", s).ok, 18);
 }
 
@@ -182,18 +185,18 @@ TEST(Refine, PointToPointWithModelAtSceneVoxel) {
 // the smaller on the subset).
 TEST_F(RefineCases, OwnIcpAgreesWithStockPclCaseByCase) {
   RefineSettings plain, no_recip, sub;
-  plain.icp_coarse_points = 0;  // PCL's one stage
+  plain.icp.coarse_points = 0;  // PCL's one stage
   no_recip = sub = plain;
   no_recip.reciprocal_correspondences = false;
-  sub.icp_sample_points = 150;
+  sub.icp.sample_points = 150;
   const std::vector<std::tuple<std::string, std::string, RefineSettings>> pairs = {
       {"icp", "icp_pcl", plain},           {"icp", "icp_pcl", no_recip},
       {"icp", "icp_pcl", sub},             {"icp_plane", "icp_plane_pcl", plain},
       {"icp_plane", "icp_plane_pcl", no_recip}};
   for (const auto& [own, pcl, s] : pairs) {
     SCOPED_TRACE(own + " reciprocal " + std::to_string(s.reciprocal_correspondences) + " subset " +
-                 std::to_string(s.icp_sample_points));
-    for (size_t i = 0; i < cases_.size() && s.icp_sample_points == 0; ++i) {
+                 std::to_string(s.icp.sample_points));
+    for (size_t i = 0; i < cases_.size() && s.icp.sample_points == 0; ++i) {
       const auto& c = cases_[i];
       const RefineResult a = refine_pose(own, c.model, c.scene, c.init, s, derive_seed(kSeed, {7, i}));
       const RefineResult b = refine_pose(pcl, c.model, c.scene, c.init, s, derive_seed(kSeed, {7, i}));
@@ -210,7 +213,7 @@ TEST_F(RefineCases, OwnIcpAgreesWithStockPclCaseByCase) {
 
 TEST_F(RefineCases, SameInputsGiveSamePoseBits) {
   RefineSettings sub;
-  sub.icp_sample_points = 100;
+  sub.icp.sample_points = 100;
   const std::vector<std::pair<std::string, RefineSettings>> runs = {
       {"icp", RefineSettings{}}, {"icp", sub},  {"icp_lm", RefineSettings{}}, {"icp_plane", RefineSettings{}},
       {"gicp", RefineSettings{}}, {"ndt", RefineSettings{}}};
@@ -240,8 +243,8 @@ TEST_F(RefineCases, SameInputsGiveSamePoseBits) {
 TEST_F(RefineCases, OwnIcpPosesAreTheRecordedBits) {
   RefineSettings one_way, sub, coarse;
   one_way.reciprocal_correspondences = false;
-  sub.icp_sample_points = 100;
-  coarse.icp_coarse_points = 200;
+  sub.icp.sample_points = 100;
+  coarse.icp.coarse_points = 200;
   std::string bytes;
   for (const std::string method : {"icp", "icp_plane"})
     for (const RefineSettings& s : {RefineSettings{}, one_way, sub, coarse})
@@ -350,10 +353,11 @@ TEST(Refine, EmptyOrFarCloudsReturnTheInitialPose) {
 TEST(Refine, ParseReadsEveryFieldAndRejectsBadOnes) {
   const YamlNode n = YamlNode::load_string(
       "refine:\n  max_iterations: 25\n  max_correspondence_mm: 15\n  transformation_epsilon: 1e-9\n"
-      "  rotation_epsilon_deg: 0.1\n  fitness_epsilon: 1e-5\n  icp_sample_points: 200\n"
-      "  ndt_resolution_mm: 30\n  ndt_resolution_fraction: 0.2\n  ndt_step_size_mm: 5\n"
-      "  ndt_outlier_ratio: 0.4\n  ndt_min_points_per_cell: 4\n  gicp_correspondence_randomness: 10\n"
-      "  gicp_covariances_from_normals: false\n  crop_margin_mm: 30\n  normal_neighbours: 12\n",
+      "  rotation_epsilon_deg: 0.1\n  fitness_epsilon: 1e-5\n  crop_margin_mm: 30\n  normal_neighbours: 12\n"
+      "  icp: {sample_points: 200, coarse_points: 400, fine_iterations: 5}\n"
+      "  ndt:\n    resolution_mm: 30\n    resolution_fraction: 0.2\n    step_size_mm: 5\n"
+      "    outlier_ratio: 0.4\n    min_points_per_cell: 4\n"
+      "  gicp: {correspondence_randomness: 10, covariances_from_normals: false}\n",
       "cfg.yaml");
   RefineSettings s;
   parse_section(n["refine"], s);
@@ -362,14 +366,16 @@ TEST(Refine, ParseReadsEveryFieldAndRejectsBadOnes) {
   EXPECT_EQ(s.transformation_epsilon, 1e-9);
   EXPECT_EQ(s.rotation_epsilon_deg, 0.1);
   EXPECT_EQ(s.fitness_epsilon, 1e-5);
-  EXPECT_EQ(s.icp_sample_points, 200);
-  EXPECT_EQ(s.ndt_resolution_mm, 30);
-  EXPECT_EQ(s.ndt_resolution_fraction, 0.2);
-  EXPECT_EQ(s.ndt_step_size_mm, 5);
-  EXPECT_EQ(s.ndt_outlier_ratio, 0.4);
-  EXPECT_EQ(s.ndt_min_points_per_cell, 4);
-  EXPECT_EQ(s.gicp_correspondence_randomness, 10);
-  EXPECT_FALSE(s.gicp_covariances_from_normals);
+  EXPECT_EQ(s.icp.sample_points, 200);
+  EXPECT_EQ(s.icp.coarse_points, 400);
+  EXPECT_EQ(s.icp.fine_iterations, 5);
+  EXPECT_EQ(s.ndt.resolution_mm, 30);
+  EXPECT_EQ(s.ndt.resolution_fraction, 0.2);
+  EXPECT_EQ(s.ndt.step_size_mm, 5);
+  EXPECT_EQ(s.ndt.outlier_ratio, 0.4);
+  EXPECT_EQ(s.ndt.min_points_per_cell, 4);
+  EXPECT_EQ(s.gicp.correspondence_randomness, 10);
+  EXPECT_FALSE(s.gicp.covariances_from_normals);
   EXPECT_EQ(s.crop_margin_mm, 30);
   EXPECT_EQ(s.normal_neighbours, 12);
 
@@ -387,9 +393,45 @@ TEST(Refine, ParseReadsEveryFieldAndRejectsBadOnes) {
   fails("refine:\n  max_iterationz: 3\n", "refine.max_iterationz");
   fails("refine:\n  max_iterations: 0\n", "refine.max_iterations");
   fails("refine:\n  max_correspondence_mm: -1\n", "refine.max_correspondence_mm");
-  fails("refine:\n  ndt_outlier_ratio: 1.5\n", "refine.ndt_outlier_ratio");
-  fails("refine:\n  ndt_min_points_per_cell: 2\n", "refine.ndt_min_points_per_cell");
-  fails("refine:\n  icp_sample_points: many\n", "refine.icp_sample_points");
+  fails("refine:\n  ndt:\n    outlier_ratio: 1.5\n", "refine.ndt.outlier_ratio");
+  fails("refine:\n  ndt: {min_points_per_cell: 2}\n", "refine.ndt.min_points_per_cell");
+  fails("refine:\n  icp: {sample_points: many}\n", "refine.icp.sample_points");
+  fails("refine:\n  icp: {samples: 3}\n", "refine.icp.samples");
+  fails("refine:\n  icp_sample_points: 200\n", "refine.icp_sample_points");  // unknown: it is icp.sample_points
+}
+
+// Each method is built by name from the registry with the common settings
+// and its own subsection; "none" is no method.
+TEST(Refine, MethodsAreBuiltByNameWithTheirOwnSection) {
+  RefineSettings s;
+  EXPECT_EQ(make_refiner("none", s), nullptr);
+  EXPECT_FALSE(make_refiner("icp", s)->needs_normals());
+  EXPECT_TRUE(make_refiner("icp_plane", s)->needs_normals());
+  EXPECT_TRUE(make_refiner("icp_plane_pcl", s)->needs_normals());
+  EXPECT_FALSE(make_refiner("ndt", s)->needs_normals());
+  EXPECT_TRUE(make_refiner("gicp", s)->needs_normals());
+  s.gicp.covariances_from_normals = false;
+  EXPECT_FALSE(make_refiner("gicp", s)->needs_normals());
+  EXPECT_THROW(make_refiner("icp2", s), InputError);
+  for (const auto& e : refinement_registry())
+    EXPECT_TRUE(e.section.empty() || e.section == "icp" || e.section == "gicp" || e.section == "ndt") << e.name;
+}
+
+// A nested section's lengths may be relative ("refine.ndt.resolution_mm"),
+// are written back so in the JSON, nested, and resolve like the others.
+TEST(Refine, NestedSectionsTakeRelativeLengths) {
+  const RecognitionSettings s = parse_recognition_settings(
+      YamlNode::load_string("refine:\n  ndt: {resolution_mm: 0.2d, step_size_mm: 50}\n", "cfg.yaml"));
+  EXPECT_EQ(s.relative.at("refine.ndt.resolution_mm"), 0.2);
+  EXPECT_EQ(s.relative.count("refine.ndt.step_size_mm"), 0u);
+  const auto j = recognition_settings_json(s);
+  EXPECT_EQ(j["refine"]["ndt"]["resolution_mm"], "0.2d");
+  EXPECT_EQ(j["refine"]["ndt"]["step_size_mm"], 50.0);
+  EXPECT_EQ(j["refine"]["icp"]["coarse_points"], 1000);
+  const RecognitionSettings r = resolve_lengths(s, 100);
+  EXPECT_DOUBLE_EQ(r.refine.ndt.resolution_mm, 20);
+  EXPECT_DOUBLE_EQ(r.refine.ndt.step_size_mm, 50);
+  EXPECT_TRUE(RecognitionSettings().relative.count("refine.ndt.step_size_mm"));
 }
 
 }  // namespace

@@ -17,6 +17,12 @@
 // positive, got -3", "must be in [0, 1]", ...), with file, line and key
 // through YamlNode::fail.
 //
+// A field may also be a nested section, a settings struct of its own under
+// a key of the parent's YAML section (`refine: {ndt: {resolution_mm: 30}}`):
+// `f.section("ndt", s.ndt)` in the parent's fields list. Every visitor has
+// a section(key, sub) member; keys inside it are "PARENT.key.field" in the
+// relative map and in messages.
+//
 // A length field (rule wrapped in fields::length) may also be given as a
 // fraction of the object's diameter, `voxel_mm: 0.05d`, when the caller
 // passes a `relative` map: the fraction is kept there under "PREFIX.key" and
@@ -76,10 +82,23 @@ std::string rule_text(const Rule& r);
 void check(const YamlNode& node, double v, const Rule& r);
 void check(const YamlNode& node, const std::string& v, const Rule& r);
 
+// A visitor with a `prefix` member visits a nested section as a copy of
+// itself with the prefix extended by "key.".
+template <typename V, typename Sub>
+void nested(const V& v, const char* key, Sub& sub) {
+  V inner = v;
+  inner.prefix = v.prefix + key + ".";
+  std::decay_t<Sub>::fields(sub, inner);
+}
+
 struct KeyLister {
   std::set<std::string> keys;
   template <typename T>
   void operator()(const char* key, const T&, const Rule& = {}) {
+    keys.insert(key);
+  }
+  template <typename Sub>
+  void section(const char* key, const Sub&) {
     keys.insert(key);
   }
 };
@@ -117,6 +136,8 @@ struct Reader {
       check(n, static_cast<double>(v), r);
     }
   }
+  template <typename Sub>
+  void section(const char* key, Sub& sub);  // parse_section of node[key], below
 };
 
 struct JsonWriter {
@@ -134,12 +155,20 @@ struct JsonWriter {
     }
     j[key] = v;
   }
+  template <typename Sub>
+  void section(const char* key, const Sub& sub) {
+    JsonWriter inner{nlohmann::ordered_json::object(), relative, prefix + key + "."};
+    Sub::fields(sub, inner);
+    j[key] = std::move(inner.j);
+  }
 };
 
 // Every field's key, type, default and rule_text: the settings reference
 // (`posebench schema settings`, docs/settings.md).
 struct SchemaWriter {
   nlohmann::ordered_json fields = nlohmann::ordered_json::array();
+  nlohmann::ordered_json sections = nlohmann::ordered_json::array();  // nested: {name, fields}, names
+                                                                       // "key" or "key.inner"
   const std::map<std::string, double>* relative = nullptr;  // defaults given as fractions
   std::string prefix;
   template <typename T>
@@ -154,6 +183,18 @@ struct SchemaWriter {
     else f["default"] = v;
     f["accepts"] = rule_text(r);
     fields.push_back(std::move(f));
+  }
+  template <typename Sub>
+  void section(const char* key, const Sub& sub) {
+    SchemaWriter inner;
+    inner.relative = relative;
+    inner.prefix = prefix + key + ".";
+    Sub::fields(sub, inner);
+    sections.push_back({{"name", key}, {"fields", std::move(inner.fields)}});
+    for (auto& s : inner.sections) {
+      s["name"] = std::string(key) + "." + s["name"].get<std::string>();
+      sections.push_back(std::move(s));
+    }
   }
 };
 
@@ -182,6 +223,11 @@ void parse_section(const YamlNode& node, S& s, std::map<std::string, double>* re
 }
 
 // Every field, in declaration order; fields in `relative` as "0.05d".
+template <typename Sub>
+void fields::Reader::section(const char* key, Sub& sub) {
+  if (node.has(key)) parse_section(node[key], sub, relative, prefix + key + ".", given_relative);
+}
+
 template <typename S>
 nlohmann::ordered_json section_json(const S& s, const std::map<std::string, double>* relative = nullptr,
                                     const std::string& prefix = "") {

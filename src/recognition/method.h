@@ -32,9 +32,11 @@ class Method {
   virtual void save(BinaryWriter& out) const = 0;
   virtual void load(BinaryReader& in) = 0;
   // Online: preprocessed scene (plane removed, normals) -> hypotheses of
-  // T_cam_model, best first (Hypothesis::view set). Fills times.describe,
-  // match, group, initial_pose. Must be const and thread-safe; random
-  // choices draw from `seed`.
+  // T_cam_model, best first (Hypothesis::view set). Must be const and
+  // thread-safe; random choices draw from `seed`. A method writes its
+  // stages (describe, match, group, initial_pose) as functions and
+  // implements this as run_stages (stages.h), which times them into
+  // times.describe, match, group and initial_pose.
   virtual std::vector<Hypothesis> hypothesize(const PointSet& scene, const std::vector<ViewData>& views,
                                               uint64_t seed, StageTimes& times) const = 0;
 };

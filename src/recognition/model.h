@@ -8,8 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "core/training_views.h"
 #include "recognition/method.h"
-#include "recognition/pipeline.h"
+#include "recognition/settings.h"
 
 namespace pb {
 

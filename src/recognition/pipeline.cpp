@@ -65,6 +65,7 @@ void refine_all(std::vector<Hypothesis>& hyps, const std::vector<uint64_t>& stre
                 const PointSet& scene, const PointIndex& index, const RecognitionSettings& s,
                 const std::vector<PointSet>* sources = nullptr) {
   for (const auto& h : hyps) model.model_cloud(h.view);  // throws for a view index out of range
+  const std::unique_ptr<Refiner> refiner = make_refiner(s.refinement, s.refine);
   const long nh = static_cast<long>(hyps.size());
   std::vector<std::exception_ptr> errors(hyps.size());
 #pragma omp parallel for schedule(dynamic, 1)
@@ -72,7 +73,7 @@ void refine_all(std::vector<Hypothesis>& hyps, const std::vector<uint64_t>& stre
     try {
       Hypothesis& h = hyps[static_cast<size_t>(i)];
       const PointSet& source = sources ? (*sources)[static_cast<size_t>(i)] : model.model_cloud(h.view);
-      const RefineResult r = refine_pose(s.refinement, source, scene, h.T_cam_model, s.refine,
+      const RefineResult r = refine_pose(refiner.get(), source, scene, h.T_cam_model, s.refine,
                                          derive_seed(s.seed, {kStreamRefine, stream[static_cast<size_t>(i)]}),
                                          &index.tree());
       if (finite_pose(r.T_cam_model)) {

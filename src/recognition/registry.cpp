@@ -24,17 +24,17 @@ const std::vector<DescriptorEntry>& descriptor_registry() {
 }
 
 const std::vector<RefinementEntry>& refinement_registry() {
-  using namespace refine_detail;
-  auto no = [](const RefineSettings&) { return false; };
+  // Each factory takes the RegistrationSettings part of `refine` and its own
+  // subsection.
   static const std::vector<RefinementEntry> v = {
-      {"none", no, nullptr},
-      {"icp", no, run_icp},
-      {"icp_lm", no, run_icp_lm},
-      {"icp_plane", [](const RefineSettings&) { return true; }, run_icp_plane},
-      {"icp_pcl", no, run_icp_pcl},
-      {"icp_plane_pcl", [](const RefineSettings&) { return true; }, run_icp_plane_pcl},
-      {"gicp", [](const RefineSettings& s) { return s.gicp_covariances_from_normals; }, run_gicp},
-      {"ndt", no, run_ndt},
+      {"none", "", [](const RefineSettings&) { return std::unique_ptr<Refiner>(); }},
+      {"icp", "icp", [](const RefineSettings& s) { return make_icp_refiner(s, s.icp); }},
+      {"icp_lm", "", [](const RefineSettings& s) { return make_icp_lm_refiner(s); }},
+      {"icp_plane", "icp", [](const RefineSettings& s) { return make_icp_plane_refiner(s, s.icp); }},
+      {"icp_pcl", "icp", [](const RefineSettings& s) { return make_icp_pcl_refiner(s, s.icp); }},
+      {"icp_plane_pcl", "", [](const RefineSettings& s) { return make_icp_plane_pcl_refiner(s); }},
+      {"gicp", "gicp", [](const RefineSettings& s) { return make_gicp_refiner(s, s.gicp); }},
+      {"ndt", "ndt", [](const RefineSettings& s) { return make_ndt_refiner(s, s.ndt); }},
   };
   return v;
 }
@@ -85,6 +85,10 @@ std::string check_name(const YamlNode& node, const std::vector<std::string>& all
 std::unique_ptr<Method> make_method(const RecognitionSettings& s) {
   silence_pcl_console();
   return descriptor_entry(s.descriptor).make(s);
+}
+
+std::unique_ptr<Refiner> make_refiner(const std::string& name, const RefineSettings& s) {
+  return refinement_entry(name).make(s);
 }
 
 }  // namespace pb

@@ -9,7 +9,7 @@
 
 #include "core/yaml.h"
 #include "recognition/method.h"
-#include "recognition/refine/internal.h"
+#include "recognition/refine/refiner.h"
 
 namespace pb {
 
@@ -23,9 +23,11 @@ struct DescriptorEntry {
 
 struct RefinementEntry {
   std::string name;
-  bool (*needs_normals)(const RefineSettings& s);  // both clouds need normals (plane metrics)
-  // Aligns p.src to p.tgt (refine/internal.h); null for "none".
-  refine_detail::Outcome (*run)(const refine_detail::Problem& p, const RefineSettings& s, uint64_t seed);
+  std::string section;  // the subsection of `refine` the method reads besides the common settings
+                        // ("icp", "gicp", "ndt"; "" = none)
+  // Builds the method with the common settings and that subsection alone;
+  // null for "none" (no registration).
+  std::unique_ptr<Refiner> (*make)(const RefineSettings& s);
 };
 
 const std::vector<DescriptorEntry>& descriptor_registry();
@@ -42,5 +44,7 @@ const RefinementEntry& refinement_entry(const std::string& name, const std::stri
 std::string check_name(const YamlNode& node, const std::vector<std::string>& allowed);
 
 std::unique_ptr<Method> make_method(const RecognitionSettings& s);  // for s.descriptor
+// The refinement method `name` (InputError when unknown); null for "none".
+std::unique_ptr<Refiner> make_refiner(const std::string& name, const RefineSettings& s);
 
 }  // namespace pb

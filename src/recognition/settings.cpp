@@ -44,6 +44,10 @@ struct Resolver {
       if (it != relative.end()) v = std::max(it->second * d, floor);
     }
   }
+  template <typename Sub>
+  void section(const char* key, Sub& sub) {
+    fields::nested(*this, key, sub);
+  }
 };
 
 // Every length field's value in a default-constructed RecognitionSettings
@@ -56,6 +60,10 @@ struct LengthCollector {
   void operator()(const char* key, const T& v, const fields::Rule& r = {}) {
     if constexpr (std::is_floating_point_v<T>)
       if (r.length) out[prefix + key] = v;
+  }
+  template <typename Sub>
+  void section(const char* key, Sub& sub) {
+    fields::nested(*this, key, sub);
   }
 };
 const std::map<std::string, double>& placeholders() {
@@ -92,6 +100,10 @@ struct PlaceholderVisitor {
                                "\" from RecognitionSettings::relative to use mm");
       }
     }
+  }
+  template <typename Sub>
+  void section(const char* key, Sub& sub) {
+    fields::nested(*this, key, sub);
   }
 };
 
@@ -154,6 +166,10 @@ nlohmann::ordered_json recognition_settings_schema() {
     w.prefix = std::string(name) + ".";
     std::decay_t<decltype(section)>::fields(section, w);
     j["sections"].push_back({{"name", name}, {"fields", std::move(w.fields)}});
+    for (auto& sub : w.sections) {  // nested sections as "section.sub"
+      sub["name"] = std::string(name) + "." + sub["name"].get<std::string>();
+      j["sections"].push_back(std::move(sub));
+    }
   });
   return j;
 }
@@ -166,7 +182,7 @@ const std::map<std::string, double>& default_relative_lengths() {
       {"local.hough_bin_mm", 0.25},            {"global.cluster_tolerance_mm", 0.06},
       {"global.cvfh_cluster_tolerance_mm", 0.075}, {"global.cvfh_normal_radius_mm", 0.10},
       {"ppf.position_cluster_mm", 0.15},       {"refine.max_correspondence_mm", 0.10},
-      {"refine.ndt_resolution_mm", 0.15},      {"refine.ndt_step_size_mm", 0.40},
+      {"refine.ndt.resolution_mm", 0.15},      {"refine.ndt.step_size_mm", 0.40},
       {"verify.inlier_threshold_mm", 0.05},    {"verify.instance_separation_mm", 0.20},
   };
   return m;

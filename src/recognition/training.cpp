@@ -6,6 +6,7 @@
 #include "core/file_lock.h"
 #include "core/random.h"
 #include "recognition/model.h"
+#include "recognition/pipeline.h"
 #include "recognition/preprocess/voxel_grid.h"
 #include "recognition/registry.h"
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <set>
 #include <sstream>
 
@@ -38,10 +39,16 @@ std::vector<ResolvedLengths> resolved_lengths(const std::vector<TrialRecord>& re
     };
     for (const char* section : kSections) {
       if (!s.contains(section) || !s[section].is_object()) continue;
-      for (auto f = s[section].begin(); f != s[section].end(); ++f) {
-        const std::string& k = f.key();
-        if (k.size() > 3 && k.compare(k.size() - 3, 3, "_mm") == 0) add(std::string(section) + "." + k, f.value());
-      }
+      // The section's *_mm fields and those of its nested sections (refine.ndt).
+      std::function<void(const std::string&, const nlohmann::json&)> lengths = [&](const std::string& prefix,
+                                                                                   const nlohmann::json& obj) {
+        for (auto f = obj.begin(); f != obj.end(); ++f) {
+          const std::string& k = f.key();
+          if (f.value().is_object()) lengths(prefix + k + ".", f.value());
+          else if (k.size() > 3 && k.compare(k.size() - 3, 3, "_mm") == 0) add(prefix + k, f.value());
+        }
+      };
+      lengths(std::string(section) + ".", s[section]);
     }
     if (s.contains("scale") && s["scale"].is_object() && s["scale"].contains("min_length_mm"))
       add("scale.min_length_mm", s["scale"]["min_length_mm"]);

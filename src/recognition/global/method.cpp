@@ -23,14 +23,15 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <tuple>
 
 #include "core/error.h"
 #include "core/random.h"
-#include "core/timer.h"
 #include "recognition/global/esf.h"
 #include "recognition/global/internal.h"
 #include "recognition/method.h"
+#include "recognition/stages.h"
 
 namespace pb {
 namespace global {
@@ -95,7 +96,7 @@ std::vector<Signature> signatures(Kind kind, const PointSet& cloud, const Global
 // The method's signatures of one cloud (a training view or a scene cluster),
 // with view_ray_axis the camera-to-centroid ray for an axis taken from a
 // mean normal (CVFH, CESF).
-std::vector<Signature> describe(Kind kind, const PointSet& cloud, const GlobalSettings& g, uint64_t seed) {
+std::vector<Signature> describe_cloud(Kind kind, const PointSet& cloud, const GlobalSettings& g, uint64_t seed) {
   std::vector<Signature> out = signatures(kind, cloud, g, seed);
   if (g.view_ray_axis && (kind == Kind::kCvfh || kind == Kind::kCesf))
     for (Signature& s : out)
@@ -170,6 +171,23 @@ Mat3 nearest_rotation(const Mat3& M) {
   return U * V.transpose();
 }
 
+// The scene's clusters and their signatures (the describe stage).
+struct SceneSignatures {
+  std::vector<PointSet> clusters;  // Euclidean clusters of the scene
+  std::vector<Signature> sigs;     // their signatures (source = cluster)
+};
+
+// A scene signature matched to a model signature.
+struct SigMatch {
+  double dist;  // L2 distance of the histograms
+  int view, model, scene;
+};
+
+// Matches by distance, then view, model signature, scene signature.
+bool match_order(const SigMatch& a, const SigMatch& b) {
+  return std::tie(a.dist, a.view, a.model, a.scene) < std::tie(b.dist, b.view, b.model, b.scene);
+}
+
 constexpr char kMagic[8] = {'P', 'B', 'G', 'L', 'O', 'B', 'A', 'L'};
 // 3: CESF falls back to the whole cloud's ESF when it has no stable region
 // (states of version 2 lack those signatures: retrained).
@@ -185,7 +203,7 @@ class GlobalMethod : public Method {
     view_poses_.clear();
     for (size_t v = 0; v < views.size(); ++v) {
       view_poses_.push_back(views[v].T_cam_model);
-      auto sigs = describe(kind_, views[v].cloud, g_, derive_seed(seed, {kTrainStream, v}));
+      auto sigs = describe_cloud(kind_, views[v].cloud, g_, derive_seed(seed, {kTrainStream, v}));
       for (auto& sig : sigs) {
         sig.source = static_cast<int>(v);
         sig.crh = global::crh_spectrum(views[v].cloud, sig.axis);
@@ -241,104 +259,113 @@ class GlobalMethod : public Method {
     sigs_ = std::move(sigs);
   }
 
-  std::vector<Hypothesis> hypothesize(const PointSet& scene, const std::vector<ViewData>& /*views*/,
+  std::vector<Hypothesis> hypothesize(const PointSet& scene, const std::vector<ViewData>& views,
                                       uint64_t seed, StageTimes& times) const override {
-    const GlobalSettings& g = g_;
-    std::vector<Hypothesis> hyps;
+    return run_stages(*this, SceneInput{scene, views, seed}, times);
+  }
 
-    // 1. Segmentation and description.
-    Timer timer;
-    const auto clusters =
-        global::euclidean_clusters(scene.points, g.cluster_tolerance_mm, g.cluster_min_points, g.cluster_max_points);
-    std::vector<PointSet> cluster_clouds;
-    std::vector<Signature> scene_sigs;
+  // The stages (stages.h), in order; no group stage.
+
+  // Describe: Euclidean clusters of the scene, each cluster's signatures.
+  std::optional<SceneSignatures> describe(const SceneInput& in) const {
+    SceneSignatures d;
+    const auto clusters = global::euclidean_clusters(in.scene.points, g_.cluster_tolerance_mm, g_.cluster_min_points,
+                                                     g_.cluster_max_points);
     for (size_t c = 0; c < clusters.size(); ++c) {
-      cluster_clouds.push_back(subset(scene, clusters[c]));
-      auto sigs = describe(kind_, cluster_clouds.back(), g, derive_seed(seed, {kSceneStream, c}));
+      d.clusters.push_back(subset(in.scene, clusters[c]));
+      auto sigs = describe_cloud(kind_, d.clusters.back(), g_, derive_seed(in.seed, {kSceneStream, c}));
       for (auto& sig : sigs) {
         sig.source = static_cast<int>(c);
-        scene_sigs.push_back(std::move(sig));
+        d.sigs.push_back(std::move(sig));
       }
     }
-    times.describe += timer.seconds();
+    return d;
+  }
 
-    // 2. Matching: every pair (or each scene signature's nearest), the top_k
-    // overall.
-    timer.reset();
-    struct Match {
-      double dist;
-      int view, model, scene;
-    };
-    const auto order = [](const Match& a, const Match& b) {
-      return std::tie(a.dist, a.view, a.model, a.scene) < std::tie(b.dist, b.view, b.model, b.scene);
-    };
-    std::vector<Match> matches, own;
-    const size_t per_sig = static_cast<size_t>(g.matches_per_signature);
-    for (size_t i = 0; i < scene_sigs.size(); ++i) {
+  // Match: every pair (or each scene signature's nearest), the top_k
+  // overall.
+  std::vector<SigMatch> match(const SceneInput&, const SceneSignatures& d) const {
+    std::vector<SigMatch> matches, own;
+    const size_t per_sig = static_cast<size_t>(g_.matches_per_signature);
+    for (size_t i = 0; i < d.sigs.size(); ++i) {
       own.clear();
       for (size_t j = 0; j < sigs_.size(); ++j) {
-        if (sigs_[j].hist.size() != scene_sigs[i].hist.size()) continue;
-        const double d = l2(scene_sigs[i].hist, sigs_[j].hist);
-        if (!std::isfinite(d)) continue;
-        own.push_back({d, sigs_[j].source, static_cast<int>(j), static_cast<int>(i)});
+        if (sigs_[j].hist.size() != d.sigs[i].hist.size()) continue;
+        const double dist = l2(d.sigs[i].hist, sigs_[j].hist);
+        if (!std::isfinite(dist)) continue;
+        own.push_back({dist, sigs_[j].source, static_cast<int>(j), static_cast<int>(i)});
       }
       if (per_sig > 0 && own.size() > per_sig) {  // this signature's nearest only
-        std::partial_sort(own.begin(), own.begin() + static_cast<std::ptrdiff_t>(per_sig), own.end(), order);
+        std::partial_sort(own.begin(), own.begin() + static_cast<std::ptrdiff_t>(per_sig), own.end(), match_order);
         own.resize(per_sig);
       }
       matches.insert(matches.end(), own.begin(), own.end());
     }
-    const size_t k = std::min(matches.size(), static_cast<size_t>(std::max(g.top_k, 1)));
-    std::partial_sort(matches.begin(), matches.begin() + k, matches.end(), order);
+    const size_t k = std::min(matches.size(), static_cast<size_t>(std::max(g_.top_k, 1)));
+    std::partial_sort(matches.begin(), matches.begin() + k, matches.end(), match_order);
     matches.resize(k);
-    times.match += timer.seconds();
+    return matches;
+  }
 
-    // 3. Initial poses.
-    timer.reset();
-    std::vector<std::vector<float>> scene_crh(scene_sigs.size());
-    std::vector<char> crh_done(scene_sigs.size(), 0);
-    for (const Match& m : matches) {
+  // Initial pose: the poses of each match, in match order, scored
+  // 1 / (1 + histogram distance).
+  std::vector<Hypothesis> initial_pose(const SceneInput&, const SceneSignatures& d,
+                                       std::vector<SigMatch> matches) const {
+    std::vector<Hypothesis> hyps;
+    SceneCrh crh(d.sigs.size());
+    for (const SigMatch& m : matches) {
       const Signature& ms = sigs_[m.model];
-      const Signature& ss = scene_sigs[m.scene];
-      const Pose& T_view_model = view_poses_[ms.source];
-      const double score = 1.0 / (1.0 + m.dist);
-      std::vector<Pose> T_cam_view;
-      if (kind_ == Kind::kOurCvfh && ms.has_rf && ss.has_rf) {
-        Pose T = ss.T_rf_cam.inverse() * ms.T_rf_cam;
-        T.R = nearest_rotation(T.R);
-        T_cam_view.push_back(T);
-      } else {
-        std::vector<double> rolls;
-        if (!g.skip_crh) {
-          if (!crh_done[m.scene]) {
-            scene_crh[m.scene] = global::crh_spectrum(cluster_clouds[ss.source], ss.axis);
-            crh_done[m.scene] = 1;
-          }
-          rolls = global::crh_roll_peaks(scene_crh[m.scene], ms.crh, g);
-        }
-        if (rolls.empty()) rolls.push_back(global::upright_roll(ms.axis, ss.axis));
-        for (double theta : rolls) {
-          Pose T;
-          T.R = global::roll_rotation(ms.axis, ss.axis, theta);
-          T.t = ss.centroid.cast<double>() - T.R * ms.centroid.cast<double>();
-          T_cam_view.push_back(T);
-        }
-      }
-      for (const Pose& T : T_cam_view) {
+      for (const Pose& T : aligned_views(d, m, crh)) {
         Hypothesis h;
-        h.T_cam_model = T * T_view_model;
+        h.T_cam_model = T * view_poses_[ms.source];
         h.view = ms.source;
-        h.score = score;
+        h.score = 1.0 / (1.0 + m.dist);
         hyps.push_back(h);
       }
     }
-    const size_t top_k = static_cast<size_t>(std::max(g.top_k, 1));
-    if (g.top_k_counts_rolls && hyps.size() > top_k) hyps.resize(top_k);  // the first top_k hypotheses
-    times.initial_pose += timer.seconds();
+    const size_t top_k = static_cast<size_t>(std::max(g_.top_k, 1));
+    if (g_.top_k_counts_rolls && hyps.size() > top_k) hyps.resize(top_k);  // the first top_k hypotheses
     return hyps;
   }
 
  private:
+  // The scene signatures' CRHs, computed on first use.
+  struct SceneCrh {
+    explicit SceneCrh(size_t n) : spectrum(n), done(n, 0) {}
+    std::vector<std::vector<float>> spectrum;
+    std::vector<char> done;
+  };
+
+  // T_cam_view of one match: from the two reference frames (OUR-CVFH),
+  // else the axes aligned and each roll of the CRH (or the upright one).
+  std::vector<Pose> aligned_views(const SceneSignatures& d, const SigMatch& m, SceneCrh& crh) const {
+    const Signature& ms = sigs_[m.model];
+    const Signature& ss = d.sigs[m.scene];
+    std::vector<Pose> T_cam_view;
+    if (kind_ == Kind::kOurCvfh && ms.has_rf && ss.has_rf) {
+      Pose T = ss.T_rf_cam.inverse() * ms.T_rf_cam;
+      T.R = nearest_rotation(T.R);
+      T_cam_view.push_back(T);
+      return T_cam_view;
+    }
+    std::vector<double> rolls;
+    if (!g_.skip_crh) {
+      if (!crh.done[m.scene]) {
+        crh.spectrum[m.scene] = global::crh_spectrum(d.clusters[ss.source], ss.axis);
+        crh.done[m.scene] = 1;
+      }
+      rolls = global::crh_roll_peaks(crh.spectrum[m.scene], ms.crh, g_);
+    }
+    if (rolls.empty()) rolls.push_back(global::upright_roll(ms.axis, ss.axis));
+    for (double theta : rolls) {
+      Pose T;
+      T.R = global::roll_rotation(ms.axis, ss.axis, theta);
+      T.t = ss.centroid.cast<double>() - T.R * ms.centroid.cast<double>();
+      T_cam_view.push_back(T);
+    }
+    return T_cam_view;
+  }
+
   Kind kind_;
   GlobalSettings g_;
   std::vector<Signature> sigs_;   // every training view's signatures (source = view)

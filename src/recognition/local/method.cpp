@@ -11,13 +11,14 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
-#include "core/timer.h"
 #include "recognition/local/local.h"
 #include "recognition/local/internal.h"
 #include "recognition/method.h"
+#include "recognition/stages.h"
 
 namespace pb {
 
@@ -92,6 +93,30 @@ Described keep_valid(const PointSet& cloud, const std::vector<int>& idx, const s
   return d;
 }
 
+// The scene's described keypoints (the describe stage).
+struct SceneKeypoints {
+  std::vector<int> idx;        // keypoints: indices into the scene
+  Support sp;                  // their support cloud
+  std::vector<float> desc;     // idx.size() x dim
+  std::vector<int> described;  // positions in idx of the keypoints with a valid descriptor
+};
+
+// Per described keypoint, its matches: (index row, squared distance).
+using Neighbours = std::vector<std::vector<std::pair<int, float>>>;
+
+// One Hough cluster of one training view.
+struct Cand {
+  int view;
+  HoughCluster cluster;
+};
+
+// The group stage's result: the voting keypoints (no descriptors) and the
+// clusters, in view order.
+struct Clusters {
+  Described voters;
+  std::vector<Cand> cands;
+};
+
 constexpr char kMagic[8] = {'P', 'B', 'L', 'O', 'C', 'A', 'L', '1'};
 
 class LocalMethod : public Method {
@@ -147,122 +172,134 @@ class LocalMethod : public Method {
   std::vector<Hypothesis> hypothesize(const PointSet& scene, const std::vector<ViewData>& views,
                                       // No random choice here: the only one, PCL's RANSAC
                                       // inside Hough3DGrouping, uses its fixed seed.
-                                      uint64_t /*seed*/, StageTimes& times) const override {
-    const LocalSettings& s = s_;
-    std::vector<Hypothesis> out;
-    if (views.size() != views_.size())
-      throw std::invalid_argument("local method: " + std::to_string(views.size()) +
+                                      uint64_t seed, StageTimes& times) const override {
+    return run_stages(*this, SceneInput{scene, views, seed}, times);
+  }
+
+  // The stages (stages.h), in order.
+
+  // Describe: keypoints and their descriptors; only keypoints with a valid
+  // descriptor are matched.
+  std::optional<SceneKeypoints> describe(const SceneInput& in) const {
+    if (in.views.size() != views_.size())
+      throw std::invalid_argument("local method: " + std::to_string(in.views.size()) +
                                   " views given, trained on " + std::to_string(views_.size()));
-    if (scene.empty() || !scene.has_normals() || index_.size() == 0) return out;
+    if (in.scene.empty() || !in.scene.has_normals() || index_.size() == 0) return std::nullopt;
     const int dim = dim_of(kind_);
+    SceneKeypoints d;
+    d.idx = voxel_keypoints(in.scene, s_.keypoint_voxel_mm);
+    d.sp = support_of(in.scene, d.idx, s_);
+    d.desc = descriptors(kind_, d.sp.cloud(), d.sp.at, s_);
+    for (size_t i = 0; i < d.idx.size(); ++i)
+      if (finite_row(d.desc.data() + i * dim, dim)) d.described.push_back(static_cast<int>(i));
+    return d;
+  }
 
-    // Describe: keypoints + descriptors; only keypoints with a valid
-    // descriptor are matched.
-    Timer timer;
-    const std::vector<int> idx = voxel_keypoints(scene, s.keypoint_voxel_mm);
-    const Support sp = support_of(scene, idx, s);
-    const std::vector<float> desc = descriptors(kind_, sp.cloud(), sp.at, s);
-    std::vector<int> described;  // positions in idx
-    for (size_t i = 0; i < idx.size(); ++i)
-      if (finite_row(desc.data() + i * dim, dim)) described.push_back(static_cast<int>(i));
-    times.describe += timer.seconds();
-
-    // Match: k nearest model descriptors under the threshold, per view.
-    timer.reset();
-    const float thr = static_cast<float>(kind_ == Kind::Fpfh ? s.fpfh_match_threshold : s.match_threshold);
-    // The described keypoints' rows: the descriptors as they are when every
-    // one is valid (the usual case), else a compacted copy.
-    std::vector<float> compacted;
-    if (described.size() < idx.size()) {
-      compacted.resize(described.size() * static_cast<size_t>(dim));
-      for (size_t i = 0; i < described.size(); ++i)
-        std::copy_n(desc.data() + static_cast<size_t>(described[i]) * dim, dim, compacted.data() + i * dim);
-    }
-    const float* query = compacted.empty() ? desc.data() : compacted.data();
+  // Match: each described keypoint's k nearest model descriptors under the
+  // threshold, over every view.
+  Neighbours match(const SceneInput&, const SceneKeypoints& d) const {
+    const int dim = dim_of(kind_);
+    const float thr = static_cast<float>(kind_ == Kind::Fpfh ? s_.fpfh_match_threshold : s_.match_threshold);
+    const std::vector<float> compacted = described_rows(d, dim);
+    const float* query = compacted.empty() ? d.desc.data() : compacted.data();
     // One result slot per described keypoint, merged in keypoint order: the
-    // same matches for any thread count.
-    // Blocks of kMatchBlock queries: each indexed row is read once per block.
+    // same matches for any thread count. Blocks of kMatchBlock queries: each
+    // indexed row is read once per block.
     constexpr int kMatchBlock = 32;
-    std::vector<std::vector<std::pair<int, float>>> nn(described.size());
-    const int nkp = static_cast<int>(described.size());
+    Neighbours nn(d.described.size());
+    const int nkp = static_cast<int>(d.described.size());
     const int nblocks = (nkp + kMatchBlock - 1) / kMatchBlock;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(omp_threads(s.threads)) if (nblocks > 1)
+#pragma omp parallel for schedule(dynamic, 1) num_threads(omp_threads(s_.threads)) if (nblocks > 1)
     for (int b = 0; b < nblocks; ++b) {
       const int first = b * kMatchBlock, count = std::min(kMatchBlock, nkp - first);
-      index_.knn_block(query + static_cast<size_t>(first) * dim, count, s.matches_per_keypoint, thr,
-                       nn.data() + first, kind_ == Kind::Shot ? s.match_max_checks : 0);
+      index_.knn_block(query + static_cast<size_t>(first) * dim, count, s_.matches_per_keypoint, thr,
+                       nn.data() + first, kind_ == Kind::Shot ? s_.match_max_checks : 0);
     }
-    times.match += timer.seconds();
+    return nn;
+  }
 
-    // Scene reference frames, needed for voting (part of grouping): only of
-    // the matched keypoints, the only ones that vote; a match whose keypoint
-    // has no valid frame is dropped. Each keypoint is matched on its own, so
-    // the matches are those of describing every keypoint's frame first.
-    timer.reset();
+  // Group: the matched keypoints' reference frames, then 3D Hough voting
+  // per training view.
+  Clusters group(const SceneInput& in, const SceneKeypoints& d, Neighbours nn) const {
+    Clusters g;
+    const std::vector<std::vector<Match>> per_view = voting_keypoints(in, d, nn, g.voters);
+    HoughParams hp;
+    hp.bin_mm = s_.hough_bin_mm;
+    hp.min_votes = s_.hough_min_votes;
+    hp.interpolation = s_.hough_interpolation;
+    for (size_t v = 0; v < views_.size(); ++v) {
+      if (static_cast<int>(per_view[v].size()) < s_.hough_min_votes) continue;
+      for (HoughCluster& c : hough_grouping(views_[v].kp, views_[v].lrf, g.voters.kp, g.voters.lrf, per_view[v], hp))
+        g.cands.push_back({static_cast<int>(v), std::move(c)});
+    }
+    return g;
+  }
+
+  // Initial pose: Procrustes on each cluster's correspondences; ranked by
+  // votes, ties in view / cluster order (stable, deterministic).
+  std::vector<Hypothesis> initial_pose(const SceneInput& in, const SceneKeypoints&, Clusters g) const {
+    std::vector<Hypothesis> out;
+    for (const Cand& c : g.cands) {
+      if (c.cluster.matches.size() < 3) continue;
+      std::vector<Vec3f> m, q;
+      for (const Match& k : c.cluster.matches) {
+        m.push_back(views_[c.view].kp[k.model]);
+        q.push_back(g.voters.kp[k.scene]);
+      }
+      Pose T_scene_view;
+      if (!procrustes(m, q, T_scene_view)) continue;
+      Hypothesis h;
+      h.T_cam_model = T_scene_view * in.views[c.view].T_cam_model;
+      h.view = c.view;
+      h.score = static_cast<double>(c.cluster.matches.size());
+      out.push_back(h);
+    }
+    std::stable_sort(out.begin(), out.end(),
+                     [](const Hypothesis& a, const Hypothesis& b) { return a.score > b.score; });
+    if (static_cast<int>(out.size()) > s_.max_hypotheses) out.resize(s_.max_hypotheses);
+    return out;
+  }
+
+ private:
+  // The described keypoints' descriptor rows: empty when every keypoint is
+  // described (the usual case: the rows are d.desc as it is), else a
+  // compacted copy.
+  static std::vector<float> described_rows(const SceneKeypoints& d, int dim) {
+    std::vector<float> compacted;
+    if (d.described.size() < d.idx.size()) {
+      compacted.resize(d.described.size() * static_cast<size_t>(dim));
+      for (size_t i = 0; i < d.described.size(); ++i)
+        std::copy_n(d.desc.data() + static_cast<size_t>(d.described[i]) * dim, dim, compacted.data() + i * dim);
+    }
+    return compacted;
+  }
+
+  // The voting keypoints: the matched ones with a valid reference frame
+  // (frames are computed for the matched keypoints alone, each on its own,
+  // so they are those of describing every keypoint's frame first). Returns
+  // their matches per training view.
+  std::vector<std::vector<Match>> voting_keypoints(const SceneInput& in, const SceneKeypoints& d,
+                                                   const Neighbours& nn, Described& voters) const {
     std::vector<int> matched;  // support point indices
     for (size_t i = 0; i < nn.size(); ++i)
-      if (!nn[i].empty()) matched.push_back(sp.at[static_cast<size_t>(described[i])]);
-    const std::vector<float> lrf = compute_board_lrf(sp.cloud(), matched, s.lrf_radius_mm);
-    Described sc;  // the voting keypoints (no descriptors)
+      if (!nn[i].empty()) matched.push_back(d.sp.at[static_cast<size_t>(d.described[i])]);
+    const std::vector<float> lrf = compute_board_lrf(d.sp.cloud(), matched, s_.lrf_radius_mm);
     std::vector<std::vector<Match>> per_view(views_.size());
     for (size_t i = 0, m = 0; i < nn.size(); ++i) {
       if (nn[i].empty()) continue;
       const float* lr = lrf.data() + (m++) * kLrfDim;
       if (!finite_row(lr, kLrfDim)) continue;
-      const int slot = static_cast<int>(sc.kp.size());
-      sc.kp.push_back(scene.points[static_cast<size_t>(idx[static_cast<size_t>(described[i])])]);
-      sc.lrf.insert(sc.lrf.end(), lr, lr + kLrfDim);
+      const int slot = static_cast<int>(voters.kp.size());
+      voters.kp.push_back(in.scene.points[static_cast<size_t>(d.idx[static_cast<size_t>(d.described[i])])]);
+      voters.lrf.insert(voters.lrf.end(), lr, lr + kLrfDim);
       for (const auto& [row, d2] : nn[i]) {
         const auto& [v, k] = row_owner_[row];
         per_view[v].push_back({k, slot, d2});
       }
     }
-    times.group += timer.seconds();
-
-    // Group: 3D Hough voting per training view.
-    timer.reset();
-    HoughParams hp;
-    hp.bin_mm = s.hough_bin_mm;
-    hp.min_votes = s.hough_min_votes;
-    hp.interpolation = s.hough_interpolation;
-    struct Cand {
-      int view;
-      HoughCluster cluster;
-    };
-    std::vector<Cand> cands;
-    for (size_t v = 0; v < views_.size(); ++v) {
-      if (static_cast<int>(per_view[v].size()) < s.hough_min_votes) continue;
-      for (HoughCluster& c : hough_grouping(views_[v].kp, views_[v].lrf, sc.kp, sc.lrf, per_view[v], hp))
-        cands.push_back({static_cast<int>(v), std::move(c)});
-    }
-    times.group += timer.seconds();
-
-    // Initial pose: Procrustes on each cluster's correspondences.
-    timer.reset();
-    for (const Cand& c : cands) {
-      if (c.cluster.matches.size() < 3) continue;
-      std::vector<Vec3f> m, q;
-      for (const Match& k : c.cluster.matches) {
-        m.push_back(views_[c.view].kp[k.model]);
-        q.push_back(sc.kp[k.scene]);
-      }
-      Pose T_scene_view;
-      if (!procrustes(m, q, T_scene_view)) continue;
-      Hypothesis h;
-      h.T_cam_model = T_scene_view * views[c.view].T_cam_model;
-      h.view = c.view;
-      h.score = static_cast<double>(c.cluster.matches.size());
-      out.push_back(h);
-    }
-    // Rank by votes; ties keep view / cluster order (stable, deterministic).
-    std::stable_sort(out.begin(), out.end(),
-                     [](const Hypothesis& a, const Hypothesis& b) { return a.score > b.score; });
-    if (static_cast<int>(out.size()) > s.max_hypotheses) out.resize(s.max_hypotheses);
-    times.initial_pose += timer.seconds();
-    return out;
+    return per_view;
   }
 
- private:
   void build_index() {
     std::vector<float> all;
     row_owner_.clear();

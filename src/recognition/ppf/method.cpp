@@ -48,11 +48,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "core/log.h"
 #include "core/random.h"
-#include "core/timer.h"
 #include "recognition/method.h"
+#include "recognition/stages.h"
 #include "recognition/pcl_adapter.h"
 #include "recognition/ppf/internal.h"
 #include "recognition/preprocess/voxel_grid.h"
@@ -60,6 +61,15 @@
 namespace pb {
 
 namespace {
+
+// The scene as the PPF stages see it (the describe stage).
+struct PpfScene {
+  bool whole_scene = false;  // the scene is paired as it is (no sampling step)
+  PointSet sampled;          // else: the scene at the model's sampling
+  std::vector<int> refs;     // reference points: indices into the paired cloud
+  PointSet partners;         // a coarser sampling the references pair with (empty: the paired cloud)
+  const PointSet& paired(const SceneInput& in) const { return whole_scene ? in.scene : sampled; }
+};
 
 constexpr char kStateMagic[8] = {'P', 'B', 'P', 'P', 'F', '0', '0', '2'};
 
@@ -121,52 +131,55 @@ class PpfMethod : public Method {
 
   std::vector<Hypothesis> hypothesize(const PointSet& scene, const std::vector<ViewData>& views, uint64_t seed,
                                       StageTimes& times) const override {
-    std::vector<Hypothesis> out;
-    if (m_.table.empty() || !scene.has_normals() || scene.size() < 2) return out;
+    return run_stages(*this, SceneInput{scene, views, seed}, times);
+  }
 
-    // Describe: the scene at the model's sampling, the seeded subset of
-    // reference points.
-    Timer timer;
+  // The stages (stages.h), in order.
+
+  // Describe: the scene at the model's sampling, the seeded subset of
+  // reference points, and the partners (a coarser sampling where asked).
+  std::optional<PpfScene> describe(const SceneInput& in) const {
+    if (m_.table.empty() || !in.scene.has_normals() || in.scene.size() < 2) return std::nullopt;
+    PpfScene d;
     const double leaf = s_.scene_sampling_steps * m_.distance_step;
     VoxelGridOptions grid;
     grid.leaf_mm = leaf;
     grid.normal_cluster_deg = s_.normal_cluster_deg;
-    const PointSet sampled = leaf > 0 ? voxel_downsample(scene, grid) : PointSet();
-    const PointSet& paired = leaf > 0 ? sampled : scene;
-    if (paired.size() < 2 || !paired.has_normals()) return out;
-    const std::vector<int> refs = ppf::reference_points(paired.size(), s_.scene_reference_fraction, seed);
-    // The partners: a coarser sampling of the scene where asked.
+    d.whole_scene = !(leaf > 0);
+    if (!d.whole_scene) d.sampled = voxel_downsample(in.scene, grid);
+    const PointSet& paired = d.paired(in);
+    if (paired.size() < 2 || !paired.has_normals()) return std::nullopt;
+    d.refs = ppf::reference_points(paired.size(), s_.scene_reference_fraction, in.seed);
     const double partner_leaf = s_.scene_partner_steps * m_.distance_step;
-    PointSet partners;
     if (partner_leaf > 0 && partner_leaf != leaf) {
       VoxelGridOptions coarse = grid;
       coarse.leaf_mm = partner_leaf;
-      partners = voxel_downsample(scene, coarse);
+      d.partners = voxel_downsample(in.scene, coarse);
     }
-    const PointSet* partner_cloud = partners.points.empty() ? nullptr : &partners;
-    times.describe += timer.seconds();
+    return d;
+  }
 
-    // Match: vote per reference point.
-    timer.reset();
+  // Match: the votes of each reference point's pairs, its best pose.
+  std::vector<ppf::PoseVote> match(const SceneInput& in, const PpfScene& d) const {
     ppf::VoteOptions vo;
     vo.margin = static_cast<float>(s_.neighbour_margin);
     vo.vote_once = s_.vote_once;
-    std::vector<ppf::PoseVote> poses = ppf::vote(m_, paired, refs, vo, partner_cloud);
-    times.match += timer.seconds();
+    return ppf::vote(m_, d.paired(in), d.refs, vo, d.partners.points.empty() ? nullptr : &d.partners);
+  }
 
-    // Group: greedy pose clustering, most votes first.
-    timer.reset();
-    out = ppf::cluster_poses(std::move(poses), s_);
-    times.group += timer.seconds();
+  // Group: greedy pose clustering, most votes first.
+  std::vector<Hypothesis> group(const SceneInput&, const PpfScene&, std::vector<ppf::PoseVote> poses) const {
+    return ppf::cluster_poses(std::move(poses), s_);
+  }
 
-    // Initial pose: the training view that sees the object from the
-    // hypothesis' direction.
-    timer.reset();
+  // Initial pose: each hypothesis gets the training view that sees the
+  // object from its direction.
+  std::vector<Hypothesis> initial_pose(const SceneInput& in, const PpfScene&, std::vector<Hypothesis> out) const {
     for (auto& h : out) {
       const Vec3 cam_dir = -(h.T_cam_model.R.transpose() * h.T_cam_model.t);
       double best = -std::numeric_limits<double>::infinity();
-      for (size_t v = 0; v < views.size(); ++v) {
-        const Vec3 view_dir = -(views[v].T_cam_model.R.transpose() * views[v].T_cam_model.t);
+      for (size_t v = 0; v < in.views.size(); ++v) {
+        const Vec3 view_dir = -(in.views[v].T_cam_model.R.transpose() * in.views[v].T_cam_model.t);
         const double c = cam_dir.normalized().dot(view_dir.normalized());
         if (c > best) {
           best = c;
@@ -174,7 +187,6 @@ class PpfMethod : public Method {
         }
       }
     }
-    times.initial_pose += timer.seconds();
     return out;
   }
 

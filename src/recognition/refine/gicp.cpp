@@ -2,7 +2,7 @@
 // each point carries a covariance that is flat along its surface; by default
 // built from the clouds' normals (thesis: "covariances from normals"),
 // otherwise PCL computes them from k neighbours. The clouds arrive de-meaned
-// (centred on the scene crop, internal.h): PCL issue 6263, GICP fails
+// (centred on the scene crop, refiner.h): PCL issue 6263, GICP fails
 // on clouds far from the origin.
 #include <pcl/registration/gicp.h>
 
@@ -11,10 +11,11 @@
 #include "recognition/pcl_adapter.h"
 #include "recognition/refine/pcl_registration.h"
 
-namespace pb::refine_detail {
+namespace pb {
 
 namespace {
 
+using namespace refine_detail;
 using Gicp = pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ>;
 
 // Covariance of a locally planar patch with unit normal n: variance 1 in the
@@ -29,38 +30,56 @@ Gicp::MatricesVectorPtr plane_covariances(const std::vector<Vec3f>& normals) {
   return cov;
 }
 
+// Plane-to-plane registration; the covariances from the normals when
+// covariances_from_normals and both clouds have them, else PCL's from k
+// neighbours.
+class GicpRefiner : public Refiner {
+ public:
+  GicpRefiner(const RegistrationSettings& r, const GicpSettings& s) : r_(r), s_(s) {}
+  bool needs_normals() const override { return s_.covariances_from_normals; }
+
+  RegistrationOutcome align(const RegistrationProblem& p, uint64_t /*seed: no random choice*/) const override {
+    const int k = static_cast<int>(s_.correspondence_randomness);
+    const bool from_normals = s_.covariances_from_normals && p.src_normals.size() == p.src.size() &&
+                              p.tgt_normals.size() == p.tgt.size();
+    // PCL's own covariances need k neighbours in both clouds.
+    if (!from_normals && (static_cast<int>(p.src.size()) < k || static_cast<int>(p.tgt.size()) < k)) return {};
+
+    auto configure = [&](auto& reg) {
+      if (!from_normals) reg.setCorrespondenceRandomness(k);
+      reg.setMaxCorrespondenceDistance(r_.max_correspondence_mm * 1e-3);
+      // PCL's GICP stops when every translation entry of the per-iteration
+      // change is below transformation_epsilon (m, not squared) and every
+      // rotation entry below rotation_epsilon (~ radians): the same rule as
+      // the ICP family.
+      reg.setTransformationEpsilon(std::sqrt(r_.transformation_epsilon));
+      reg.setRotationEpsilon(r_.rotation_epsilon_deg * M_PI / 180.0);
+      // The inner BFGS stops when the gradient norms drop below these; PCL's
+      // 1e-2 assumes metre-sized scenes and stops several degrees short on
+      // objects of about 10 cm (measured: mean rotation error 3.2 degrees).
+      reg.setTranslationGradientTolerance(1e-6);
+      reg.setRotationGradientTolerance(1e-6);
+    };
+    // Setting the inputs resets the covariances: set them after.
+    auto after_inputs = [&](auto& reg) {
+      if (!from_normals) return;
+      reg.setSourceCovariances(plane_covariances(p.src_normals));
+      reg.setTargetCovariances(plane_covariances(p.tgt_normals));
+    };
+    Counted<Gicp> gicp;
+    return pcl_align<StopReport::kFlagAndCap>(gicp, pcl_adapter::xyz(p.src), pcl_adapter::xyz(p.tgt), r_, configure,
+                                              after_inputs);
+  }
+
+ private:
+  RegistrationSettings r_;
+  GicpSettings s_;
+};
+
 }  // namespace
 
-Outcome run_gicp(const Problem& p, const RefineSettings& s, uint64_t /*seed*/) {
-  const int k = static_cast<int>(s.gicp_correspondence_randomness);
-  const bool from_normals = s.gicp_covariances_from_normals && p.src_normals.size() == p.src.size() &&
-                            p.tgt_normals.size() == p.tgt.size();
-  // PCL's own covariances need k neighbours in both clouds.
-  if (!from_normals && (static_cast<int>(p.src.size()) < k || static_cast<int>(p.tgt.size()) < k)) return {};
-
-  auto configure = [&](auto& r) {
-    if (!from_normals) r.setCorrespondenceRandomness(k);
-    r.setMaxCorrespondenceDistance(s.max_correspondence_mm * 1e-3);
-    // PCL's GICP stops when every translation entry of the per-iteration change
-    // is below transformation_epsilon (m, not squared) and every rotation entry
-    // below rotation_epsilon (~ radians): the same rule as the ICP family.
-    r.setTransformationEpsilon(std::sqrt(s.transformation_epsilon));
-    r.setRotationEpsilon(s.rotation_epsilon_deg * M_PI / 180.0);
-    // The inner BFGS stops when the gradient norms drop below these; PCL's
-    // 1e-2 assumes metre-sized scenes and stops several degrees short on
-    // objects of about 10 cm (measured: mean rotation error 3.2 degrees).
-    r.setTranslationGradientTolerance(1e-6);
-    r.setRotationGradientTolerance(1e-6);
-  };
-  // Setting the inputs resets the covariances: set them after.
-  auto after_inputs = [&](auto& r) {
-    if (!from_normals) return;
-    r.setSourceCovariances(plane_covariances(p.src_normals));
-    r.setTargetCovariances(plane_covariances(p.tgt_normals));
-  };
-  Counted<Gicp> gicp;
-  return align<StopReport::kFlagAndCap>(gicp, pcl_adapter::xyz(p.src), pcl_adapter::xyz(p.tgt), s, configure,
-               after_inputs);
+std::unique_ptr<Refiner> make_gicp_refiner(const RegistrationSettings& r, const GicpSettings& s) {
+  return std::make_unique<GicpRefiner>(r, s);
 }
 
-}  // namespace pb::refine_detail
+}  // namespace pb

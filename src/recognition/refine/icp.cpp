@@ -23,14 +23,14 @@
 //                    squared correspondence distance changing by less than
 //                    fitness_epsilon (relative) or 1e-12 (absolute); fewer
 //                    than 3 correspondences ends it unconverged.
-// Both use icp_sample_points (a seeded random subset of the source points),
-// and, when the source has more than icp_coarse_points points, register in
-// two stages: a coarse one on a seeded random subset of icp_coarse_points of
-// them, until a stopping rule fires or all but icp_fine_iterations of the
+// Both use icp.sample_points (a seeded random subset of the source points),
+// and, when the source has more than icp.coarse_points points, register in
+// two stages: a coarse one on a seeded random subset of icp.coarse_points of
+// them, until a stopping rule fires or all but icp.fine_iterations of the
 // iteration cap are used, then a fine one on all of them from there, for the
 // rest of the cap (the stopping rules start afresh). The total stays within
 // max_iterations.
-// Frame and units: internal.h (metres, local frame).
+// Frame and units: refiner.h (metres, local frame).
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -40,9 +40,11 @@
 #include "recognition/kdtree.h"
 #include "recognition/refine/internal.h"
 
-namespace pb::refine_detail {
+namespace pb {
 
 namespace {
+
+using namespace refine_detail;
 
 // Leaf size of ICP's kd-trees (the target's: kTargetLeafSize, internal.h):
 // nearest-neighbour queries only, whose answer does not depend on it (ties
@@ -61,7 +63,7 @@ using Mat4 = Eigen::Matrix4d;
 // `last[i]`: source point i's match of the previous iteration (or -1), the
 // target search's starting bound (the same answer, found sooner).
 void correspond(const std::vector<Vec3f>& src, const KdTree3& src_tree, const std::vector<Vec3f>& tgt,
-                const KdTree3& tgt_tree, const Mat4& T, const RefineSettings& s, std::vector<int>& last,
+                const KdTree3& tgt_tree, const Mat4& T, const RegistrationSettings& s, std::vector<int>& last,
                 std::vector<Pair>& out) {
   out.clear();
   const double max_m = s.max_correspondence_mm * 1e-3;
@@ -143,8 +145,8 @@ enum class Metric { kPoint, kPlane };
 // Iterates from T until a stopping rule fires or `cap` iterations have run
 // (o.iterations counts every stage's iterations; o.converged is the last
 // stage's).
-void iterate(const std::vector<Vec3f>& src, const Problem& p, const KdTree3& tgt_tree, const RefineSettings& s,
-             Metric metric, int cap, Mat4& T, Outcome& o) {
+void iterate(const std::vector<Vec3f>& src, const RegistrationProblem& p, const KdTree3& tgt_tree,
+             const RegistrationSettings& s, Metric metric, int cap, Mat4& T, RegistrationOutcome& o) {
   o.converged = false;
   if (cap <= 0 || src.size() < 3) return;
   const KdTree3 src_tree = s.reciprocal_correspondences ? KdTree3(src, kIcpLeafSize) : KdTree3();
@@ -183,33 +185,50 @@ std::vector<Vec3f> sampled(const std::vector<Vec3f>& pts, int k, uint64_t seed) 
   return out;
 }
 
-Outcome icp(const Problem& p, const RefineSettings& s, uint64_t seed, Metric metric) {
-  Outcome o;
-  const std::vector<Vec3f> src = sampled(p.src, s.icp_sample_points, seed);
+RegistrationOutcome icp(const RegistrationProblem& p, const RegistrationSettings& r, const IcpSettings& s,
+                        uint64_t seed, Metric metric) {
+  RegistrationOutcome o;
+  const std::vector<Vec3f> src = sampled(p.src, s.sample_points, seed);
   if (src.size() < 3 || p.tgt.size() < 3) return o;
   const KdTree3 own = p.tgt_tree ? KdTree3() : KdTree3(p.tgt, kIcpLeafSize);
   const KdTree3& tgt_tree = p.tgt_tree ? *p.tgt_tree : own;
   Mat4 T = Mat4::Identity();
-  int cap = s.max_iterations;
+  int cap = r.max_iterations;
   // Coarse stage: a seeded random subset of the source points, leaving the
-  // fine stage at least icp_fine_iterations of the cap.
-  const size_t coarse = static_cast<size_t>(std::max(0, s.icp_coarse_points));
-  if (coarse >= 3 && src.size() > coarse && cap > s.icp_fine_iterations) {
+  // fine stage at least fine_iterations of the cap.
+  const size_t coarse = static_cast<size_t>(std::max(0, s.coarse_points));
+  if (coarse >= 3 && src.size() > coarse && cap > s.fine_iterations) {
     const std::vector<Vec3f> sub = sampled(src, static_cast<int>(coarse), derive_seed(seed, {1}));
-    iterate(sub, p, tgt_tree, s, metric, cap - s.icp_fine_iterations, T, o);
+    iterate(sub, p, tgt_tree, r, metric, cap - s.fine_iterations, T, o);
     cap -= o.iterations;
   }
-  iterate(src, p, tgt_tree, s, metric, cap, T, o);
+  iterate(src, p, tgt_tree, r, metric, cap, T, o);
   o.delta = T.cast<float>();
   return o;
 }
 
+class IcpRefiner : public Refiner {
+ public:
+  IcpRefiner(const RegistrationSettings& r, const IcpSettings& s, Metric metric) : r_(r), s_(s), metric_(metric) {}
+  bool needs_normals() const override { return metric_ == Metric::kPlane; }
+  RegistrationOutcome align(const RegistrationProblem& p, uint64_t seed) const override {
+    return icp(p, r_, s_, seed, metric_);
+  }
+
+ private:
+  RegistrationSettings r_;
+  IcpSettings s_;
+  Metric metric_;
+};
+
 }  // namespace
 
-Outcome run_icp(const Problem& p, const RefineSettings& s, uint64_t seed) { return icp(p, s, seed, Metric::kPoint); }
-
-Outcome run_icp_plane(const Problem& p, const RefineSettings& s, uint64_t seed) {
-  return icp(p, s, seed, Metric::kPlane);
+std::unique_ptr<Refiner> make_icp_refiner(const RegistrationSettings& r, const IcpSettings& s) {
+  return std::make_unique<IcpRefiner>(r, s, Metric::kPoint);
 }
 
-}  // namespace pb::refine_detail
+std::unique_ptr<Refiner> make_icp_plane_refiner(const RegistrationSettings& r, const IcpSettings& s) {
+  return std::make_unique<IcpRefiner>(r, s, Metric::kPlane);
+}
+
+}  // namespace pb

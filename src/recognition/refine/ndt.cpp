@@ -4,7 +4,7 @@
 // 2 cm grid converged). PCL compares its transformation epsilon with the
 // squared translation step (m^2), so the ICP family's epsilon is used as is;
 // its hasConverged() is also true at the iteration cap, so convergence here
-// means "stopped before the cap". Frame and units: internal.h.
+// means "stopped before the cap". Frame and units: refiner.h.
 #include <pcl/registration/ndt.h>
 
 #include <algorithm>
@@ -12,22 +12,41 @@
 #include "recognition/pcl_adapter.h"
 #include "recognition/refine/pcl_registration.h"
 
-namespace pb::refine_detail {
+namespace pb {
 
-Outcome run_ndt(const Problem& p, const RefineSettings& s, uint64_t /*seed*/) {
-  double res_m = s.ndt_resolution_mm * 1e-3;
-  if (s.ndt_resolution_fraction > 0) res_m = std::max(res_m, s.ndt_resolution_fraction * p.model_diameter_m);
-  Counted<pcl::NormalDistributionsTransform<pcl::PointXYZ, pcl::PointXYZ>> ndt;
-  auto configure = [&](auto& r) {
-    r.setMinPointPerVoxel(static_cast<unsigned>(std::max(3, s.ndt_min_points_per_cell)));
-    r.setResolution(static_cast<float>(res_m));
-    r.setStepSize(s.ndt_step_size_mm * 1e-3);
-    r.setOulierRatio(s.ndt_outlier_ratio);  // sic, PCL 1.13 spelling
-    r.setTransformationEpsilon(s.transformation_epsilon);
-    r.setTransformationRotationEpsilon(rotation_epsilon_cos(s));
-  };
-  return align<StopReport::kBeforeCap>(ndt, pcl_adapter::xyz(p.src), pcl_adapter::xyz(p.tgt), s, configure,
-               no_after_inputs());
+namespace {
+
+class NdtRefiner : public Refiner {
+ public:
+  NdtRefiner(const RegistrationSettings& r, const NdtSettings& s) : r_(r), s_(s) {}
+  bool needs_normals() const override { return false; }
+
+  RegistrationOutcome align(const RegistrationProblem& p, uint64_t /*seed: no random choice*/) const override {
+    using namespace refine_detail;
+    double res_m = s_.resolution_mm * 1e-3;
+    if (s_.resolution_fraction > 0) res_m = std::max(res_m, s_.resolution_fraction * p.model_diameter_m);
+    Counted<pcl::NormalDistributionsTransform<pcl::PointXYZ, pcl::PointXYZ>> ndt;
+    auto configure = [&](auto& reg) {
+      reg.setMinPointPerVoxel(static_cast<unsigned>(std::max(3, s_.min_points_per_cell)));
+      reg.setResolution(static_cast<float>(res_m));
+      reg.setStepSize(s_.step_size_mm * 1e-3);
+      reg.setOulierRatio(s_.outlier_ratio);  // sic, PCL 1.13 spelling
+      reg.setTransformationEpsilon(r_.transformation_epsilon);
+      reg.setTransformationRotationEpsilon(rotation_epsilon_cos(r_));
+    };
+    return pcl_align<StopReport::kBeforeCap>(ndt, pcl_adapter::xyz(p.src), pcl_adapter::xyz(p.tgt), r_, configure,
+                                             no_after_inputs());
+  }
+
+ private:
+  RegistrationSettings r_;
+  NdtSettings s_;
+};
+
+}  // namespace
+
+std::unique_ptr<Refiner> make_ndt_refiner(const RegistrationSettings& r, const NdtSettings& s) {
+  return std::make_unique<NdtRefiner>(r, s);
 }
 
-}  // namespace pb::refine_detail
+}  // namespace pb

@@ -5,7 +5,7 @@
 // builds its target structures), sets source and target, calls after_inputs
 // (for what PCL resets with the inputs, e.g. GICP's covariances), aligns from
 // the identity and reads the correction, the iteration count and whether a
-// stopping rule (not the cap) ended it. Frame and units: internal.h.
+// stopping rule (not the cap) ended it. Frame and units: refiner.h.
 #pragma once
 
 #include <pcl/registration/default_convergence_criteria.h>
@@ -33,11 +33,11 @@ enum class StopReport {
 };
 
 // cos of the rotation stopping threshold, as PCL's ICP family compares it.
-inline double rotation_epsilon_cos(const RefineSettings& s) { return std::cos(s.rotation_epsilon_deg * M_PI / 180.0); }
+inline double rotation_epsilon_cos(const RegistrationSettings& s) { return std::cos(s.rotation_epsilon_deg * M_PI / 180.0); }
 
 template <StopReport report, typename Reg, typename CloudPtr, typename Configure, typename AfterInputs>
-Outcome align(Reg& reg, const CloudPtr& src, const CloudPtr& tgt, const RefineSettings& s, Configure&& configure,
-              AfterInputs&& after_inputs) {
+RegistrationOutcome pcl_align(Reg& reg, const CloudPtr& src, const CloudPtr& tgt, const RegistrationSettings& s,
+                              Configure&& configure, AfterInputs&& after_inputs) {
   reg.setMaximumIterations(s.max_iterations);
   configure(reg);
   reg.setInputSource(src);
@@ -46,7 +46,7 @@ Outcome align(Reg& reg, const CloudPtr& src, const CloudPtr& tgt, const RefineSe
   std::remove_const_t<typename CloudPtr::element_type> out;
   reg.align(out);
 
-  Outcome o;
+  RegistrationOutcome o;
   o.delta = reg.getFinalTransformation();
   o.iterations = reg.iterations();
   if constexpr (report == StopReport::kCriteria) {
@@ -65,7 +65,7 @@ Outcome align(Reg& reg, const CloudPtr& src, const CloudPtr& tgt, const RefineSe
 // The stopping and correspondence settings of the ICP family (icp, icp_lm,
 // icp_plane): every pcl::IterativeClosestPoint subclass.
 template <typename Icp>
-void configure_icp_family(Icp& icp, const RefineSettings& s) {
+void configure_icp_family(Icp& icp, const RegistrationSettings& s) {
   icp.setMaxCorrespondenceDistance(s.max_correspondence_mm * 1e-3);
   icp.setTransformationEpsilon(s.transformation_epsilon);
   icp.setTransformationRotationEpsilon(rotation_epsilon_cos(s));

@@ -1,5 +1,7 @@
-// Refinement (registration) methods: ICP, ICP-LM, ICP point-to-plane, GICP,
-// 3D-NDT, through PCL. Source = the model view, target = the scene (thesis).
+// Refinement (registration): the `refine` settings, one struct per method
+// family, and refine_pose, which registers a model view (source) to the
+// scene (target, thesis) with a Refiner (refiner.h): ICP, ICP-LM, ICP
+// point-to-plane, GICP, 3D-NDT.
 #pragma once
 
 #include <string>
@@ -14,7 +16,11 @@ namespace pb {
 // Units: every *_mm field is in millimetres. PCL registers in metres (float),
 // in a frame centred on the cropped scene (refine_pose.cpp), so the epsilons
 // marked "m" are in metres as PCL compares them.
-struct RefineSettings {
+
+// What every registration method reads: the iteration cap, the
+// correspondence bound and the stopping rules (the top of the `refine`
+// section).
+struct RegistrationSettings {
   int max_iterations = 40;                 // thesis: at most 40 iterations
   double max_correspondence_mm = 20.0;     // pairs farther apart are rejected
   double transformation_epsilon = 1e-8;    // stop on small change of transform: squared translation
@@ -26,30 +32,82 @@ struct RefineSettings {
   bool reciprocal_correspondences = true;  // ICP, ICP-LM, ICP-plane: keep only mutual nearest
                                            // neighbours (PCL's reciprocal correspondences); makes
                                            // them robust to surface seen in one cloud only
-  int icp_sample_points = 0;               // icp, icp_plane (and icp_pcl): seeded random subset of
-                                           // this many source points (0 = all)
-  int icp_coarse_points = 1000;            // icp, icp_plane: a source of more points is registered
-                                           // coarse to fine: first a seeded random subset of this
-                                           // many, then all of them from there (0 = one stage on
-                                           // all, as PCL)
-  int icp_fine_iterations = 10;            // ... of max_iterations, at least this many are left to
-                                           // the fine stage (the coarse one stops earlier on a
-                                           // stopping rule and leaves it the rest)
-  double ndt_resolution_mm = 30.0;         // NDT grid cell, at least this (a planar cell needs about
-                                           // 6 scene points: >= 2.5 x the scene voxel; 30 mm for the
-                                           // table's 10 mm voxel)
-  double ndt_resolution_fraction = 0.15;   // NDT grid sized to the object: cell = this fraction of
-                                           // the model cloud's bounding box diagonal, but at least
-                                           // ndt_resolution_mm (0: ndt_resolution_mm alone)
-  double ndt_step_size_mm = 80.0;          // NDT max More-Thuente step (PCL's 6-vector of metres and
-                                           // radians: 80 mm also allows 4.6 degrees per step)
-  double ndt_outlier_ratio = 0.55;         // NDT outlier ratio of the Gaussian mixture (PCL default)
-  int ndt_min_points_per_cell = 6;         // NDT cells with fewer scene points are ignored (PCL
-                                           // default 6, at least 3)
-  double gicp_correspondence_randomness = 20;  // GICP neighbours for covariances (when not from normals)
-  bool gicp_covariances_from_normals = true;   // GICP plane covariances built from the clouds' normals
-                                               // (thesis: "covariances from normals"); false = PCL's
-                                               // own k-neighbour covariances
+
+  template <class S, class F>
+  static void fields(S& s, F& f) {
+    f("max_iterations", s.max_iterations, fields::at_least(1));
+    f("max_correspondence_mm", s.max_correspondence_mm, fields::length(fields::positive()));
+    f("transformation_epsilon", s.transformation_epsilon, fields::nonnegative());
+    f("rotation_epsilon_deg", s.rotation_epsilon_deg, fields::nonnegative());
+    f("fitness_epsilon", s.fitness_epsilon, fields::nonnegative());
+    f("reciprocal_correspondences", s.reciprocal_correspondences);
+  }
+};
+
+// The project's ICP (icp, icp_plane; sample_points also icp_pcl): `refine.icp`.
+struct IcpSettings {
+  int sample_points = 0;     // seeded random subset of this many source points (0 = all)
+  int coarse_points = 1000;  // a source of more points is registered coarse to fine: first a
+                             // seeded random subset of this many, then all of them from there
+                             // (0 = one stage on all, as PCL)
+  int fine_iterations = 10;  // ... of max_iterations, at least this many are left to the fine
+                             // stage (the coarse one stops earlier on a stopping rule and
+                             // leaves it the rest)
+
+  template <class S, class F>
+  static void fields(S& s, F& f) {
+    f("sample_points", s.sample_points, fields::at_least(0));
+    f("coarse_points", s.coarse_points, fields::at_least(0));
+    f("fine_iterations", s.fine_iterations, fields::at_least(1));
+  }
+};
+
+// Generalized ICP (gicp): `refine.gicp`.
+struct GicpSettings {
+  double correspondence_randomness = 20;  // neighbours for covariances (when not from normals)
+  bool covariances_from_normals = true;   // plane covariances built from the clouds' normals
+                                          // (thesis: "covariances from normals"); false = PCL's
+                                          // own k-neighbour covariances
+
+  template <class S, class F>
+  static void fields(S& s, F& f) {
+    f("correspondence_randomness", s.correspondence_randomness, fields::at_least(3));
+    f("covariances_from_normals", s.covariances_from_normals);
+  }
+};
+
+// 3D-NDT (ndt): `refine.ndt`.
+struct NdtSettings {
+  double resolution_mm = 30.0;        // grid cell, at least this (a planar cell needs about 6 scene
+                                      // points: >= 2.5 x the scene voxel; 30 mm for the table's
+                                      // 10 mm voxel)
+  double resolution_fraction = 0.15;  // grid sized to the object: cell = this fraction of the
+                                      // model cloud's bounding box diagonal, but at least
+                                      // resolution_mm (0: resolution_mm alone)
+  double step_size_mm = 80.0;         // max More-Thuente step (PCL's 6-vector of metres and
+                                      // radians: 80 mm also allows 4.6 degrees per step)
+  double outlier_ratio = 0.55;        // outlier ratio of the Gaussian mixture (PCL default)
+  int min_points_per_cell = 6;        // cells with fewer scene points are ignored (PCL default 6,
+                                      // at least 3)
+
+  template <class S, class F>
+  static void fields(S& s, F& f) {
+    f("resolution_mm", s.resolution_mm, fields::length(fields::positive()));
+    f("resolution_fraction", s.resolution_fraction, fields::nonnegative());
+    f("step_size_mm", s.step_size_mm, fields::length(fields::positive()));
+    f("outlier_ratio", s.outlier_ratio, fields::positive());
+    f("min_points_per_cell", s.min_points_per_cell, fields::at_least(3));
+  }
+  void validate(const YamlNode& node) const {
+    if (outlier_ratio >= 1) node["outlier_ratio"].fail("must be below 1");
+  }
+};
+
+// The `refine` section: the settings every method reads, the pipeline's own
+// (crop, normals, which hypotheses), and one subsection per method family
+// with what that family alone reads. The registry (registry.h) builds a
+// method with the common settings and its subsection.
+struct RefineSettings : RegistrationSettings {
   double crop_margin_mm = -1;              // scene crop: points within model radius + this of the
                                            // initial model centre are registered (< 0: use
                                            // max_correspondence_mm, which is relative by default; a
@@ -64,32 +122,20 @@ struct RefineSettings {
                                            // random subset of this many of its model points and
                                            // ranked at that pose; the kept ones are refined on all
                                            // points from there. 0 = rank at the initial pose
+  IcpSettings icp;                         // icp, icp_plane (icp_pcl: sample_points)
+  GicpSettings gicp;                       // gicp
+  NdtSettings ndt;                         // ndt
 
   template <class S, class F>
   static void fields(S& s, F& f) {
-    f("max_iterations", s.max_iterations, fields::at_least(1));
-    f("max_correspondence_mm", s.max_correspondence_mm, fields::length(fields::positive()));
-    f("transformation_epsilon", s.transformation_epsilon, fields::nonnegative());
-    f("rotation_epsilon_deg", s.rotation_epsilon_deg, fields::nonnegative());
-    f("fitness_epsilon", s.fitness_epsilon, fields::nonnegative());
-    f("reciprocal_correspondences", s.reciprocal_correspondences);
-    f("icp_sample_points", s.icp_sample_points, fields::at_least(0));
-    f("icp_coarse_points", s.icp_coarse_points, fields::at_least(0));
-    f("icp_fine_iterations", s.icp_fine_iterations, fields::at_least(1));
-    f("ndt_resolution_mm", s.ndt_resolution_mm, fields::length(fields::positive()));
-    f("ndt_resolution_fraction", s.ndt_resolution_fraction, fields::nonnegative());
-    f("ndt_step_size_mm", s.ndt_step_size_mm, fields::length(fields::positive()));
-    f("ndt_outlier_ratio", s.ndt_outlier_ratio, fields::positive());
-    f("ndt_min_points_per_cell", s.ndt_min_points_per_cell, fields::at_least(3));
-    f("gicp_correspondence_randomness", s.gicp_correspondence_randomness, fields::at_least(3));
-    f("gicp_covariances_from_normals", s.gicp_covariances_from_normals);
+    RegistrationSettings::fields(s, f);
     f("crop_margin_mm", s.crop_margin_mm, fields::length({}));  // a length ("0.05d"); < 0: the sentinel
     f("normal_neighbours", s.normal_neighbours, fields::at_least(3));
     f("max_hypotheses", s.max_hypotheses, fields::at_least(0));
     f("screen_points", s.screen_points, fields::at_least(0));
-  }
-  void validate(const YamlNode& node) const {
-    if (ndt_outlier_ratio >= 1) node["ndt_outlier_ratio"].fail("must be below 1");
+    f.section("icp", s.icp);
+    f.section("gicp", s.gicp);
+    f.section("ndt", s.ndt);
   }
 };
 
@@ -100,14 +146,21 @@ struct RefineResult {
 };
 
 class KdTree3;
+class Refiner;
 
 // Refines `init` (T_cam_model) by aligning `model` (points in the model
-// frame, with normals) to `scene` (camera frame, with normals). method is
-// one of: none icp icp_lm icp_plane gicp ndt (InputError otherwise). Random
+// frame, with normals) to `scene` (camera frame, with normals) with
+// `refiner` (refiner.h; null: "none", the initial pose stands). Random
 // choices draw from `seed`. scene_tree (optional): a KdTree3 over
 // scene.points (verification's, PointIndex::tree()); the crop's tree is
 // then cut from it (KdTree3::restricted) instead of built, with the same
 // answers. One caller refining many hypotheses in one scene passes it.
+RefineResult refine_pose(const Refiner* refiner, const PointSet& model, const PointSet& scene, const Pose& init,
+                         const RefineSettings& s, uint64_t seed, const KdTree3* scene_tree = nullptr);
+
+// The same with the method built by name from the registry (registry.h:
+// none icp icp_lm icp_plane icp_pcl icp_plane_pcl gicp ndt; InputError
+// otherwise).
 RefineResult refine_pose(const std::string& method, const PointSet& model, const PointSet& scene,
                          const Pose& init, const RefineSettings& s, uint64_t seed,
                          const KdTree3* scene_tree = nullptr);
