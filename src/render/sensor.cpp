@@ -256,19 +256,20 @@ nlohmann::ordered_json noise_json(const NoiseSettings& n) {
               {"edge_dropout_px", s.edge_dropout_px},
               {"reference_fx", s.reference_fx}});
   }
-  if (n.model == "tof") {
-    const auto& t = n.tof;
-    j.update({{"sigma_base_mm", t.sigma_base_mm},
-              {"sigma_per_m2_mm", t.sigma_per_m2_mm},
-              {"edge_jump_mm", t.edge_jump_mm},
-              {"flying_fraction", t.flying_fraction},
-              {"max_incidence_deg", t.max_incidence_deg},
-              {"driver_edge_filter", t.driver_edge_filter},
-              {"edge_filter_close_mm", t.edge_filter_close_mm},
-              {"edge_filter_far_mm", t.edge_filter_far_mm},
-              {"edge_filter_span_mm", t.edge_filter_span_mm}});
-  }
+  if (n.model == "tof") j.update(tof_json(n.tof));
   return j;
+}
+
+nlohmann::ordered_json tof_json(const TimeOfFlightNoise& t) {
+  return {{"sigma_base_mm", t.sigma_base_mm},
+          {"sigma_per_m2_mm", t.sigma_per_m2_mm},
+          {"edge_jump_mm", t.edge_jump_mm},
+          {"flying_fraction", t.flying_fraction},
+          {"max_incidence_deg", t.max_incidence_deg},
+          {"driver_edge_filter", t.driver_edge_filter},
+          {"edge_filter_close_mm", t.edge_filter_close_mm},
+          {"edge_filter_far_mm", t.edge_filter_far_mm},
+          {"edge_filter_span_mm", t.edge_filter_span_mm}};
 }
 
 }  // namespace pb
