@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
-"""Structure limits of the source tree: file length and function length.
+"""Structure limits of the source tree: function length, and PCL's headers.
 
-    scripts/structure_check.py [--max-file 450] [--max-function 120] [DIR ...]
+    scripts/structure_check.py [--max-function 120] [DIR ...]
 
-Prints every C++ file (.h/.cpp) over --max-file lines, every function body
-over --max-function lines (from the line of its opening brace to the line
-of its closing brace), and every header that includes PCL but is not one of
+Prints every function body in a C++ file (.h/.cpp) over --max-function
+lines (from the line of its opening brace to the line of its closing
+brace), and every header that includes PCL but is not one of
 recognition's private glue headers (src/recognition/**/pcl_*.h), then exits
 1 if any, else 0. Default DIR: src.
 
@@ -100,7 +100,7 @@ def functions(text):
     return result
 
 
-def check(dirs, max_file, max_function):
+def check(dirs, max_function):
     problems = []
     for d in dirs:
         for root, _, files in os.walk(d):
@@ -110,9 +110,6 @@ def check(dirs, max_file, max_function):
                 path = os.path.join(root, f)
                 with open(path, encoding="utf-8", errors="replace") as fh:
                     text = fh.read()
-                n = text.count("\n")
-                if n > max_file:
-                    problems.append("%s: %d lines (limit %d)" % (path, n, max_file))
                 if f.endswith((".h", ".hpp")) and re.search(r"#include\s*<pcl/", text):
                     private_glue = f.startswith("pcl_") and "recognition" in os.path.normpath(path).split(os.sep)
                     if not private_glue:
@@ -126,15 +123,14 @@ def check(dirs, max_file, max_function):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--max-file", type=int, default=450)
     ap.add_argument("--max-function", type=int, default=120)
     ap.add_argument("dirs", nargs="*", default=["src"])
     a = ap.parse_args(argv)
-    problems = check(a.dirs, a.max_file, a.max_function)
+    problems = check(a.dirs, a.max_function)
     for p in problems:
         print(p)
     if not problems:
-        print("structure: every file <= %d lines, every function <= %d lines" % (a.max_file, a.max_function))
+        print("structure: every function <= %d lines" % a.max_function)
     return 1 if problems else 0
 
 

@@ -130,6 +130,83 @@ double average_time(const std::vector<BopResultRow>& rows) {
   return times.empty() ? -1 : sum / static_cast<double>(times.size());
 }
 
+// The indices of the rows that estimate a target, by image; the others
+// counted in *not_target.
+std::map<ImageKey, std::vector<int>> target_rows_by_image(const std::vector<BopResultRow>& rows,
+                                                          const std::map<ImageKey, ImageTargets>& targets,
+                                                          int* not_target) {
+  std::map<ImageKey, std::vector<int>> by_image;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const BopResultRow& r = rows[i];
+    auto t = targets.find({r.scene_id, r.im_id});
+    if (t == targets.end() || !t->second.count(r.obj_id)) {
+      ++*not_target;
+      continue;
+    }
+    by_image[{r.scene_id, r.im_id}].push_back(static_cast<int>(i));
+  }
+  return by_image;
+}
+
+// The split's scenes' images, in the order of the targets: a scene is
+// loaded when the first of its images is asked for.
+class SceneImages {
+ public:
+  SceneImages(const BopDataset& ds, const std::string& split, const std::string& targets_source)
+      : ds_(ds), split_(split), source_(targets_source) {}
+  const ImageInfo& image(const ImageKey& key) {
+    if (key.first != loaded_scene_) {
+      if (!fs::is_directory(ds_.scene_dir(split_, key.first))) {
+        throw InputError(source_, "scene " + std::to_string(key.first),
+                         "no such scene in " + ds_.scene_dir(split_, key.first));
+      }
+      scene_ = ds_.load_scene(split_, key.first);
+      loaded_scene_ = key.first;
+    }
+    auto it = scene_.images.find(key.second);
+    if (it == scene_.images.end()) {
+      throw InputError(source_, "scene " + std::to_string(key.first) + " image " + std::to_string(key.second),
+                       "no such image in " + ds_.scene_dir(split_, key.first) + "/scene_camera.json");
+    }
+    return it->second;
+  }
+
+ private:
+  const BopDataset& ds_;
+  const std::string& split_;
+  const std::string& source_;
+  int loaded_scene_ = -1;
+  SceneInfo scene_;
+};
+
+// The error computation's input for one image: its ground truth (the
+// targets valid) and the rows `mine` as its estimates.
+BopImageInput image_input(const ImageKey& key, const ImageInfo& im, const ImageTargets& objs,
+                          const std::vector<BopResultRow>& rows, const std::vector<int>& mine) {
+  BopImageInput in;
+  in.scene_id = key.first;
+  in.im_id = key.second;
+  in.K = im.K;
+  for (const GtObject& g : im.gt) {
+    in.gt_obj_ids.push_back(g.obj_id);
+    in.gt_poses.push_back(g.T_cam_model);
+  }
+  in.gt_valid = valid_gts(im, objs);
+  for (int i : mine) in.estimates.push_back(BopEstimate{rows[i].obj_id, rows[i].score, rows[i].T_cam_model});
+  return in;
+}
+
+// One image's estimates' errors as scored rows (each with its line of the file).
+void add_scored(const BopImageErrors& errs, const std::vector<BopResultRow>& rows, const std::vector<int>& mine,
+                std::vector<ScoredEstimate>& out) {
+  for (const BopEstimateErrors& e : errs.estimates) {
+    const BopResultRow& r = rows[mine[e.source]];
+    ScoredEstimate se{r.line, r.scene_id, r.im_id, r.obj_id, r.score, {}};
+    for (const BopPairErrors& p : e.pairs) se.pairs.push_back(ScoredPair{p.gt, p.mssd_mm, p.mspd_px, p.vsd});
+    out.push_back(std::move(se));
+  }
+}
+
 }  // namespace
 
 ScoreResult score_bop_results(const ScoreSettings& s) {
@@ -150,51 +227,18 @@ ScoreResult score_bop_results(const ScoreSettings& s) {
   const auto targets = load_targets(s, ds, res.split, &res.targets_source);
   Models models;
   load_models(ds, targets, res.targets_source, models);
-
-  std::map<ImageKey, std::vector<int>> rows_by_image;
-  for (size_t i = 0; i < rows.size(); ++i) {
-    const BopResultRow& r = rows[i];
-    auto t = targets.find({r.scene_id, r.im_id});
-    if (t == targets.end() || !t->second.count(r.obj_id)) {
-      ++res.rows_not_target;
-      continue;
-    }
-    rows_by_image[{r.scene_id, r.im_id}].push_back(static_cast<int>(i));
-  }
+  std::map<ImageKey, std::vector<int>> rows_by_image = target_rows_by_image(rows, targets, &res.rows_not_target);
 
   BopErrorOptions opt;
   opt.compute_vsd = s.vsd;
   opt.vsd.delta_mm = s.vsd_delta_mm;
   std::map<std::pair<int, int>, std::unique_ptr<DepthRenderer>> renderers;  // by image size
   std::vector<BopImageErrors> images;
-  int loaded_scene = -1;
-  SceneInfo scene;
+  SceneImages scenes(ds, res.split, res.targets_source);
   for (const auto& [key, objs] : targets) {
-    if (key.first != loaded_scene) {
-      if (!fs::is_directory(ds.scene_dir(res.split, key.first))) {
-        throw InputError(res.targets_source, "scene " + std::to_string(key.first),
-                         "no such scene in " + ds.scene_dir(res.split, key.first));
-      }
-      scene = ds.load_scene(res.split, key.first);
-      loaded_scene = key.first;
-    }
-    auto it = scene.images.find(key.second);
-    if (it == scene.images.end()) {
-      throw InputError(res.targets_source, "scene " + std::to_string(key.first) + " image " + std::to_string(key.second),
-                       "no such image in " + ds.scene_dir(res.split, key.first) + "/scene_camera.json");
-    }
-    const ImageInfo& im = it->second;
-    BopImageInput in;
-    in.scene_id = key.first;
-    in.im_id = key.second;
-    in.K = im.K;
-    for (const GtObject& g : im.gt) {
-      in.gt_obj_ids.push_back(g.obj_id);
-      in.gt_poses.push_back(g.T_cam_model);
-    }
-    in.gt_valid = valid_gts(im, objs);
+    const ImageInfo& im = scenes.image(key);
     const auto& mine = rows_by_image[key];
-    for (int i : mine) in.estimates.push_back(BopEstimate{rows[i].obj_id, rows[i].score, rows[i].T_cam_model});
+    BopImageInput in = image_input(key, im, objs, rows, mine);
     DepthImage depth;
     DepthRenderer* renderer = nullptr;
     if (s.vsd && !in.estimates.empty()) {
@@ -206,12 +250,7 @@ ScoreResult score_bop_results(const ScoreSettings& s) {
       renderer = r.get();
     }
     BopImageErrors errs = bop_image_errors(in, models.bop, opt, renderer);
-    for (const BopEstimateErrors& e : errs.estimates) {
-      const BopResultRow& r = rows[mine[e.source]];
-      ScoredEstimate se{r.line, r.scene_id, r.im_id, r.obj_id, r.score, {}};
-      for (const BopPairErrors& p : e.pairs) se.pairs.push_back(ScoredPair{p.gt, p.mssd_mm, p.mspd_px, p.vsd});
-      res.errors.push_back(std::move(se));
-    }
+    add_scored(errs, rows, mine, res.errors);
     images.push_back(std::move(errs));
   }
   std::sort(res.errors.begin(), res.errors.end(),

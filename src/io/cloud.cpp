@@ -49,80 +49,109 @@ uint64_t parse_count(const std::string& path, const std::string& key, const std:
   return std::strtoull(tok.c_str(), nullptr, 10);
 }
 
+// The per-field lists of a header (SIZE, TYPE, COUNT), as given, and
+// whether it had a POINTS line.
+struct FieldLists {
+  std::vector<std::string> sizes, types, counts;
+  bool have_points = false;
+};
+
+// The header line starting at `pos` (at most 4096 bytes of it); pos moves
+// past its newline.
+std::string next_header_line(const std::string& path, const std::string& bytes, size_t& pos) {
+  if (pos >= bytes.size()) fail(path, "DATA", "the header ends without a DATA line");
+  size_t nl = bytes.find('\n', pos);
+  if (nl == std::string::npos) nl = bytes.size();
+  std::string line = bytes.substr(pos, std::min<size_t>(nl - pos, 4096));
+  pos = nl + 1;
+  for (char c : line)
+    if (static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\r')
+      fail(path, "header", "a header line holds control byte " + std::to_string(static_cast<int>(c)));
+  return line;
+}
+
+// One header line `key vals...` into h (or the field lists).
+void apply_header_line(const std::string& path, const std::string& line, const std::string& key,
+                       const std::vector<std::string>& vals, PcdHeader& h, FieldLists& lists) {
+  if (key == "VERSION") return;
+  if (key == "FIELDS") {
+    if (vals.empty() || vals.size() > 1000) fail(path, "FIELDS", "expected 1 to 1000 field names");
+    for (const auto& v : vals) h.fields.push_back(PcdField{v});
+  } else if (key == "SIZE") {
+    lists.sizes = vals;
+  } else if (key == "TYPE") {
+    lists.types = vals;
+  } else if (key == "COUNT") {
+    lists.counts = vals;
+  } else if (key == "WIDTH" && vals.size() == 1) {
+    h.width = parse_count(path, key, vals[0]);
+  } else if (key == "HEIGHT" && vals.size() == 1) {
+    h.height = parse_count(path, key, vals[0]);
+  } else if (key == "POINTS" && vals.size() == 1) {
+    h.points = parse_count(path, key, vals[0]);
+    lists.have_points = true;
+  } else if (key == "VIEWPOINT" && vals.size() == 7) {
+    for (int i = 0; i < 7; ++i) {
+      char* end = nullptr;
+      h.viewpoint[i] = std::strtod(vals[i].c_str(), &end);
+      if (*end != '\0' || !std::isfinite(h.viewpoint[i])) fail(path, "VIEWPOINT", "expected 7 finite numbers");
+    }
+  } else if (key == "DATA" && vals.size() == 1) {
+    h.data = vals[0];
+    if (h.data != "ascii" && h.data != "binary" && h.data != "binary_compressed")
+      fail(path, "DATA", "'" + h.data.substr(0, 20) + "' is not ascii, binary or binary_compressed");
+  } else {
+    fail(path, key.substr(0, 20), "unknown or malformed header line '" + line.substr(0, 60) + "'");
+  }
+}
+
+// Each field's size, type, count and offset in the record (and the
+// record's size), checked.
+void lay_out_fields(const std::string& path, const FieldLists& lists, PcdHeader& h) {
+  const size_t nf = h.fields.size();
+  if (nf == 0) fail(path, "FIELDS", "missing");
+  if (lists.sizes.size() != nf) fail(path, "SIZE", "expected one size per field (" + std::to_string(nf) + ")");
+  if (lists.types.size() != nf) fail(path, "TYPE", "expected one type per field (" + std::to_string(nf) + ")");
+  if (!lists.counts.empty() && lists.counts.size() != nf) fail(path, "COUNT", "expected one count per field");
+  for (size_t i = 0; i < nf; ++i) {
+    PcdField& f = h.fields[i];
+    const std::string& size = lists.sizes[i];
+    const std::string& type = lists.types[i];
+    f.size = size == "1" ? 1 : size == "2" ? 2 : size == "4" ? 4 : size == "8" ? 8 : 0;
+    if (f.size == 0) fail(path, "SIZE", "field '" + f.name + "': size must be 1, 2, 4 or 8");
+    if (type.size() != 1 || std::string("FIU").find(type[0]) == std::string::npos)
+      fail(path, "TYPE", "field '" + f.name + "': type must be F, I or U");
+    f.type = type[0];
+    if (f.type == 'F' && f.size != 4 && f.size != 8) fail(path, "SIZE", "field '" + f.name + "': F needs size 4 or 8");
+    f.count = lists.counts.empty()
+                  ? 1
+                  : static_cast<int>(std::min<uint64_t>(parse_count(path, "COUNT", lists.counts[i]), 1u << 20));
+    if (f.count < 1) fail(path, "COUNT", "field '" + f.name + "': count must be >= 1");
+    f.offset = h.record;
+    h.record += static_cast<size_t>(f.size) * static_cast<size_t>(f.count);
+  }
+}
+
 // The header's lines up to and including DATA.
 PcdHeader parse_pcd_header(const std::string& path, const std::string& bytes) {
   PcdHeader h;
-  std::vector<std::string> sizes, types, counts;
-  bool have_points = false;
+  FieldLists lists;
   size_t pos = 0;
   while (h.data.empty()) {
-    if (pos >= bytes.size()) fail(path, "DATA", "the header ends without a DATA line");
-    size_t nl = bytes.find('\n', pos);
-    if (nl == std::string::npos) nl = bytes.size();
-    std::string line = bytes.substr(pos, std::min<size_t>(nl - pos, 4096));
-    pos = nl + 1;
-    for (char c : line)
-      if (static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\r')
-        fail(path, "header", "a header line holds control byte " + std::to_string(static_cast<int>(c)));
+    const std::string line = next_header_line(path, bytes, pos);
     std::istringstream w(line);
     std::string key;
     if (!(w >> key) || key[0] == '#') continue;
     std::vector<std::string> vals;
     for (std::string t; w >> t;) vals.push_back(t);
-    if (key == "VERSION") continue;
-    if (key == "FIELDS") {
-      if (vals.empty() || vals.size() > 1000) fail(path, "FIELDS", "expected 1 to 1000 field names");
-      for (const auto& v : vals) h.fields.push_back(PcdField{v});
-    } else if (key == "SIZE") {
-      sizes = vals;
-    } else if (key == "TYPE") {
-      types = vals;
-    } else if (key == "COUNT") {
-      counts = vals;
-    } else if (key == "WIDTH" && vals.size() == 1) {
-      h.width = parse_count(path, key, vals[0]);
-    } else if (key == "HEIGHT" && vals.size() == 1) {
-      h.height = parse_count(path, key, vals[0]);
-    } else if (key == "POINTS" && vals.size() == 1) {
-      h.points = parse_count(path, key, vals[0]);
-      have_points = true;
-    } else if (key == "VIEWPOINT" && vals.size() == 7) {
-      for (int i = 0; i < 7; ++i) {
-        char* end = nullptr;
-        h.viewpoint[i] = std::strtod(vals[i].c_str(), &end);
-        if (*end != '\0' || !std::isfinite(h.viewpoint[i])) fail(path, "VIEWPOINT", "expected 7 finite numbers");
-      }
-    } else if (key == "DATA" && vals.size() == 1) {
-      h.data = vals[0];
-      if (h.data != "ascii" && h.data != "binary" && h.data != "binary_compressed")
-        fail(path, "DATA", "'" + h.data.substr(0, 20) + "' is not ascii, binary or binary_compressed");
-    } else {
-      fail(path, key.substr(0, 20), "unknown or malformed header line '" + line.substr(0, 60) + "'");
-    }
+    apply_header_line(path, line, key, vals, h, lists);
   }
   h.body = std::min(pos, bytes.size());
-  const size_t nf = h.fields.size();
-  if (nf == 0) fail(path, "FIELDS", "missing");
-  if (sizes.size() != nf) fail(path, "SIZE", "expected one size per field (" + std::to_string(nf) + ")");
-  if (types.size() != nf) fail(path, "TYPE", "expected one type per field (" + std::to_string(nf) + ")");
-  if (!counts.empty() && counts.size() != nf) fail(path, "COUNT", "expected one count per field");
-  for (size_t i = 0; i < nf; ++i) {
-    PcdField& f = h.fields[i];
-    f.size = sizes[i] == "1" ? 1 : sizes[i] == "2" ? 2 : sizes[i] == "4" ? 4 : sizes[i] == "8" ? 8 : 0;
-    if (f.size == 0) fail(path, "SIZE", "field '" + f.name + "': size must be 1, 2, 4 or 8");
-    if (types[i].size() != 1 || std::string("FIU").find(types[i][0]) == std::string::npos)
-      fail(path, "TYPE", "field '" + f.name + "': type must be F, I or U");
-    f.type = types[i][0];
-    if (f.type == 'F' && f.size != 4 && f.size != 8) fail(path, "SIZE", "field '" + f.name + "': F needs size 4 or 8");
-    f.count = counts.empty() ? 1 : static_cast<int>(std::min<uint64_t>(parse_count(path, "COUNT", counts[i]), 1u << 20));
-    if (f.count < 1) fail(path, "COUNT", "field '" + f.name + "': count must be >= 1");
-    f.offset = h.record;
-    h.record += static_cast<size_t>(f.size) * static_cast<size_t>(f.count);
-  }
+  lay_out_fields(path, lists, h);
   if (h.width == 0 || h.height == 0) fail(path, "WIDTH", "WIDTH and HEIGHT must be positive");
   if (h.width > kMaxPoints || h.height > kMaxPoints || h.width * h.height > kMaxPoints)
     fail(path, "WIDTH", "more than " + std::to_string(kMaxPoints) + " points");
-  if (have_points && h.points != h.width * h.height)
+  if (lists.have_points && h.points != h.width * h.height)
     fail(path, "POINTS", std::to_string(h.points) + " points but WIDTH x HEIGHT = " + std::to_string(h.width * h.height));
   h.points = h.width * h.height;
   for (const char* axis : {"x", "y", "z"}) {

@@ -94,19 +94,22 @@ struct Walk {
   std::vector<Vec3f>* xyz = nullptr;    // when set: the vertices' x, y, z
 };
 
+[[noreturn]] void broken(const Walk& walk, const std::string& why) {
+  throw InputError(walk.path, walk.field, "broken PLY: " + why);
+}
+
 // Walks the body: every declared value present; face index lists of 3 or
 // more indices, each in [0, vertices). `signs`: per element, per property,
 // whether its (item) type is signed.
 void walk_body(const Walk& walk, const std::string& bytes, size_t body, int format,
                const std::vector<Element>& elements, const std::vector<std::vector<bool>>& signs, uint64_t vertices) {
-  const std::string& path = walk.path;
-  const auto fail = [&](const std::string& why) { throw InputError(path, walk.field, "broken PLY: " + why); };
+  const auto fail = [&walk](const std::string& why) { broken(walk, why); };
   // Each declared value needs at least one byte: counts the data cannot hold
   // are rejected before anything is read or allocated.
   const uint64_t avail = bytes.size() - body;
   for (const auto& e : elements)
     if (!e.props.empty() && e.count > avail) fail("element '" + e.name + "' declares more values than the file holds");
-  Body r(path, walk.field, bytes, body, format);
+  Body r(walk.path, walk.field, bytes, body, format);
   for (size_t ei = 0; ei < elements.size(); ++ei) {
     const Element& e = elements[ei];
     if (e.props.empty()) continue;  // holds no data, whatever its count (a loop over 10^10 would hang)
@@ -146,109 +149,144 @@ void walk_body(const Walk& walk, const std::string& bytes, size_t body, int form
 
 namespace {
 
-void read_ply(const Walk& walk, const std::string& bytes) {
-  const std::string& path = walk.path;
-  const auto fail = [&](const std::string& why) { throw InputError(path, walk.field, "broken PLY: " + why); };
-  if (!(bytes.compare(0, 4, "ply\n") == 0 || bytes.compare(0, 5, "ply\r\n") == 0))
-    throw InputError(path, walk.field, "not a PLY file (the first line is not 'ply')");
-  // The header ends at a line that is exactly "end_header" (a comment that
-  // merely contains the word does not end it: assimp reads on, found by
-  // fuzzing).
-  size_t body = std::string::npos, end = 0;
+// Where the header's last line "end_header" starts (*end) and the body
+// after it (*body). That line is exactly "end_header" (a comment that
+// merely contains the word does not end it: assimp reads on, found by
+// fuzzing).
+void find_end_header(const Walk& walk, const std::string& bytes, size_t* end, size_t* body) {
+  *body = std::string::npos;
+  *end = 0;
   for (size_t pos = 0; pos < bytes.size();) {
     size_t nl = bytes.find('\n', pos);
     if (nl == std::string::npos) nl = bytes.size();
     std::string l = bytes.substr(pos, nl - pos);
     while (!l.empty() && (l.back() == '\r' || l.back() == ' ' || l.back() == '\t')) l.pop_back();
     if (l == "end_header") {
-      end = pos;
-      body = nl + 1;
+      *end = pos;
+      *body = nl + 1;
       break;
     }
     pos = nl + 1;
   }
-  if (body == std::string::npos)
-    throw InputError(path, walk.field, "truncated PLY: the header has no 'end_header' line");
-  if (body > bytes.size()) body = bytes.size();
-  // The header is text lines: no control bytes, CR only before LF (assimp
-  // misread a property name holding NUL bytes, and a CR inside a line, and
-  // crashed: found by fuzzing). Bytes >= 0x80
-  // (UTF-8 in a comment) are fine; names are checked below.
+  if (*body == std::string::npos)
+    throw InputError(walk.path, walk.field, "truncated PLY: the header has no 'end_header' line");
+  if (*body > bytes.size()) *body = bytes.size();
+}
+
+// The header is text lines: no control bytes, CR only before LF (assimp
+// misread a property name holding NUL bytes, and a CR inside a line, and
+// crashed: found by fuzzing). Bytes >= 0x80 (UTF-8 in a comment) are fine;
+// names are checked as they are read.
+void check_header_bytes(const Walk& walk, const std::string& bytes, size_t end) {
   for (size_t i = 0; i < end; ++i) {
     const auto c = static_cast<unsigned char>(bytes[i]);
     if (c < 0x20 && c != '\n' && c != '\t' && !(c == '\r' && i + 1 < bytes.size() && bytes[i + 1] == '\n'))
-      fail("the header holds control byte " + std::to_string(c) + " at offset " + std::to_string(i) +
-           (c == '\r' ? " (a carriage return not ending a line)" : ""));
+      broken(walk, "the header holds control byte " + std::to_string(c) + " at offset " + std::to_string(i) +
+                       (c == '\r' ? " (a carriage return not ending a line)" : ""));
   }
-  std::istringstream header(bytes.substr(0, end));
-  std::string line;
-  int format = -1;
+}
+
+struct PlyHeader {
+  int format = -1;  // 0 ascii, 1 binary little endian, 2 binary big endian
   std::vector<Element> elements;
   std::vector<std::vector<bool>> signs;  // per element, per property: the (item) type is signed
-  std::getline(header, line);            // "ply"
+};
+
+// An "element name count" line (w past the key).
+void add_element(const Walk& walk, const std::string& line, std::istringstream& w, PlyHeader& h) {
+  Element e;
+  std::string count;
+  if (!(w >> e.name >> count) || count.empty() || count.find_first_not_of("0123456789") != std::string::npos ||
+      count.size() > 10)
+    broken(walk, "bad element line '" + line.substr(0, 60) + "'");
+  e.count = std::strtoull(count.c_str(), nullptr, 10);
+  if (!is_name(e.name)) broken(walk, "bad element name in '" + line.substr(0, 60) + "'");
+  for (const auto& o : h.elements)
+    if (o.name == e.name) broken(walk, "element '" + e.name + "' is declared twice");
+  h.elements.push_back(e);
+  h.signs.emplace_back();
+}
+
+// A "property [list count_type] type name" line of the last element (w
+// past the key).
+void add_property(const Walk& walk, const std::string& line, std::istringstream& w, PlyHeader& h) {
+  if (h.elements.empty()) broken(walk, "a property before any element");
+  std::string type;
+  w >> type;
+  Property p;
+  std::string item = type;
+  bool f = false;
+  if (type == "list") {
+    std::string ct;
+    w >> ct >> item;
+    p.count_size = type_size(ct, &f);
+    if (p.count_size == 0 || f) broken(walk, "bad list count type in '" + line.substr(0, 60) + "'");
+  }
+  p.size = type_size(item, &p.is_float);
+  std::string rest;
+  if (p.size == 0 || !(w >> p.name) || !is_name(p.name) || (w >> rest))
+    broken(walk, "bad property line '" + line.substr(0, 60) + "'");
+  for (const auto& o : h.elements.back().props)
+    if (o.name == p.name)
+      broken(walk, "property '" + p.name + "' of element '" + h.elements.back().name + "' is declared twice");
+  h.elements.back().props.push_back(p);
+  h.signs.back().push_back(is_signed_type(item));
+}
+
+// The header's lines after "ply": the format, the elements and their properties.
+PlyHeader parse_header(const Walk& walk, const std::string& text) {
+  std::istringstream header(text);
+  std::string line;
+  PlyHeader h;
+  std::getline(header, line);  // "ply"
   while (std::getline(header, line)) {
     std::istringstream w(line);
     std::string key;
     if (!(w >> key)) continue;
-    if (format < 0 && key != "format") fail("the line after 'ply' must be the format line (assimp needs it there)");
+    if (h.format < 0 && key != "format")
+      broken(walk, "the line after 'ply' must be the format line (assimp needs it there)");
     if (key == "comment" || key == "obj_info") continue;
     if (key == "format") {
-      if (format >= 0) fail("two format lines");
+      if (h.format >= 0) broken(walk, "two format lines");
       std::string f;
       w >> f;
-      format = f == "ascii" ? 0 : f == "binary_little_endian" ? 1 : f == "binary_big_endian" ? 2 : -1;
-      if (format < 0) fail("unknown format '" + f + "'");
+      h.format = f == "ascii" ? 0 : f == "binary_little_endian" ? 1 : f == "binary_big_endian" ? 2 : -1;
+      if (h.format < 0) broken(walk, "unknown format '" + f + "'");
     } else if (key == "element") {
-      Element e;
-      std::string count;
-      if (!(w >> e.name >> count) || count.empty() || count.find_first_not_of("0123456789") != std::string::npos ||
-          count.size() > 10)
-        fail("bad element line '" + line.substr(0, 60) + "'");
-      e.count = std::strtoull(count.c_str(), nullptr, 10);
-      if (!is_name(e.name)) fail("bad element name in '" + line.substr(0, 60) + "'");
-      for (const auto& o : elements)
-        if (o.name == e.name) fail("element '" + e.name + "' is declared twice");
-      elements.push_back(e);
-      signs.emplace_back();
+      add_element(walk, line, w, h);
     } else if (key == "property") {
-      if (elements.empty()) fail("a property before any element");
-      std::string type;
-      w >> type;
-      Property p;
-      std::string item = type;
-      bool f = false;
-      if (type == "list") {
-        std::string ct;
-        w >> ct >> item;
-        p.count_size = type_size(ct, &f);
-        if (p.count_size == 0 || f) fail("bad list count type in '" + line.substr(0, 60) + "'");
-      }
-      p.size = type_size(item, &p.is_float);
-      std::string rest;
-      if (p.size == 0 || !(w >> p.name) || !is_name(p.name) || (w >> rest))
-        fail("bad property line '" + line.substr(0, 60) + "'");
-      for (const auto& o : elements.back().props)
-        if (o.name == p.name) fail("property '" + p.name + "' of element '" + elements.back().name + "' is declared twice");
-      elements.back().props.push_back(p);
-      signs.back().push_back(is_signed_type(item));
+      add_property(walk, line, w, h);
     } else {
-      fail("unknown header line '" + line.substr(0, 60) + "'");
+      broken(walk, "unknown header line '" + line.substr(0, 60) + "'");
     }
   }
-  if (format < 0) fail("no format line");
-  // A mesh needs vertices with scalar x, y and z.
-  uint64_t vertices = 0;
+  if (h.format < 0) broken(walk, "no format line");
+  return h;
+}
+
+// The number of vertices: a mesh needs a vertex element with scalar x, y and z.
+uint64_t vertex_count(const Walk& walk, const std::vector<Element>& elements) {
   const Element* vertex = nullptr;
   for (const auto& e : elements)
     if (e.name == "vertex") vertex = &e;
-  if (vertex == nullptr) fail("no 'vertex' element");
-  vertices = vertex->count;
+  if (vertex == nullptr) broken(walk, "no 'vertex' element");
   for (const char* axis : {"x", "y", "z"}) {
     bool found = false;
     for (const auto& p : vertex->props) found = found || (p.name == axis && p.count_size == 0);
-    if (!found) fail(std::string("the vertex element has no scalar property '") + axis + "'");
+    if (!found) broken(walk, std::string("the vertex element has no scalar property '") + axis + "'");
   }
-  walk_body(walk, bytes, body, format, elements, signs, vertices);
+  return vertex->count;
+}
+
+void read_ply(const Walk& walk, const std::string& bytes) {
+  if (!(bytes.compare(0, 4, "ply\n") == 0 || bytes.compare(0, 5, "ply\r\n") == 0))
+    throw InputError(walk.path, walk.field, "not a PLY file (the first line is not 'ply')");
+  size_t end = 0, body = 0;
+  find_end_header(walk, bytes, &end, &body);
+  check_header_bytes(walk, bytes, end);
+  const PlyHeader h = parse_header(walk, bytes.substr(0, end));
+  const uint64_t vertices = vertex_count(walk, h.elements);
+  walk_body(walk, bytes, body, h.format, h.elements, h.signs, vertices);
 }
 
 }  // namespace

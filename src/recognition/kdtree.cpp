@@ -1,12 +1,71 @@
+// KdTree3 (kdtree.h): the build, the leaf kernel, the nearest, radius and
+// thinned searches, the search over the points not yet taken (Remaining)
+// and the tree cut down to a subset of its points (restricted).
 #include "recognition/kdtree.h"
-#include "recognition/kdtree_leaf.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <limits>
+#ifdef __SSE2__
+#include <xmmintrin.h>
+#endif
 
 namespace pb {
+
+// The leaf kernel and the radius traversal, used by the searches below.
+inline int KdTree3::leaf_distances(const Vec3f& q, int i, int m, float bound, float* d4) const {
+#ifdef __SSE2__
+  // Four lanes read whole (the arrays are padded); lanes from m on are masked.
+  const __m128 dx = _mm_sub_ps(_mm_loadu_ps(&xyz_[0][static_cast<size_t>(i)]), _mm_set1_ps(q.x()));
+  const __m128 dy = _mm_sub_ps(_mm_loadu_ps(&xyz_[1][static_cast<size_t>(i)]), _mm_set1_ps(q.y()));
+  const __m128 dz = _mm_sub_ps(_mm_loadu_ps(&xyz_[2][static_cast<size_t>(i)]), _mm_set1_ps(q.z()));
+  const __m128 d = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_add_ps(_mm_mul_ps(dy, dy), _mm_mul_ps(dz, dz)));
+  _mm_storeu_ps(d4, d);
+  return _mm_movemask_ps(_mm_cmple_ps(d, _mm_set1_ps(bound))) & ((1 << m) - 1);
+#else
+  int mask = 0;
+  for (int k = 0; k < m; ++k) {
+    d4[k] = (points_[static_cast<size_t>(i + k)] - q).squaredNorm();
+    if (d4[k] <= bound) mask |= 1 << k;
+  }
+  return mask;
+#endif
+}
+
+template <class F>
+bool KdTree3::scan_leaf(const Node& n, const Vec3f& q, const float& bound, F&& f) const {
+  float d4[4];
+  for (int i = n.begin; i < n.end; i += 4) {
+    const int m = std::min(4, n.end - i);
+    for (int mask = leaf_distances(q, i, m, bound, d4); mask != 0; mask &= mask - 1) {
+      const int k = __builtin_ctz(static_cast<unsigned>(mask));
+      if (f(d4[k], i + k)) return true;
+    }
+  }
+  return false;
+}
+
+// visit_radius (kdtree.h): near child first, the far one when the splitting
+// plane is within the radius.
+template <class F, class Skip>
+void KdTree3::visit_radius(int node, const Vec3f& q, float r2, F& f, const Skip& skip) const {
+  if (skip(node)) return;
+  const Node& n = nodes_[static_cast<size_t>(node)];
+  if (n.dim < 0) {  // the same distances as squaredNorm, visited in tree order
+    scan_leaf(n, q, r2, [&](float d, int pos) {
+      f(d, order_[static_cast<size_t>(pos)]);
+      return false;
+    });
+    return;
+  }
+  const float diff = q[n.dim] - n.split;
+  const int near = diff < 0 ? n.left : n.right, far = diff < 0 ? n.right : n.left;
+  visit_radius(near, q, r2, f, skip);
+  if (diff * diff <= r2) visit_radius(far, q, r2, f, skip);
+}
 
 KdTree3::KdTree3(const std::vector<Vec3f>& points, int leaf_size) {
   if (points.empty()) return;
@@ -404,6 +463,114 @@ size_t KdTree3::within_thinned(const Vec3f& q, float max_sq_dist, int max_points
     return last_found = 0;
   }
   return last_found = thinned(q, max_sq_dist, max_points, out);
+}
+
+// KdTree3::Remaining and radius_remaining (kdtree.h): a radius search that
+// skips the points taken so far. Region growing visits every point's
+// neighbourhood once; in a smooth region most of a neighbourhood is taken
+// by the time it is searched, and a subtree whose points are all taken is
+// not entered. The points reported are radius_unsorted's, in its order,
+// without the taken ones.
+KdTree3::Remaining::Remaining(const KdTree3& tree)
+    : tree_(&tree),
+      count_(tree.nodes_.size()),
+      parent_(tree.nodes_.size(), -1),
+      leaf_(tree.points_.size(), -1),
+      alive_(tree.points_.size(), 1) {
+  for (size_t id = 0; id < tree.nodes_.size(); ++id) {
+    const Node& n = tree.nodes_[id];
+    count_[id] = n.end - n.begin;
+    if (n.dim < 0) {
+      std::fill(leaf_.begin() + n.begin, leaf_.begin() + n.end, static_cast<int>(id));
+    } else {
+      parent_[static_cast<size_t>(n.left)] = static_cast<int>(id);
+      parent_[static_cast<size_t>(n.right)] = static_cast<int>(id);
+    }
+  }
+}
+
+void KdTree3::Remaining::remove(int index) {
+  const size_t pos = static_cast<size_t>(tree_->position_[static_cast<size_t>(index)]);
+  if (!alive_[pos]) return;
+  alive_[pos] = 0;
+  for (int node = leaf_[pos]; node >= 0; node = parent_[static_cast<size_t>(node)]) --count_[static_cast<size_t>(node)];
+}
+
+// visit_radius's order and pruning; a subtree with nothing left is skipped.
+void KdTree3::radius_remaining(const Vec3f& q, float r, const Remaining& left, std::vector<int>& out) const {
+  out.clear();
+  if (nodes_.empty() || !q.allFinite() || !(r > 0)) return;
+  auto add = [&left, &out](float, int i) {
+    if (left.has(i)) out.push_back(i);
+  };
+  visit_radius(0, q, r * r, add, [&left](int node) { return left.count_[static_cast<size_t>(node)] == 0; });
+}
+
+// KdTree3::restricted (kdtree.h): a tree over a subset of the points in
+// mapped coordinates, from this tree's structure. The nodes keep their
+// dimensions and children; their tree-order ranges shrink to the kept
+// points (an emptied leaf is an empty range), their splits are mapped.
+// Why that is a valid kd-tree: every point left of a split has its
+// coordinate at most the split, every point right of it at least the split
+// (the build's median), and a non-decreasing map keeps both relations.
+KdTree3 KdTree3::restricted(const std::vector<size_t>& keep, const std::vector<Vec3f>& points,
+                            const std::function<float(int, float)>& map) const {
+  KdTree3 t;
+  if (keep.empty() || nodes_.empty()) return t;
+  std::vector<int> rank(order_.size(), -1);  // input index -> its k, -1 when left out
+  for (size_t k = 0; k < keep.size(); ++k) rank[keep[k]] = static_cast<int>(k);
+  // Kept points in this tree's order; before[pos]: how many of them precede
+  // tree position pos (a node's new range is [before[begin], before[end])).
+  std::vector<int> before(order_.size() + 1);
+  t.order_.reserve(keep.size());
+  t.points_.reserve(keep.size());
+  for (size_t pos = 0; pos < order_.size(); ++pos) {
+    before[pos] = static_cast<int>(t.order_.size());
+    const int k = rank[static_cast<size_t>(order_[pos])];
+    if (k < 0) continue;
+    t.order_.push_back(k);
+    t.points_.push_back(points[static_cast<size_t>(k)]);
+  }
+  before[order_.size()] = static_cast<int>(t.order_.size());
+  t.position_.resize(t.order_.size());
+  for (auto& c : t.xyz_) c.reserve(t.points_.size() + 3);
+  for (size_t i = 0; i < t.order_.size(); ++i) {
+    t.position_[static_cast<size_t>(t.order_[i])] = static_cast<int>(i);
+    t.xyz_[0].push_back(t.points_[i].x());
+    t.xyz_[1].push_back(t.points_[i].y());
+    t.xyz_[2].push_back(t.points_[i].z());
+  }
+  for (auto& c : t.xyz_) c.resize(t.points_.size() + 3, 0.f);  // padded as a build pads them
+  t.nodes_ = nodes_;
+  t.boxes_.resize(nodes_.size());
+  // Nodes are numbered parent before children: from the last one back, a
+  // node's children are done when it is reached.
+  const float inf = std::numeric_limits<float>::infinity();
+  for (size_t id = t.nodes_.size(); id-- > 0;) {
+    Node& n = t.nodes_[id];
+    n.begin = before[static_cast<size_t>(n.begin)];
+    n.end = before[static_cast<size_t>(n.end)];
+    Box& b = t.boxes_[id];
+    std::fill(b.lo, b.lo + 3, inf);  // an empty node: an empty box
+    std::fill(b.hi, b.hi + 3, -inf);
+    if (n.dim < 0) {
+      for (int i = n.begin; i < n.end; ++i)
+        for (int d = 0; d < 3; ++d) {
+          b.lo[d] = std::min(b.lo[d], t.points_[static_cast<size_t>(i)][d]);
+          b.hi[d] = std::max(b.hi[d], t.points_[static_cast<size_t>(i)][d]);
+        }
+      continue;
+    }
+    n.split = map(n.dim, n.split);
+    for (const int child : {n.left, n.right}) {
+      const Box& c = t.boxes_[static_cast<size_t>(child)];
+      for (int d = 0; d < 3; ++d) {
+        b.lo[d] = std::min(b.lo[d], c.lo[d]);
+        b.hi[d] = std::max(b.hi[d], c.hi[d]);
+      }
+    }
+  }
+  return t;
 }
 
 }  // namespace pb

@@ -66,7 +66,7 @@ class KdTree3 {
     std::vector<char> alive_;  // per tree position
   };
   // radius_unsorted without the points `left` no longer has: the others in
-  // the same order (kdtree_remaining.cpp).
+  // the same order.
   void radius_remaining(const Vec3f& q, float r, const Remaining& left, std::vector<int>& out) const;
   // The list of within(q, max_sq_dist, out, false) thinned by
   // keep_evenly(out, max_points), the same entries in the same order, and
@@ -90,7 +90,7 @@ class KdTree3 {
   // points, so the result is a kd-tree over `points`: nearest and the any_
   // queries answer as on KdTree3(points), radius and within list the same
   // points (the unsorted orders differ). O(size) where a build is
-  // O(size log size). kdtree_restricted.cpp.
+  // O(size log size).
   KdTree3 restricted(const std::vector<size_t>& keep, const std::vector<Vec3f>& points,
                      const std::function<float(int, float)>& map) const;
   // Sorts (squared distance, index) entries as std::sort does (distance,
@@ -152,13 +152,13 @@ class KdTree3 {
   // Calls f(squared distance, tree position) for each point of leaf `n` at
   // most `bound` from q, in tree order, four distances at a time; `bound` is
   // read again for every four, so f may lower it. f returns true to stop the
-  // scan; then so does scan_leaf (kdtree_leaf.h).
+  // scan; then so does scan_leaf.
   template <class F>
   bool scan_leaf(const Node& n, const Vec3f& q, const float& bound, F&& f) const;
   // within()'s keys (entry_key) sorted into out, as (distance, index).
   static void sorted_entries(std::vector<uint64_t>& keys, std::vector<std::pair<float, int>>& out);
   // Calls f(squared distance, input index) for every point within sqrt(r2)
-  // of the subtrees for which skip(node) is false (kdtree_leaf.h).
+  // of the subtrees for which skip(node) is false.
   struct NoSkip {
     bool operator()(int) const { return false; }
   };

@@ -52,6 +52,27 @@ std::string unknown_sensor(const std::string& name) {
          "; or give a map with width, height, fx, fy, cx, cy, or a profile file NAME.yaml)";
 }
 
+// The structured-light model's fields, in noise_json's order.
+nlohmann::ordered_json structured_light_json(const StructuredLightNoise& s) {
+  return {{"baseline_mm", s.baseline_mm},
+          {"disparity_step_px", s.disparity_step_px},
+          {"disparity_sigma_px", s.disparity_sigma_px},
+          {"smoothing_radius_px", s.smoothing_radius_px},
+          {"smoothing_edge_px", s.smoothing_edge_px},
+          {"max_incidence_deg", s.max_incidence_deg},
+          {"shadows", s.shadows},
+          {"edge_bleed_px", s.edge_bleed_px},
+          {"edge_dropout_rate", s.edge_dropout_rate},
+          {"edge_dropout_px", s.edge_dropout_px},
+          {"reference_fx", s.reference_fx}};
+}
+
+std::set<std::string> keys_of(const nlohmann::ordered_json& object) {
+  std::set<std::string> keys;
+  for (auto it = object.begin(); it != object.end(); ++it) keys.insert(it.key());
+  return keys;
+}
+
 }  // namespace
 
 std::vector<std::string> sensor_names() { return {"synthetic", "astra", "kinect_one"}; }
@@ -175,13 +196,9 @@ NoiseSettings parse_noise(const YamlNode& node, const NoiseSettings& base) {
     return n;
   }
   const std::set<std::string> gaussian_keys = {"sigma_mm"};
-  const std::set<std::string> sl_keys = {"baseline_mm",         "disparity_step_px", "disparity_sigma_px",
-                                         "smoothing_radius_px", "smoothing_edge_px", "max_incidence_deg",
-                                         "shadows",             "edge_bleed_px",     "edge_dropout_rate",
-                                         "edge_dropout_px",     "reference_fx"};
-  const std::set<std::string> tof_keys = {"sigma_base_mm",        "sigma_per_m2_mm",    "edge_jump_mm",
-                                          "flying_fraction",      "max_incidence_deg",  "driver_edge_filter",
-                                          "edge_filter_close_mm", "edge_filter_far_mm", "edge_filter_span_mm"};
+  // Each model's keys: those noise_json writes for it.
+  const std::set<std::string> sl_keys = keys_of(structured_light_json(StructuredLightNoise{}));
+  const std::set<std::string> tof_keys = keys_of(tof_json(TimeOfFlightNoise{}));
   std::set<std::string> all = {"model"};
   all.insert(gaussian_keys.begin(), gaussian_keys.end());
   all.insert(sl_keys.begin(), sl_keys.end());
@@ -242,33 +259,21 @@ nlohmann::ordered_json noise_json(const NoiseSettings& n) {
   nlohmann::ordered_json j;
   j["model"] = n.model;
   if (n.model == "gaussian") j["sigma_mm"] = n.gaussian.sigma_mm;
-  if (n.model == "structured_light") {
-    const auto& s = n.structured_light;
-    j.update({{"baseline_mm", s.baseline_mm},
-              {"disparity_step_px", s.disparity_step_px},
-              {"disparity_sigma_px", s.disparity_sigma_px},
-              {"smoothing_radius_px", s.smoothing_radius_px},
-              {"smoothing_edge_px", s.smoothing_edge_px},
-              {"max_incidence_deg", s.max_incidence_deg},
-              {"shadows", s.shadows},
-              {"edge_bleed_px", s.edge_bleed_px},
-              {"edge_dropout_rate", s.edge_dropout_rate},
-              {"edge_dropout_px", s.edge_dropout_px},
-              {"reference_fx", s.reference_fx}});
-  }
-  if (n.model == "tof") {
-    const auto& t = n.tof;
-    j.update({{"sigma_base_mm", t.sigma_base_mm},
-              {"sigma_per_m2_mm", t.sigma_per_m2_mm},
-              {"edge_jump_mm", t.edge_jump_mm},
-              {"flying_fraction", t.flying_fraction},
-              {"max_incidence_deg", t.max_incidence_deg},
-              {"driver_edge_filter", t.driver_edge_filter},
-              {"edge_filter_close_mm", t.edge_filter_close_mm},
-              {"edge_filter_far_mm", t.edge_filter_far_mm},
-              {"edge_filter_span_mm", t.edge_filter_span_mm}});
-  }
+  if (n.model == "structured_light") j.update(structured_light_json(n.structured_light));
+  if (n.model == "tof") j.update(tof_json(n.tof));
   return j;
+}
+
+nlohmann::ordered_json tof_json(const TimeOfFlightNoise& t) {
+  return {{"sigma_base_mm", t.sigma_base_mm},
+          {"sigma_per_m2_mm", t.sigma_per_m2_mm},
+          {"edge_jump_mm", t.edge_jump_mm},
+          {"flying_fraction", t.flying_fraction},
+          {"max_incidence_deg", t.max_incidence_deg},
+          {"driver_edge_filter", t.driver_edge_filter},
+          {"edge_filter_close_mm", t.edge_filter_close_mm},
+          {"edge_filter_far_mm", t.edge_filter_far_mm},
+          {"edge_filter_span_mm", t.edge_filter_span_mm}};
 }
 
 }  // namespace pb

@@ -156,6 +156,9 @@ SensorProfile parse_sensor(const YamlNode& node);
 bool is_profile_file(const std::string& name);
 // The model's fields as a `noise:` map (parse_noise reads it back).
 nlohmann::ordered_json noise_json(const NoiseSettings& n);
+// The time-of-flight model's fields, in noise_json's order (noise_json's
+// `tof` keys; the scene set's posebench_scene.json lists them too).
+nlohmann::ordered_json tof_json(const TimeOfFlightNoise& t);
 // Intrinsics from a YAML map {width, height, fx, fy | hfov_deg, vfov_deg, cx,
 // cy}, each key defaulting to `base`'s (required where `base` has none; cx,
 // cy to the image centre when the size differs from base's). InputError

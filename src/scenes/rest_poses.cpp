@@ -28,115 +28,10 @@ class QuickHull {
   QuickHull(const std::vector<Vec3>& p) : P(p) {}
 
   std::vector<Eigen::Vector3i> run() {
-    const int n = static_cast<int>(P.size());
-    if (n < 4) return {};
-    Eigen::AlignedBox3d box;
-    for (const auto& p : P) box.extend(p);
-    const double diag = box.diagonal().norm();
-    if (!(diag > 0)) return {};
-    eps = 1e-6 * diag + 1e-9;
-
-    // Initial simplex from extreme points.
-    int axis = 0;
-    box.diagonal().maxCoeff(&axis);
-    int i0 = 0, i1 = 0;
-    for (int i = 0; i < n; ++i) {
-      if (P[i][axis] < P[i0][axis]) i0 = i;
-      if (P[i][axis] > P[i1][axis]) i1 = i;
-    }
-    const Vec3 dir = (P[i1] - P[i0]).normalized();
-    int i2 = -1;
-    double best = eps;
-    for (int i = 0; i < n; ++i) {
-      const Vec3 w = P[i] - P[i0];
-      const double dist = (w - dir * dir.dot(w)).norm();
-      if (dist > best) best = dist, i2 = i;
-    }
-    if (i2 < 0) return {};
-    const Vec3 pn = (P[i1] - P[i0]).cross(P[i2] - P[i0]).normalized();
-    int i3 = -1;
-    best = eps;
-    for (int i = 0; i < n; ++i) {
-      const double dist = std::abs(pn.dot(P[i] - P[i0]));
-      if (dist > best) best = dist, i3 = i;
-    }
-    if (i3 < 0) return {};
-    if (pn.dot(P[i3] - P[i0]) > 0) std::swap(i1, i2);  // i3 below plane (i0,i1,i2)
-    add_face(i0, i1, i2);
-    add_face(i0, i3, i1);
-    add_face(i1, i3, i2);
-    add_face(i2, i3, i0);
-
-    for (int i = 0; i < n; ++i) {
-      if (i == i0 || i == i1 || i == i2 || i == i3) continue;
-      for (int f = 0; f < 4; ++f)
-        if (dist(f, i) > eps) {
-          faces[f].outside.push_back(i);
-          break;
-        }
-    }
-
-    std::vector<int> stamp;
-    int stamp_id = 0;
-    for (size_t fi = 0; fi < faces.size(); ++fi) {
-      if (!faces[fi].alive || faces[fi].outside.empty()) continue;
-      // Furthest outside point.
-      int eye = -1;
-      double far = -1;
-      for (int i : faces[fi].outside) {
-        const double d = dist(static_cast<int>(fi), i);
-        if (d > far) far = d, eye = i;
-      }
-      // Faces visible from the eye (flood fill over adjacency).
-      stamp.resize(faces.size(), 0);
-      ++stamp_id;
-      std::vector<int> visible, stack{static_cast<int>(fi)};
-      stamp[fi] = stamp_id;
-      std::vector<char> is_visible(faces.size(), 0);
-      while (!stack.empty()) {
-        const int f = stack.back();
-        stack.pop_back();
-        if (dist(f, eye) <= eps) continue;
-        is_visible[f] = 1;
-        visible.push_back(f);
-        for (int k = 0; k < 3; ++k) {
-          const int g = neighbour(f, k);
-          if (g >= 0 && stamp[g] != stamp_id) {
-            stamp[g] = stamp_id;
-            stack.push_back(g);
-          }
-        }
-      }
-      // Horizon edges (a, b) as oriented in the visible faces.
-      std::vector<std::pair<int, int>> horizon;
-      std::vector<int> orphans;
-      for (int f : visible) {
-        for (int k = 0; k < 3; ++k) {
-          const int g = neighbour(f, k);
-          if (g < 0 || !is_visible[g]) horizon.emplace_back(faces[f].v[k], faces[f].v[(k + 1) % 3]);
-        }
-        for (int i : faces[f].outside)
-          if (i != eye) orphans.push_back(i);
-      }
-      for (int f : visible) {
-        faces[f].alive = false;
-        faces[f].outside.clear();
-        faces[f].outside.shrink_to_fit();
-        for (int k = 0; k < 3; ++k) {
-          auto it = edges.find(edge_key(faces[f].v[k], faces[f].v[(k + 1) % 3]));
-          if (it != edges.end() && it->second == f) edges.erase(it);
-        }
-      }
-      const size_t first_new = faces.size();
-      for (const auto& e : horizon) add_face(e.first, e.second, eye);
-      for (int i : orphans)
-        for (size_t f = first_new; f < faces.size(); ++f)
-          if (dist(static_cast<int>(f), i) > eps) {
-            faces[f].outside.push_back(i);
-            break;
-          }
-    }
-
+    if (P.size() < 4 || !initial_simplex()) return {};
+    // Every face in turn, the new ones too, until no point is outside any.
+    for (size_t fi = 0; fi < faces.size(); ++fi)
+      if (faces[fi].alive && !faces[fi].outside.empty()) add_farthest_point(static_cast<int>(fi));
     std::vector<Eigen::Vector3i> out;
     for (const auto& f : faces)
       if (f.alive) out.emplace_back(f.v[0], f.v[1], f.v[2]);
@@ -144,10 +39,140 @@ class QuickHull {
   }
 
  private:
+  // The first tetrahedron, from extreme points, with every other point
+  // given to a face it lies outside of; false when the points are flat.
+  bool initial_simplex() {
+    const int n = static_cast<int>(P.size());
+    Eigen::AlignedBox3d box;
+    for (const auto& p : P) box.extend(p);
+    const double diag = box.diagonal().norm();
+    if (!(diag > 0)) return false;
+    eps = 1e-6 * diag + 1e-9;
+    int axis = 0;
+    box.diagonal().maxCoeff(&axis);
+    int i0 = 0, i1 = 0;
+    for (int i = 0; i < n; ++i) {
+      if (P[i][axis] < P[i0][axis]) i0 = i;
+      if (P[i][axis] > P[i1][axis]) i1 = i;
+    }
+    int i2 = farthest_from_line(i0, i1);
+    if (i2 < 0) return false;
+    const Vec3 pn = (P[i1] - P[i0]).cross(P[i2] - P[i0]).normalized();
+    const int i3 = farthest_from_plane(i0, pn);
+    if (i3 < 0) return false;
+    if (pn.dot(P[i3] - P[i0]) > 0) std::swap(i1, i2);  // i3 below plane (i0,i1,i2)
+    add_face(i0, i1, i2);
+    add_face(i0, i3, i1);
+    add_face(i1, i3, i2);
+    add_face(i2, i3, i0);
+    for (int i = 0; i < n; ++i)
+      if (i != i0 && i != i1 && i != i2 && i != i3) give_to_face_from(0, i);
+    return true;
+  }
+
+  // The point farthest (beyond eps) from the line through points a and b, or -1.
+  int farthest_from_line(int a, int b) const {
+    const Vec3 dir = (P[b] - P[a]).normalized();
+    int far = -1;
+    double best = eps;
+    for (int i = 0; i < static_cast<int>(P.size()); ++i) {
+      const Vec3 w = P[i] - P[a];
+      const double dist = (w - dir * dir.dot(w)).norm();
+      if (dist > best) best = dist, far = i;
+    }
+    return far;
+  }
+
+  // The point farthest (beyond eps) from the plane through point a with unit
+  // normal pn, on either side, or -1.
+  int farthest_from_plane(int a, const Vec3& pn) const {
+    int far = -1;
+    double best = eps;
+    for (int i = 0; i < static_cast<int>(P.size()); ++i) {
+      const double dist = std::abs(pn.dot(P[i] - P[a]));
+      if (dist > best) best = dist, far = i;
+    }
+    return far;
+  }
+
+  // Point i joins the outside list of the first face from `first` on that
+  // it lies outside of (none: it is inside the hull).
+  void give_to_face_from(size_t first, int i) {
+    for (size_t f = first; f < faces.size(); ++f)
+      if (dist(static_cast<int>(f), i) > eps) {
+        faces[f].outside.push_back(i);
+        break;
+      }
+  }
+
+  // Adds face fi's farthest outside point (the eye) to the hull: the faces
+  // it sees go, a cone from the eye to their horizon replaces them, and
+  // their other outside points go to the new faces.
+  void add_farthest_point(int fi) {
+    int eye = -1;
+    double far = -1;
+    for (int i : faces[fi].outside) {
+      const double d = dist(fi, i);
+      if (d > far) far = d, eye = i;
+    }
+    std::vector<char> is_visible(faces.size(), 0);
+    const std::vector<int> visible = faces_seen_from(fi, eye, is_visible);
+    std::vector<std::pair<int, int>> horizon;  // edges (a, b) as oriented in the visible faces
+    std::vector<int> orphans;
+    for (int f : visible) {
+      for (int k = 0; k < 3; ++k) {
+        const int g = neighbour(f, k);
+        if (g < 0 || !is_visible[g]) horizon.emplace_back(faces[f].v[k], faces[f].v[(k + 1) % 3]);
+      }
+      for (int i : faces[f].outside)
+        if (i != eye) orphans.push_back(i);
+    }
+    for (int f : visible) remove_face(f);
+    const size_t first_new = faces.size();
+    for (const auto& e : horizon) add_face(e.first, e.second, eye);
+    for (int i : orphans) give_to_face_from(first_new, i);
+  }
+
+  // The faces the eye sees, found by a flood fill over adjacency from face
+  // fi (which it sees), each marked in is_visible.
+  std::vector<int> faces_seen_from(int fi, int eye, std::vector<char>& is_visible) {
+    stamp.resize(faces.size(), 0);
+    ++stamp_id;
+    std::vector<int> visible, stack{fi};
+    stamp[fi] = stamp_id;
+    while (!stack.empty()) {
+      const int f = stack.back();
+      stack.pop_back();
+      if (dist(f, eye) <= eps) continue;
+      is_visible[f] = 1;
+      visible.push_back(f);
+      for (int k = 0; k < 3; ++k) {
+        const int g = neighbour(f, k);
+        if (g >= 0 && stamp[g] != stamp_id) {
+          stamp[g] = stamp_id;
+          stack.push_back(g);
+        }
+      }
+    }
+    return visible;
+  }
+
+  void remove_face(int f) {
+    faces[f].alive = false;
+    faces[f].outside.clear();
+    faces[f].outside.shrink_to_fit();
+    for (int k = 0; k < 3; ++k) {
+      auto it = edges.find(edge_key(faces[f].v[k], faces[f].v[(k + 1) % 3]));
+      if (it != edges.end() && it->second == f) edges.erase(it);
+    }
+  }
+
   const std::vector<Vec3>& P;
   std::vector<HullFace> faces;
   std::unordered_map<uint64_t, int> edges;  // directed edge -> face
   double eps = 0;
+  std::vector<int> stamp;  // per face: the flood fill that last reached it
+  int stamp_id = 0;
 
   double dist(int f, int i) const { return faces[f].n.dot(P[i]) - faces[f].d; }
   int neighbour(int f, int k) const {
@@ -275,20 +300,11 @@ bool convex_polygons_overlap(const std::vector<Eigen::Vector2d>& a,
   return !(separated_on(a) || separated_on(b));
 }
 
-RestPoses compute_rest_poses(const Mesh& mesh, double min_margin_fraction) {
-  RestPoses out;
-  std::vector<Vec3> V;
-  V.reserve(mesh.vertices.size());
-  for (const auto& v : mesh.vertices) V.push_back(v.cast<double>());
-  const auto H = convex_hull_3d(V);
-  if (H.empty()) return out;
-  const Vec3 com = centre_of_mass(mesh);
-  out.centre_of_mass = com;
-  Eigen::AlignedBox3d box;
-  for (const auto& v : V) box.extend(v);
-  const double min_margin = std::max(0.05, min_margin_fraction * box.diagonal().norm());
+namespace {
 
-  // Merge coplanar adjacent hull triangles into facets (union-find).
+// The hull's triangles grouped into facets: adjacent coplanar triangles
+// merged (union-find), each facet its triangles' indices.
+std::map<int, std::vector<int>> coplanar_facets(const std::vector<Vec3>& V, const std::vector<Eigen::Vector3i>& H) {
   const int nf = static_cast<int>(H.size());
   std::vector<Vec3> normal(nf);
   for (int f = 0; f < nf; ++f)
@@ -307,51 +323,82 @@ RestPoses compute_rest_poses(const Mesh& mesh, double min_margin_fraction) {
     }
   std::map<int, std::vector<int>> groups;
   for (int f = 0; f < nf; ++f) groups[find(f)].push_back(f);
+  return groups;
+}
 
+// The smallest distance of c inside the convex polygon (negative outside).
+double margin_inside(const std::vector<Eigen::Vector2d>& poly, const Eigen::Vector2d& c) {
+  double margin = 1e300;
+  for (size_t i = 0; i < poly.size(); ++i) {
+    const Eigen::Vector2d e = poly[(i + 1) % poly.size()] - poly[i];
+    const Eigen::Vector2d r = c - poly[i];
+    margin = std::min(margin, (e.x() * r.y() - e.y() * r.x()) / e.norm());  // left of edge > 0
+  }
+  return margin;
+}
+
+// The rest pose on one facet (its triangles `members` of H), its
+// probability the (unnormalized) solid angle of the facet seen from the
+// centre of mass; false when the facet is degenerate or the centre of mass
+// projects less than min_margin inside it.
+bool rest_pose_on_facet(const std::vector<Vec3>& V, const std::vector<Eigen::Vector3i>& H,
+                        const std::vector<int>& members, const Vec3& com, double min_margin, RestPose& rp) {
+  // Area-weighted facet normal and its vertices.
+  Vec3 n = Vec3::Zero();
+  std::vector<int> verts;
+  for (int f : members) {
+    n += (V[H[f][1]] - V[H[f][0]]).cross(V[H[f][2]] - V[H[f][0]]);
+    for (int k = 0; k < 3; ++k) verts.push_back(H[f][k]);
+  }
+  if (n.norm() <= 0) return false;
+  n.normalize();
+  std::sort(verts.begin(), verts.end());
+  verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+  const Vec3 u = n.unitOrthogonal();
+  const Vec3 w = n.cross(u);
+  std::vector<Eigen::Vector2d> p2;
+  double d = 0;
+  for (int i : verts) {
+    p2.emplace_back(u.dot(V[i]), w.dot(V[i]));
+    d += n.dot(V[i]);
+  }
+  d /= verts.size();
+  const auto poly = convex_hull_2d(p2);
+  if (poly.size() < 3) return false;
+  const double margin = margin_inside(poly, Eigen::Vector2d(u.dot(com), w.dot(com)));
+  if (margin < min_margin) return false;
+  // Solid angle of the facet polygon seen from the centre of mass.
+  auto lift = [&](const Eigen::Vector2d& q) { return Vec3(u * q.x() + w * q.y() + n * d - com); };
+  double omega = 0;
+  const Vec3 a = lift(poly[0]);
+  for (size_t i = 1; i + 1 < poly.size(); ++i) omega += solid_angle(a, lift(poly[i]), lift(poly[i + 1]));
+  rp.normal = n;
+  rp.probability = omega;
+  rp.margin_mm = margin;
+  rp.R_rest = Eigen::Quaterniond::FromTwoVectors(n, Vec3(0, 0, -1)).toRotationMatrix();
+  return true;
+}
+
+}  // namespace
+
+RestPoses compute_rest_poses(const Mesh& mesh, double min_margin_fraction) {
+  RestPoses out;
+  std::vector<Vec3> V;
+  V.reserve(mesh.vertices.size());
+  for (const auto& v : mesh.vertices) V.push_back(v.cast<double>());
+  const auto H = convex_hull_3d(V);
+  if (H.empty()) return out;
+  const Vec3 com = centre_of_mass(mesh);
+  out.centre_of_mass = com;
+  Eigen::AlignedBox3d box;
+  for (const auto& v : V) box.extend(v);
+  const double min_margin = std::max(0.05, min_margin_fraction * box.diagonal().norm());
   double total = 0;
-  for (const auto& [root, members] : groups) {
-    // Area-weighted facet normal and its vertices.
-    Vec3 n = Vec3::Zero();
-    std::vector<int> verts;
-    for (int f : members) {
-      n += (V[H[f][1]] - V[H[f][0]]).cross(V[H[f][2]] - V[H[f][0]]);
-      for (int k = 0; k < 3; ++k) verts.push_back(H[f][k]);
-    }
-    if (n.norm() <= 0) continue;
-    n.normalize();
-    std::sort(verts.begin(), verts.end());
-    verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
-    const Vec3 u = n.unitOrthogonal();
-    const Vec3 w = n.cross(u);
-    std::vector<Eigen::Vector2d> p2;
-    double d = 0;
-    for (int i : verts) {
-      p2.emplace_back(u.dot(V[i]), w.dot(V[i]));
-      d += n.dot(V[i]);
-    }
-    d /= verts.size();
-    const auto poly = convex_hull_2d(p2);
-    if (poly.size() < 3) continue;
-    const Eigen::Vector2d c2(u.dot(com), w.dot(com));
-    double margin = 1e300;
-    for (size_t i = 0; i < poly.size(); ++i) {
-      const Eigen::Vector2d e = poly[(i + 1) % poly.size()] - poly[i];
-      const Eigen::Vector2d r = c2 - poly[i];
-      margin = std::min(margin, (e.x() * r.y() - e.y() * r.x()) / e.norm());  // left of edge > 0
-    }
-    if (margin < min_margin) continue;
-    // Solid angle of the facet polygon seen from the centre of mass.
-    auto lift = [&](const Eigen::Vector2d& q) { return Vec3(u * q.x() + w * q.y() + n * d - com); };
-    double omega = 0;
-    const Vec3 a = lift(poly[0]);
-    for (size_t i = 1; i + 1 < poly.size(); ++i) omega += solid_angle(a, lift(poly[i]), lift(poly[i + 1]));
+  for (const auto& [root, members] : coplanar_facets(V, H)) {
     RestPose rp;
-    rp.normal = n;
-    rp.probability = omega;
-    rp.margin_mm = margin;
-    rp.R_rest = Eigen::Quaterniond::FromTwoVectors(n, Vec3(0, 0, -1)).toRotationMatrix();
+    if (!rest_pose_on_facet(V, H, members, com, min_margin, rp)) continue;
     out.poses.push_back(rp);
-    total += omega;
+    total += rp.probability;
   }
   if (out.poses.empty()) return out;
   for (auto& p : out.poses) p.probability /= total;

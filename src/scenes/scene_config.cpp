@@ -350,16 +350,7 @@ std::string scene_settings_json(const SceneSettings& s) {
         {"smoothing_radius_px", n.structured_light.smoothing_radius_px},
         {"max_incidence_deg", n.structured_light.max_incidence_deg},
         {"shadows", n.structured_light.shadows}}},
-      {"tof",
-       {{"sigma_base_mm", n.tof.sigma_base_mm},
-        {"sigma_per_m2_mm", n.tof.sigma_per_m2_mm},
-        {"edge_jump_mm", n.tof.edge_jump_mm},
-        {"flying_fraction", n.tof.flying_fraction},
-        {"max_incidence_deg", n.tof.max_incidence_deg},
-        {"driver_edge_filter", n.tof.driver_edge_filter},
-        {"edge_filter_close_mm", n.tof.edge_filter_close_mm},
-        {"edge_filter_far_mm", n.tof.edge_filter_far_mm},
-        {"edge_filter_span_mm", n.tof.edge_filter_span_mm}}}};
+      {"tof", tof_json(n.tof)}};
   j["depth_scale"] = s.depth_scale;
   if (s.has_stated_intrinsics) {  // older sets' json
     const Intrinsics& S = s.stated_intrinsics;

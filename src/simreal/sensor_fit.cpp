@@ -152,24 +152,18 @@ FitLoss fit_loss(const SensorStats& real, const SensorStats& sim, int64_t min_pi
   return L;
 }
 
-SensorFitResult fit_sensor(const std::string& dataset, const SensorFitSettings& s) {
-  const std::string& model = s.base.noise.model;
-  if (model != "structured_light" && model != "tof")
-    throw InputError(dataset, "--base", "the base profile's noise model is '" + model +
-                                            "'; sensor-fit fits structured_light or tof");
-  const BopDataset ds(dataset);
+namespace {
+
+// The frames the fit simulates, one per ground-truth frame: its twin's
+// renders (the truth and the scene), the real frame's statistics added to
+// `real`, its support plane listed in r.planes; [depth_lo, depth_hi] takes
+// in the real frames' depths.
+std::vector<FitFrame> twin_frames(const BopDataset& ds, const SensorFitSettings& s, SensorStatsAccumulator& real,
+                                  SensorFitResult& r, double& depth_lo, double& depth_hi) {
   std::vector<GtFrame> gt_frames = list_gt_frames(ds, s.split, s.max_images, s.stride);
-  SensorFitResult r;
-  r.dataset = dataset;
-  r.planes = nlohmann::ordered_json::array();
   RendererPool pool;
   ModelMeshes meshes(ds);
-  // The final statistics also measure the normals (too slow for every candidate).
-  SensorStatsSettings with_normals = s.stats;
-  if (with_normals.normal_window_px == 0) with_normals.normal_window_px = 5;
-  SensorStatsAccumulator real(with_normals);
   std::vector<FitFrame> frames;
-  double depth_lo = 1e300, depth_hi = 0;
   for (GtFrame& g : gt_frames) {
     load_gt_depth(ds, s.split, g);
     const int sid = g.scene_id, iid = g.info.im_id;
@@ -191,6 +185,48 @@ SensorFitResult fit_sensor(const std::string& dataset, const SensorFitSettings& 
     if (frames.empty()) r.K = g.info.K;
     frames.push_back(std::move(f));
   }
+  return frames;
+}
+
+// Coordinate descent over the axes' values from their middle values: each
+// axis in turn takes the value of the least loss(x), the others held;
+// passes until none changes (at most 3). The values found, axis by axis.
+std::vector<double> coordinate_descent(const std::vector<Axis>& axes,
+                                       const std::function<double(const std::vector<double>&)>& loss) {
+  std::vector<double> at(axes.size());
+  for (size_t k = 0; k < axes.size(); ++k) at[k] = axes[k].values[axes[k].values.size() / 2];
+  double best = loss(at);
+  for (int pass = 0; pass < 3; ++pass) {
+    bool changed = false;
+    for (size_t k = 0; k < axes.size(); ++k)
+      for (double v : axes[k].values) {
+        std::vector<double> x = at;
+        x[k] = v;
+        const double l = loss(x);
+        if (l < best - 1e-12) best = l, at = x, changed = true;
+      }
+    if (!changed) break;
+  }
+  return at;
+}
+
+}  // namespace
+
+SensorFitResult fit_sensor(const std::string& dataset, const SensorFitSettings& s) {
+  const std::string& model = s.base.noise.model;
+  if (model != "structured_light" && model != "tof")
+    throw InputError(dataset, "--base", "the base profile's noise model is '" + model +
+                                            "'; sensor-fit fits structured_light or tof");
+  const BopDataset ds(dataset);
+  SensorFitResult r;
+  r.dataset = dataset;
+  r.planes = nlohmann::ordered_json::array();
+  // The final statistics also measure the normals (too slow for every candidate).
+  SensorStatsSettings with_normals = s.stats;
+  if (with_normals.normal_window_px == 0) with_normals.normal_window_px = 5;
+  SensorStatsAccumulator real(with_normals);
+  double depth_lo = 1e300, depth_hi = 0;
+  const std::vector<FitFrame> frames = twin_frames(ds, s, real, r, depth_lo, depth_hi);
   r.images = static_cast<int>(frames.size());
   // The sensor measured what the frames show: the base's range widens to
   // take it in (a close-range mode, say), else the simulation drops it.
@@ -204,11 +240,8 @@ SensorFitResult fit_sensor(const std::string& dataset, const SensorFitSettings& 
         r.real, r.K.fx, start.structured_light.baseline_mm, start.structured_light.disparity_step_px);
   r.base = simulate(frames, base, base.noise, s, with_normals);
   r.base_loss = fit_loss(r.real, r.base);
-  // Coordinate descent: each field in turn takes the value with the least
-  // loss, the others held; passes until none changes (at most 3).
+  // Each candidate simulated once (the descent asks again for values it met).
   const std::vector<Axis> axes = axes_for(model);
-  std::vector<double> at(axes.size());
-  NoiseSettings cur = start;
   std::map<std::vector<double>, double> seen;
   auto evaluate = [&](const std::vector<double>& x) {
     if (auto it = seen.find(x); it != seen.end()) return it->second;
@@ -222,19 +255,8 @@ SensorFitResult fit_sensor(const std::string& dataset, const SensorFitSettings& 
     r.candidates.push_back(c);
     return seen[x] = c.loss.total();
   };
-  for (size_t k = 0; k < axes.size(); ++k) at[k] = axes[k].values[axes[k].values.size() / 2];
-  double best = evaluate(at);
-  for (int pass = 0; pass < 3; ++pass) {
-    bool changed = false;
-    for (size_t k = 0; k < axes.size(); ++k)
-      for (double v : axes[k].values) {
-        std::vector<double> x = at;
-        x[k] = v;
-        const double l = evaluate(x);
-        if (l < best - 1e-12) best = l, at = x, changed = true;
-      }
-    if (!changed) break;
-  }
+  const std::vector<double> at = coordinate_descent(axes, evaluate);
+  NoiseSettings cur = start;
   for (size_t k = 0; k < axes.size(); ++k) axes[k].set(cur, at[k]);
   r.profile = base;
   r.profile.name = s.name;

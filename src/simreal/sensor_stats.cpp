@@ -128,6 +128,34 @@ void SensorStatsAccumulator::count(Acc& a, double r, double centre, bool missing
   }
 }
 
+namespace {
+
+// One pixel into a silhouette bin: no depth, nearer or farther than the
+// object's surface by more than the band, else on it.
+void tally(SilhouetteBin& b, bool missing, bool nearer, bool farther) {
+  ++b.n;
+  if (missing) ++b.missing;
+  else if (nearer) ++b.nearer;
+  else if (farther) ++b.farther;
+  else ++b.object;
+}
+
+}  // namespace
+
+std::vector<double> SensorStatsAccumulator::instance_centres(const DepthImage& measured, const RenderOutput& truth,
+                                                             size_t instances) const {
+  std::vector<std::vector<float>> inst_r(instances);
+  for (size_t p = 0; p < truth.labels.size(); ++p) {
+    const int label = truth.labels[p];
+    if (label < 0 || !(measured.z[p] > 0)) continue;
+    const double zt = truth.depth.z[p], r = measured.z[p] - zt;
+    if (std::abs(r) <= s_.outlier_mm + s_.outlier_rel * zt) inst_r[label].push_back(static_cast<float>(r));
+  }
+  std::vector<double> centre(instances);
+  for (size_t k = 0; k < instances; ++k) centre[k] = median(inst_r[k]);
+  return centre;
+}
+
 void SensorStatsAccumulator::add(const DepthImage& measured, const RenderOutput& truth, const Intrinsics& K,
                                  const std::vector<int>& obj_ids) {
   const int W = measured.width, H = measured.height;
@@ -136,16 +164,7 @@ void SensorStatsAccumulator::add(const DepthImage& measured, const RenderOutput&
   std::vector<int> out_d, out_src;
   outside_distance(truth.labels, W, H, s_.silhouette_px, out_d, out_src);
   const bool have_normals = truth.normals.size() == truth.labels.size();
-  // Each instance's median inlier residual: its offset along the ray.
-  std::vector<std::vector<float>> inst_r(obj_ids.size());
-  for (size_t p = 0; p < truth.labels.size(); ++p) {
-    const int label = truth.labels[p];
-    if (label < 0 || !(measured.z[p] > 0)) continue;
-    const double zt = truth.depth.z[p], r = measured.z[p] - zt;
-    if (std::abs(r) <= s_.outlier_mm + s_.outlier_rel * zt) inst_r[label].push_back(static_cast<float>(r));
-  }
-  std::vector<double> centre(obj_ids.size());
-  for (size_t k = 0; k < obj_ids.size(); ++k) centre[k] = median(inst_r[k]);
+  const std::vector<double> centre = instance_centres(measured, truth, obj_ids.size());
   for (int v = 0; v < H; ++v)
     for (int u = 0; u < W; ++u) {
       const size_t p = static_cast<size_t>(v) * W + u;
@@ -156,13 +175,8 @@ void SensorStatsAccumulator::add(const DepthImage& measured, const RenderOutput&
         // Outside the silhouette: like the nearest object pixel's depth?
         if (out_d[p] < 1) continue;
         const double zt = truth.depth.z[out_src[p]];
-        SilhouetteBin& b = sil_[s_.silhouette_px + out_d[p]];
-        ++b.n;
         const double band = s_.outlier_mm + s_.outlier_rel * zt;
-        if (missing) ++b.missing;
-        else if (zm < zt - band) ++b.nearer;
-        else if (zm > zt + band) ++b.farther;
-        else ++b.object;
+        tally(sil_[s_.silhouette_px + out_d[p]], missing, zm < zt - band, zm > zt + band);
         continue;
       }
       const double zt = truth.depth.z[p];
@@ -183,17 +197,15 @@ void SensorStatsAccumulator::add(const DepthImage& measured, const RenderOutput&
       count(edge_[std::min(s_.edge_bins_px - 1, inside[p])], r, c, missing, zt);
       if (inside[p] >= 8 && inc < 45) count(interior_, r, c, missing, zt);
       if (inside[p] < s_.silhouette_px) {
-        SilhouetteBin& b = sil_[s_.silhouette_px - inside[p]];
-        ++b.n;
         const double band = s_.outlier_mm + s_.outlier_rel * zt;
-        if (missing) ++b.missing;
-        else if (r < -band) ++b.nearer;
-        else if (r > band) ++b.farther;
-        else ++b.object;
+        tally(sil_[s_.silhouette_px - inside[p]], missing, r < -band, r > band);
       }
     }
   if (s_.normal_window_px > 0 && truth.normals.size() == truth.labels.size()) add_normals(measured, truth, K);
-  // Quantization: distinct measured depths per bin of this frame.
+  add_quantization(measured);
+}
+
+void SensorStatsAccumulator::add_quantization(const DepthImage& measured) {
   std::vector<std::vector<float>> vals(depth_.size());
   for (float z : measured.z) {
     if (!(z > 0)) continue;

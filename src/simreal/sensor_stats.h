@@ -120,7 +120,12 @@ class SensorStatsAccumulator {
   std::vector<SilhouetteBin> sil_;
   std::vector<std::vector<double>> quant_steps_;  // per depth bin, one step per frame
   std::vector<std::vector<float>> normal_deg_;    // per depth bin
+  // Each instance's median inlier residual: its offset along the ray.
+  std::vector<double> instance_centres(const DepthImage& measured, const RenderOutput& truth, size_t instances) const;
   void add_normals(const DepthImage& measured, const RenderOutput& truth, const Intrinsics& K);
+  // Quantization: the step between distinct measured depths per depth bin
+  // of this frame (their median gap).
+  void add_quantization(const DepthImage& measured);
 };
 
 // Object pixels' distance (4-connected steps) to the nearest pixel of

@@ -72,14 +72,17 @@ std::vector<float> vfh_histogram_pcl(const std::vector<Vec3f>& points, const std
   return std::vector<float>(sig[0].histogram, sig[0].histogram + 308);
 }
 
-std::vector<Region> stable_regions_pcl(const PointSet& cloud, const GlobalSettings& s, bool sorted) {
-  std::vector<Region> regions;
+namespace {
+
+using PointNormalCloud = pcl::PointCloud<pcl::PointNormal>;
+using PointNormalTree = pcl::search::KdTree<pcl::PointNormal>;
+
+// Step 0 (as CVFH): the finite points without the ones of high curvature,
+// normals zero.
+PointNormalCloud::Ptr low_curvature_points(const PointSet& cloud, const GlobalSettings& s) {
   const size_t n = cloud.points.size();
   const bool has_c = cloud.curvature.size() == n;
-  const size_t min_pts = static_cast<size_t>(std::max(s.cvfh_min_region_points, 1));
-
-  // Step 0 (as CVFH): drop the points of high curvature.
-  pcl::PointCloud<pcl::PointNormal>::Ptr filtered(new pcl::PointCloud<pcl::PointNormal>);
+  PointNormalCloud::Ptr filtered(new PointNormalCloud);
   for (size_t i = 0; i < n; ++i) {
     if (!cloud.points[i].allFinite()) continue;
     if (has_c && !(cloud.curvature[i] <= s.cvfh_curvature_threshold)) continue;
@@ -89,68 +92,90 @@ std::vector<Region> stable_regions_pcl(const PointSet& cloud, const GlobalSettin
     p.curvature = 0;
     filtered->push_back(p);
   }
-  if (filtered->size() < min_pts) return regions;
+  return filtered;
+}
 
-  // Normals recomputed on the remaining points, toward the camera (origin).
-  pcl::search::KdTree<pcl::PointNormal>::Ptr tree(new pcl::search::KdTree<pcl::PointNormal>(false));
-  tree->setInputCloud(filtered);
-  {
-    pcl::NormalEstimation<pcl::PointNormal, pcl::PointNormal> ne;
-    ne.setRadiusSearch(s.cvfh_normal_radius_mm);
-    ne.setSearchMethod(tree);
-    ne.setInputCloud(filtered);
-    ne.setViewPoint(0.f, 0.f, 0.f);
-    ne.compute(*filtered);
+// Normals recomputed on the points, toward the camera (origin).
+void recompute_normals(const PointNormalCloud::Ptr& points, const GlobalSettings& s) {
+  PointNormalTree::Ptr tree(new PointNormalTree(false));
+  tree->setInputCloud(points);
+  pcl::NormalEstimation<pcl::PointNormal, pcl::PointNormal> ne;
+  ne.setRadiusSearch(s.cvfh_normal_radius_mm);
+  ne.setSearchMethod(tree);
+  ne.setInputCloud(points);
+  ne.setViewPoint(0.f, 0.f, 0.f);
+  ne.compute(*points);
+}
+
+// One smooth region grown from point i (CVFH's
+// extractEuclideanClustersSmooth): a neighbour within the tolerance joins
+// when its normal is within the angle of the normal of the point that
+// reached it. Its points (marked processed), in the order they joined.
+std::vector<int> grow_smooth_region(const PointNormalCloud& points, const PointNormalTree& tree, size_t i, float tol,
+                                    double eps, std::vector<char>& processed) {
+  pcl::Indices nn;
+  std::vector<float> nd;
+  processed[i] = 1;
+  std::vector<int> queue{static_cast<int>(i)};
+  for (size_t q = 0; q < queue.size(); ++q) {
+    const int seed = queue[q];
+    const Vec3f ns = points[seed].getNormalVector3fMap();
+    if (!ns.allFinite()) continue;
+    if (tree.radiusSearch(seed, tol, nn, nd) <= 0) continue;
+    // As PCL's CVFH, the first neighbour returned is skipped (it assumes
+    // it is the seed itself, which an unsorted search does not promise);
+    // kept so the regions are exactly CVFH's.
+    for (size_t jj = 1; jj < nn.size(); ++jj) {
+      const auto j = nn[jj];
+      if (processed[j]) continue;
+      const Vec3f nj = points[j].getNormalVector3fMap();
+      const double dot = ns.dot(nj);
+      if (std::acos(std::clamp(dot, -1.0, 1.0)) < eps && nj.allFinite()) {
+        processed[j] = 1;
+        queue.push_back(j);
+      }
+    }
   }
-  // The tree of the region growing: PCL's CVFH builds it unsorted.
-  tree.reset(new pcl::search::KdTree<pcl::PointNormal>(sorted));
-  tree->setInputCloud(filtered);  // same points; the normals changed
+  return queue;
+}
 
-  // Smooth region growing (CVFH's extractEuclideanClustersSmooth): a
-  // neighbour within the tolerance joins when its normal is within the
-  // angle of the normal of the point that reached it.
+// The region of the given points (ascending indices): their points and
+// normals, centroid and mean normal.
+Region region_of(const PointNormalCloud& points, const std::vector<int>& members) {
+  Region r;
+  Eigen::Vector3d c = Eigen::Vector3d::Zero(), nsum = Eigen::Vector3d::Zero();
+  for (int k : members) {
+    const auto& p = points[k];
+    r.points.push_back(p.getVector3fMap());
+    r.normals.push_back(p.getNormalVector3fMap());
+    c += p.getVector3fMap().cast<double>();
+    nsum += p.getNormalVector3fMap().cast<double>();
+  }
+  r.centroid = (c / static_cast<double>(members.size())).cast<float>();
+  if (nsum.norm() > 0) r.mean_normal = nsum.normalized().cast<float>();
+  return r;
+}
+
+}  // namespace
+
+std::vector<Region> stable_regions_pcl(const PointSet& cloud, const GlobalSettings& s, bool sorted) {
+  std::vector<Region> regions;
+  const size_t min_pts = static_cast<size_t>(std::max(s.cvfh_min_region_points, 1));
+  const PointNormalCloud::Ptr filtered = low_curvature_points(cloud, s);
+  if (filtered->size() < min_pts) return regions;
+  recompute_normals(filtered, s);
+  // The tree of the region growing: PCL's CVFH builds it unsorted.
+  PointNormalTree::Ptr tree(new PointNormalTree(sorted));
+  tree->setInputCloud(filtered);
   const double eps = s.cvfh_eps_angle_deg * M_PI / 180.0;
   const float tol = static_cast<float>(s.cvfh_cluster_tolerance_mm);
   std::vector<char> processed(filtered->size(), 0);
-  pcl::Indices nn;
-  std::vector<float> nd;
   for (size_t i = 0; i < filtered->size(); ++i) {
     if (processed[i]) continue;
-    processed[i] = 1;
-    std::vector<int> queue{static_cast<int>(i)};
-    for (size_t q = 0; q < queue.size(); ++q) {
-      const int seed = queue[q];
-      const Vec3f ns = (*filtered)[seed].getNormalVector3fMap();
-      if (!ns.allFinite()) continue;
-      if (tree->radiusSearch(seed, tol, nn, nd) <= 0) continue;
-      // As PCL's CVFH, the first neighbour returned is skipped (it assumes
-      // it is the seed itself, which an unsorted search does not promise);
-      // kept so the regions are exactly CVFH's.
-      for (size_t jj = 1; jj < nn.size(); ++jj) {
-        const auto j = nn[jj];
-        if (processed[j]) continue;
-        const Vec3f nj = (*filtered)[j].getNormalVector3fMap();
-        const double dot = ns.dot(nj);
-        if (std::acos(std::clamp(dot, -1.0, 1.0)) < eps && nj.allFinite()) {
-          processed[j] = 1;
-          queue.push_back(j);
-        }
-      }
-    }
+    std::vector<int> queue = grow_smooth_region(*filtered, *tree, i, tol, eps, processed);
     if (queue.size() < min_pts) continue;
     std::sort(queue.begin(), queue.end());
-    Region r;
-    Eigen::Vector3d c = Eigen::Vector3d::Zero(), nsum = Eigen::Vector3d::Zero();
-    for (int k : queue) {
-      const auto& p = (*filtered)[k];
-      r.points.push_back(p.getVector3fMap());
-      r.normals.push_back(p.getNormalVector3fMap());
-      c += p.getVector3fMap().cast<double>();
-      nsum += p.getNormalVector3fMap().cast<double>();
-    }
-    r.centroid = (c / static_cast<double>(queue.size())).cast<float>();
-    if (nsum.norm() > 0) r.mean_normal = nsum.normalized().cast<float>();
-    regions.push_back(std::move(r));
+    regions.push_back(region_of(*filtered, queue));
   }
   return regions;
 }

@@ -240,6 +240,75 @@ struct Samples {
 
 }  // namespace
 
+namespace {
+
+// The points centred on their centroid and scaled so that the farthest is
+// kHalf voxels away (q), their voxels (vox), marked in the grid; false when
+// the points all coincide.
+bool to_grid(const std::vector<Vec3f>& pts, std::vector<Vec3f>& q, std::vector<Eigen::Vector3i>& vox,
+             OccupancyGrid& grid) {
+  const int n = static_cast<int>(pts.size());
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const auto& p : pts) c += p.cast<double>();
+  c /= n;
+  double max_d = 0;
+  for (const auto& p : pts) max_d = std::max(max_d, (p.cast<double>() - c).norm());
+  if (!(max_d > 0)) return false;
+  const double scale = kHalf / max_d;
+  q.resize(n);
+  vox.resize(n);
+  for (int i = 0; i < n; ++i) {
+    q[i] = ((pts[i].cast<double>() - c) * scale).cast<float>();
+    vox[i] = OccupancyGrid::cell(q[i]);
+    grid.mark(vox[i]);
+  }
+  return true;
+}
+
+// The next draw of three points of q: false when it is no valid triple (a
+// repeated point, or no area).
+bool draw_triple(Rng& rng, const std::vector<Vec3f>& q, const AngleBins& angle_bin, Triple& t) {
+  const int n = static_cast<int>(q.size());
+  t.i[0] = rng.uniform_int(0, n - 1);
+  t.i[1] = rng.uniform_int(0, n - 1);
+  t.i[2] = rng.uniform_int(0, n - 1);
+  if (t.i[0] == t.i[1] || t.i[0] == t.i[2] || t.i[1] == t.i[2]) return false;
+  const Vec3f p1 = q[t.i[0]], p2 = q[t.i[1]], p3 = q[t.i[2]];
+  const Vec3f v21 = p2 - p1, v31 = p3 - p1, v23 = p2 - p3;
+  const float a = v21.norm(), b = v31.norm(), cc = v23.norm();
+  const float s = 0.5f * (a + b + cc);
+  t.area2 = s * (s - a) * (s - b) * (s - cc);  // Heron: squared area
+  if (!(t.area2 > 0.001f)) return false;
+  t.d[0] = a;
+  t.d[1] = b;
+  t.d[2] = cc;
+  // Angles at p1 (between 1->2 and 1->3), at p2 and at p3.
+  t.th[0] = angle_bin(std::abs(v21.dot(v31)) / (a * b));
+  t.th[1] = angle_bin(std::abs(v23.dot(v21)) / (cc * a));
+  t.th[2] = angle_bin(std::abs(v23.dot(v31)) / (cc * b));
+  return true;
+}
+
+// A batch of triples added with their lines 1->2, 1->3, 2->3 traced
+// together (from, to, lines: buffers kept between batches).
+void add_traced_together(const OccupancyGrid& grid, const std::vector<Eigen::Vector3i>& vox,
+                         const std::vector<Triple>& batch, Samples& acc, std::vector<Eigen::Vector3i>& from,
+                         std::vector<Eigen::Vector3i>& to, std::vector<Line>& lines) {
+  from.resize(3 * batch.size());
+  to.resize(3 * batch.size());
+  lines.resize(3 * batch.size());
+  for (size_t k = 0; k < batch.size(); ++k) {
+    const int* i = batch[k].i;
+    from[3 * k] = vox[static_cast<size_t>(i[0])], to[3 * k] = vox[static_cast<size_t>(i[1])];
+    from[3 * k + 1] = vox[static_cast<size_t>(i[0])], to[3 * k + 1] = vox[static_cast<size_t>(i[2])];
+    from[3 * k + 2] = vox[static_cast<size_t>(i[1])], to[3 * k + 2] = vox[static_cast<size_t>(i[2])];
+  }
+  esf_detail::trace_lines(grid, from.data(), to.data(), lines.size(), lines.data());
+  for (size_t k = 0; k < batch.size(); ++k) acc.add(batch[k], lines[3 * k], lines[3 * k + 1], lines[3 * k + 2]);
+}
+
+}  // namespace
+
 std::vector<float> compute_esf(const std::vector<Vec3f>& points_in, Rng& rng, int samples) {
   std::vector<float> out(kEsfBins, 0.f);
   const AngleBins& angle_bin = angle_bins();
@@ -249,55 +318,20 @@ std::vector<float> compute_esf(const std::vector<Vec3f>& points_in, Rng& rng, in
     if (p.allFinite()) pts.push_back(p);
   const int n = static_cast<int>(pts.size());
   if (n < 3 || samples <= 0) return out;
-
-  // Centre on the centroid, scale the farthest point to kHalf voxels.
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (const auto& p : pts) c += p.cast<double>();
-  c /= n;
-  double max_d = 0;
-  for (const auto& p : pts) max_d = std::max(max_d, (p.cast<double>() - c).norm());
-  if (!(max_d > 0)) return out;
-  const double scale = kHalf / max_d;
-  std::vector<Vec3f> q(n);
-  std::vector<Eigen::Vector3i> vox(n);
+  std::vector<Vec3f> q;
+  std::vector<Eigen::Vector3i> vox;
   OccupancyGrid grid;
-  for (int i = 0; i < n; ++i) {
-    q[i] = ((pts[i].cast<double>() - c) * scale).cast<float>();
-    vox[i] = OccupancyGrid::cell(q[i]);
-    grid.mark(vox[i]);
-  }
+  if (!to_grid(pts, q, vox, grid)) return out;
 
   Samples acc(samples);
   const long long max_draws = 50LL * samples;
   PairTraces traced(grid, vox, 3LL * samples);
-  // The next draw: false when it is no valid triple (a repeated point, or
-  // no area).
-  const auto draw_triple = [&](Triple& t) {
-    t.i[0] = rng.uniform_int(0, n - 1);
-    t.i[1] = rng.uniform_int(0, n - 1);
-    t.i[2] = rng.uniform_int(0, n - 1);
-    if (t.i[0] == t.i[1] || t.i[0] == t.i[2] || t.i[1] == t.i[2]) return false;
-    const Vec3f p1 = q[t.i[0]], p2 = q[t.i[1]], p3 = q[t.i[2]];
-    const Vec3f v21 = p2 - p1, v31 = p3 - p1, v23 = p2 - p3;
-    const float a = v21.norm(), b = v31.norm(), cc = v23.norm();
-    const float s = 0.5f * (a + b + cc);
-    t.area2 = s * (s - a) * (s - b) * (s - cc);  // Heron: squared area
-    if (!(t.area2 > 0.001f)) return false;
-    t.d[0] = a;
-    t.d[1] = b;
-    t.d[2] = cc;
-    // Angles at p1 (between 1->2 and 1->3), at p2 and at p3.
-    t.th[0] = angle_bin(std::abs(v21.dot(v31)) / (a * b));
-    t.th[1] = angle_bin(std::abs(v23.dot(v21)) / (cc * a));
-    t.th[2] = angle_bin(std::abs(v23.dot(v31)) / (cc * b));
-    return true;
-  };
   int valid = 0;
   long long draw = 0;
   if (traced.memoized()) {  // small clouds: each triple's lines looked up (or traced once) as it comes
     for (; valid < samples && draw < max_draws; ++draw) {
       Triple t;
-      if (!draw_triple(t)) continue;
+      if (!draw_triple(rng, q, angle_bin, t)) continue;
       acc.add(t, traced(t.i[0], t.i[1]), traced(t.i[0], t.i[2]), traced(t.i[1], t.i[2]));
       ++valid;
     }
@@ -314,19 +348,8 @@ std::vector<float> compute_esf(const std::vector<Vec3f>& points_in, Rng& rng, in
     batch.clear();
     const int want = std::min(kBatch, samples - valid);
     for (Triple t; static_cast<int>(batch.size()) < want && draw < max_draws; ++draw)
-      if (draw_triple(t)) batch.push_back(t);
-    // Each triple's lines 1->2, 1->3, 2->3.
-    from.resize(3 * batch.size());
-    to.resize(3 * batch.size());
-    lines.resize(3 * batch.size());
-    for (size_t k = 0; k < batch.size(); ++k) {
-      const int* i = batch[k].i;
-      from[3 * k] = vox[static_cast<size_t>(i[0])], to[3 * k] = vox[static_cast<size_t>(i[1])];
-      from[3 * k + 1] = vox[static_cast<size_t>(i[0])], to[3 * k + 1] = vox[static_cast<size_t>(i[2])];
-      from[3 * k + 2] = vox[static_cast<size_t>(i[1])], to[3 * k + 2] = vox[static_cast<size_t>(i[2])];
-    }
-    esf_detail::trace_lines(grid, from.data(), to.data(), lines.size(), lines.data());
-    for (size_t k = 0; k < batch.size(); ++k) acc.add(batch[k], lines[3 * k], lines[3 * k + 1], lines[3 * k + 2]);
+      if (draw_triple(rng, q, angle_bin, t)) batch.push_back(t);
+    add_traced_together(grid, vox, batch, acc, from, to, lines);
     valid += static_cast<int>(batch.size());
   }
   if (valid > 0) acc.histogram(out);

@@ -274,8 +274,8 @@ bool usable_frame(const float* row) {
 
 std::vector<float> compute_board_lrf(const PointSet& cloud, const std::vector<int>& keypoints, double radius_mm,
                                      BoardStartAxis start) {
-  std::vector<float> out(keypoints.size() * kLrfDim, std::numeric_limits<float>::quiet_NaN());
-  if (keypoints.empty() || !cloud.has_normals() || !(radius_mm > 0)) return out;
+  std::vector<float> out = undescribed_rows(keypoints.size(), kLrfDim);
+  if (!can_describe(cloud, keypoints, radius_mm)) return out;
   const CloudNeighbours tree(cloud.points);
   const float r2 = static_cast<float>(radius_mm * radius_mm);
   Neighbours nn;

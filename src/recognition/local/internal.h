@@ -12,6 +12,7 @@
 //   method.cpp     the Method (train, save/load, hypothesize)
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -56,6 +57,17 @@ std::vector<float> compute_fpfh(const PointSet& cloud, const std::vector<int>& k
                                 double radius_mm, int threads, int max_support = 0);
 std::vector<float> compute_shot(const PointSet& cloud, const std::vector<int>& keypoints,
                                 double radius_mm, int threads, int max_support = 0);
+
+// dim NaN values per keypoint: a keypoint descriptor's rows before any is
+// described (a keypoint that cannot be keeps its NaN row).
+inline std::vector<float> undescribed_rows(size_t keypoints, int dim) {
+  return std::vector<float>(keypoints * static_cast<size_t>(dim), std::numeric_limits<float>::quiet_NaN());
+}
+// Whether keypoints of the cloud can be described at all: there are some,
+// the cloud has normals and the radius is positive.
+inline bool can_describe(const PointSet& cloud, const std::vector<int>& keypoints, double radius_mm) {
+  return !keypoints.empty() && cloud.has_normals() && radius_mm > 0;
+}
 
 // OpenMP threads for a `threads` setting: 0 = OMP_NUM_THREADS (as `run`
 // gives its workers), 1 without OpenMP.

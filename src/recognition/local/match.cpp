@@ -235,7 +235,68 @@ struct SecondPass {
     offer(result, kk, static_cast<int>(r), s);
     if (result.size() == kk) bar = std::min(bar, result.back().second + margin);
   }
+
+  // The largest exact distance of the first pass's candidates: it caps the
+  // k-th best.
+  float largest_distance(const float* q, const std::vector<std::pair<float, int>>& cand) const {
+    float tau0 = 0;
+    for (const auto& c : cand) tau0 = std::max(tau0, dist(q, data + static_cast<size_t>(c.second) * dim, dim));
+    return tau0;
+  }
+
+  // The search over the rows the clusters listed with a bound up to the
+  // limit (the others' bounds are above it): capped to the max_checks
+  // smallest (value, then row), as smallest_at_most's, else exact in
+  // ascending rows.
+  void over_listed(const float* q, float margin, float limit, int max_checks,
+                   std::vector<std::pair<float, int>>& within, std::vector<std::pair<int, float>>& result) {
+    if (max_checks > 0) {
+      const size_t cap = static_cast<size_t>(max_checks);
+      if (within.size() > cap) {
+        std::nth_element(within.begin(), within.begin() + static_cast<long>(cap - 1), within.end());
+        within.resize(cap);
+      }
+      capped(q, margin, within, result);
+      return;
+    }
+    std::sort(within.begin(), within.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+    float bar = limit;
+    for (const auto& [lb, r] : within)
+      if (lb <= bar) consider(q, static_cast<size_t>(r), margin, bar, result);
+  }
+
+  // The search over every row's bound (lbs): capped to the max_checks
+  // smallest up to the limit, else exact over the rows whose bound is
+  // under the falling bar (cand: a buffer).
+  void over_bounds(const float* q, float margin, float limit, int max_checks, const float* lbs, size_t rows,
+                   bool avx2, std::vector<std::pair<float, int>>& cand, std::vector<std::pair<int, float>>& result) {
+    if (max_checks > 0) {
+      smallest_at_most(lbs, rows, limit, static_cast<size_t>(max_checks), cand, avx2);
+      capped(q, margin, cand, result);
+      return;
+    }
+    float bar = limit;
+    const auto next = avx2 ? next_at_most_avx2 : next_at_most;
+    for (size_t r = next(lbs, 0, rows, bar); r < rows; r = next(lbs, r + 1, rows, bar))
+      consider(q, r, margin, bar, result);
+  }
 };
+
+// The first pass over every row's bound: the kk smallest (value, then
+// row); for kk = 1 the smallest, the lowest row among equal ones (`min`:
+// the smallest bound when the bounds' kernel gave it, else null).
+void smallest_bounds(const float* lbs, size_t rows, size_t kk, const float* min,
+                     std::vector<std::pair<float, int>>& cand) {
+  if (kk == 1) {
+    size_t arg = rows;
+    if (min) arg = first_equal_avx2(lbs, rows, *min);
+    if (arg == rows) arg = first_argmin(lbs, rows);  // no minimum given, or none equals it (NaN)
+    cand.emplace_back(lbs[arg], static_cast<int>(arg));
+    return;
+  }
+  for (size_t r = 0; r < rows; ++r)
+    if (cand.size() < kk || lbs[r] < cand.back().first) keep_smallest(cand, kk, {lbs[r], static_cast<int>(r)});
+}
 
 }  // namespace
 
@@ -383,46 +444,15 @@ void DescriptorIndex::knn_block(const float* queries, int n, int k, float max_sq
     const int slot = pruned ? 0 : (i - dense_from) % group;
     const float* lbs = pruned ? nullptr : all.get() + static_cast<size_t>(slot) * m.rows;
     cand.clear();
-    if (pruned) {
-      cluster_smallest(m.clusters, cq, kk, cand);
-    } else if (kk == 1) {  // the smallest bound, the lowest row among equal ones
-      size_t arg = m.rows;
-      if (have_mins) arg = first_equal_avx2(lbs, m.rows, mins[static_cast<size_t>(slot)]);
-      if (arg == m.rows) arg = first_argmin(lbs, m.rows);  // no minimum given, or none equals it (NaN)
-      cand.emplace_back(lbs[arg], static_cast<int>(arg));
-    } else {
-      for (size_t r = 0; r < m.rows; ++r)
-        if (cand.size() < kk || lbs[r] < cand.back().first) keep_smallest(cand, kk, {lbs[r], static_cast<int>(r)});
-    }
-    float tau0 = 0;
-    for (const auto& c : cand)
-      tau0 = std::max(tau0, dist(q, m.data.data() + static_cast<size_t>(c.second) * dim, dim));
-    const float limit = std::min(tau0, max_sq_dist) + margin;
-    float bar = limit;
+    if (pruned) cluster_smallest(m.clusters, cq, kk, cand);
+    else smallest_bounds(lbs, m.rows, kk, have_mins ? &mins[static_cast<size_t>(slot)] : nullptr, cand);
+    const float limit = std::min(pass.largest_distance(q, cand), max_sq_dist) + margin;
     if (pruned) {  // every row with a bound up to the limit, the others' bounds are above it
       cluster_within(m.clusters, cq, limit, within);
-      if (max_checks > 0) {  // the cap smallest (value, then row), as smallest_at_most's
-        const size_t cap = static_cast<size_t>(max_checks);
-        if (within.size() > cap) {
-          std::nth_element(within.begin(), within.begin() + static_cast<long>(cap - 1), within.end());
-          within.resize(cap);
-        }
-        pass.capped(q, margin, within, out[i]);
-        continue;
-      }
-      std::sort(within.begin(), within.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
-      for (const auto& [lb, r] : within)
-        if (lb <= bar) pass.consider(q, static_cast<size_t>(r), margin, bar, out[i]);
-      continue;
+      pass.over_listed(q, margin, limit, max_checks, within, out[i]);
+    } else {
+      pass.over_bounds(q, margin, limit, max_checks, lbs, m.rows, m.avx2_bounds, cand, out[i]);
     }
-    if (max_checks > 0) {
-      smallest_at_most(lbs, m.rows, limit, static_cast<size_t>(max_checks), cand, m.avx2_bounds);
-      pass.capped(q, margin, cand, out[i]);
-      continue;
-    }
-    const auto next = m.avx2_bounds ? next_at_most_avx2 : next_at_most;
-    for (size_t r = next(lbs, 0, m.rows, bar); r < m.rows; r = next(lbs, r + 1, m.rows, bar))
-      pass.consider(q, r, margin, bar, out[i]);
   }
 }
 

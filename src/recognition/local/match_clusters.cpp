@@ -201,18 +201,14 @@ size_t nearest_cluster(const RowClusters& c, const ClusterQuery& q) {
                              q.cd.begin());
 }
 
-}  // namespace
-
-RowClusters cluster_rows(const float* proj, const float* psq, size_t rows, int pd) {
-  RowClusters out;
-  out.pd = pd;
-  if (rows == 0 || pd <= 0) return out;
-  size_t k = std::max<size_t>(1, rows / kRowsPerCluster);
+// Lloyd's iterations (kIterations) from k evenly spaced rows: the
+// centroids (k x pd) and each row's cluster (member).
+std::vector<double> k_means(const float* proj, size_t rows, int pd, size_t k, std::vector<int>& member) {
   const Eigen::Map<const RowMatF> Z(proj, static_cast<Eigen::Index>(rows), pd);
   std::vector<double> centroid(k * pd);
   for (size_t c = 0; c < k; ++c)  // evenly spaced rows
     for (int a = 0; a < pd; ++a) centroid[c * pd + a] = proj[(c * rows / k) * pd + a];
-  std::vector<int> member = assign(Z, centroid, k, pd);
+  member = assign(Z, centroid, k, pd);
   for (int it = 0; it < kIterations; ++it) {
     std::vector<double> sum(k * pd, 0.0);
     std::vector<size_t> n(k, 0);
@@ -226,35 +222,33 @@ RowClusters cluster_rows(const float* proj, const float* psq, size_t rows, int p
         for (int a = 0; a < pd; ++a) centroid[c * pd + a] = sum[c * pd + a] / static_cast<double>(n[c]);
     member = assign(Z, centroid, k, pd);
   }
-  // Clusters left empty are dropped (a nearest centroid then always has
-  // rows).
-  {
-    std::vector<int> kept(k, -1);
-    std::vector<char> used(k, 0);
-    for (const int c : member) used[static_cast<size_t>(c)] = 1;
-    size_t m = 0;
-    for (size_t c = 0; c < k; ++c)
-      if (used[c]) {
-        kept[c] = static_cast<int>(m);
-        if (m != c)
-          std::copy_n(centroid.begin() + static_cast<long>(c * pd), pd, centroid.begin() + static_cast<long>(m * pd));
-        ++m;
-      }
-    for (int& c : member) c = kept[static_cast<size_t>(c)];
-    k = m;
-    centroid.resize(k * pd);
-  }
-  // The centroids as the queries' distances read them (float, axis by axis);
-  // each row's distance to its centroid in double from those floats.
-  out.cstride = (k + 7) / 8 * 8;
-  out.centroid_t.assign(static_cast<size_t>(pd) * out.cstride, 0.f);
+  return centroid;
+}
+
+// Clusters left empty are dropped (a nearest centroid then always has
+// rows), the others renumbered in order; the number kept.
+size_t drop_empty(std::vector<double>& centroid, std::vector<int>& member, size_t k, int pd) {
+  std::vector<int> kept(k, -1);
+  std::vector<char> used(k, 0);
+  for (const int c : member) used[static_cast<size_t>(c)] = 1;
+  size_t m = 0;
   for (size_t c = 0; c < k; ++c)
-    for (int a = 0; a < pd; ++a) {
-      const float v = static_cast<float>(centroid[c * pd + a]);
-      out.centroid_t[static_cast<size_t>(a) * out.cstride + c] = v;
-      centroid[c * pd + a] = v;
+    if (used[c]) {
+      kept[c] = static_cast<int>(m);
+      if (m != c)
+        std::copy_n(centroid.begin() + static_cast<long>(c * pd), pd, centroid.begin() + static_cast<long>(m * pd));
+      ++m;
     }
-  // The positions: cluster by cluster, each in order of d(r, c) (then row).
+  for (int& c : member) c = kept[static_cast<size_t>(c)];
+  centroid.resize(m * pd);
+  return m;
+}
+
+// The rows in their positions: cluster by cluster, each in order of
+// d(r, c) (then row), each cluster's run padded to whole blocks of eight;
+// with their distances (rounded up), projections and squared norms.
+void place_rows(const float* proj, const float* psq, size_t rows, int pd, size_t k, const std::vector<double>& centroid,
+                const std::vector<int>& member, RowClusters& out) {
   std::vector<std::pair<double, int>> order(rows);
   std::vector<size_t> n(k, 0);
   for (size_t r = 0; r < rows; ++r) {
@@ -290,6 +284,29 @@ RowClusters cluster_rows(const float* proj, const float* psq, size_t rows, int p
     for (int a = 0; a < pd; ++a) out.blocks[(p / 8 * pd + a) * 8 + p % 8] = proj[static_cast<size_t>(r) * pd + a];
     out.psq[p] = psq[r];
   }
+}
+
+}  // namespace
+
+RowClusters cluster_rows(const float* proj, const float* psq, size_t rows, int pd) {
+  RowClusters out;
+  out.pd = pd;
+  if (rows == 0 || pd <= 0) return out;
+  const size_t tried = std::max<size_t>(1, rows / kRowsPerCluster);
+  std::vector<int> member;
+  std::vector<double> centroid = k_means(proj, rows, pd, tried, member);
+  const size_t k = drop_empty(centroid, member, tried, pd);
+  // The centroids as the queries' distances read them (float, axis by axis);
+  // each row's distance to its centroid in double from those floats.
+  out.cstride = (k + 7) / 8 * 8;
+  out.centroid_t.assign(static_cast<size_t>(pd) * out.cstride, 0.f);
+  for (size_t c = 0; c < k; ++c)
+    for (int a = 0; a < pd; ++a) {
+      const float v = static_cast<float>(centroid[c * pd + a]);
+      out.centroid_t[static_cast<size_t>(a) * out.cstride + c] = v;
+      centroid[c * pd + a] = v;
+    }
+  place_rows(proj, psq, rows, pd, k, centroid, member, out);
   return out;
 }
 

@@ -117,8 +117,8 @@ bool describe(const Vec3f& q, const Frame& f, const PointSet& cloud, const Neigh
 
 std::vector<float> compute_shot(const PointSet& cloud, const std::vector<int>& keypoints, double radius_mm,
                                 int threads, int max_support) {
-  std::vector<float> out(keypoints.size() * kShotDim, std::numeric_limits<float>::quiet_NaN());
-  if (keypoints.empty() || !cloud.has_normals() || !(radius_mm > 0)) return out;
+  std::vector<float> out = undescribed_rows(keypoints.size(), kShotDim);
+  if (!can_describe(cloud, keypoints, radius_mm)) return out;
   const std::vector<Vec3f>& pts = cloud.points;
   const CloudNeighbours tree(cloud.points);
   const float r2 = static_cast<float>(radius_mm * radius_mm);

@@ -183,10 +183,42 @@ __attribute__((target("avx2"))) inline __m128 negate_where(__m128 v, int m) {
   return _mm_xor_ps(v, _mm_and_ps(_mm_set1_ps(-0.0f), fbits(m)));
 }
 
+// Four votes' bins and the floats they add, as votes4 computes them in
+// lanes: lane l is vote i + l.
+struct Votes4 {
+  alignas(16) int vol[4];   // the volume
+  alignas(16) int step[4];  // the cosine bin
+  // The cosine neighbour's, the radial and elevation splits', the
+  // azimuth's and the own bin's floats.
+  alignas(16) float cosv[4];
+  alignas(16) float rv[4];
+  alignas(16) float ev[4];
+  alignas(16) float av[4];
+  alignas(16) float ownf[4];
+  // Lane masks: the cosine neighbour is the next bin (else the previous);
+  // past the radial middle, on its outer side; past the elevation's
+  // middle, on its lower side; an azimuth, ahead of its sector's centre.
+  int up, past_r, outer, past_e, lower, has_az, ahead;
+};
+
+// The additions of four votes, vote by vote (h: the histogram).
+inline void add4(const Votes4& w, float* h) {
+  for (int l = 0; l < 4; ++l) {
+    const int v = w.vol[l], st = w.step[l], base = v * kSlots;
+    h[base + (lane(w.up, l) ? (st + 1) % kCosBins : (st - 1 + kCosBins) % kCosBins)] += w.cosv[l];
+    h[lane(w.past_r, l) ? kSpare : (lane(w.outer, l) ? v - 2 : v + 2) * kSlots + st] += w.rv[l];
+    h[lane(w.past_e, l) ? kSpare : (lane(w.lower, l) ? v + 1 : v - 1) * kSlots + st] += w.ev[l];
+    if (lane(w.has_az, l))
+      h[(lane(w.ahead, l) ? (v + 4) % kVolumes : (v - 4 + kVolumes) % kVolumes) * kSlots + st] += w.av[l];
+    h[base + st] += w.ownf[l];
+  }
+}
+
 // Votes i .. i + 3: the arithmetic in lanes (series_acos and
 // series_atan2_double too, core/trig_avx2.h), the additions vote by vote.
 __attribute__((target("avx2"))) void votes4(const ShotVotes& v, size_t i, const ShotFrame& f, double radius,
                                             float* h) {
+  Votes4 w;
   const double r14 = radius / 4, r12 = radius / 2, r34 = radius * 3 / 4;
   const __m128 ox = _mm_loadu_ps(v.ox.data() + i), oy = _mm_loadu_ps(v.oy.data() + i),
                oz = _mm_loadu_ps(v.oz.data() + i);
@@ -204,9 +236,9 @@ __attribute__((target("avx2"))) void votes4(const ShotVotes& v, size_t i, const 
   const int ax_ge = mask(_mm256_cmp_pd(ax, ay, _CMP_GE_OQ)), ax_gt = mask(_mm256_cmp_pd(ax, ay, _CMP_GT_OQ));
   const int z_pos = mask(_mm256_cmp_pd(z, zero, _CMP_GT_OQ));
   const __m256d outer_m = _mm256_cmp_pd(distance, _mm256_set1_pd(r12), _CMP_GT_OQ);
-  const int outer = mask(outer_m);
+  const int outer = w.outer = mask(outer_m);
   // The cosine step and fraction.
-  alignas(16) int step[4];
+  int* step = w.step;
   _mm_store_si128(reinterpret_cast<__m128i*>(step), _mm256_cvttpd_epi32(_mm256_add_pd(bin_pos, _mm256_set1_pd(0.5))));
   const __m256d frac = _mm256_sub_pd(bin_pos, _mm256_cvtepi32_pd(_mm_load_si128(reinterpret_cast<__m128i*>(step))));
   __m256d own = _mm256_sub_pd(_mm256_set1_pd(1.0), _mm256_andnot_pd(sign, frac));
@@ -214,7 +246,7 @@ __attribute__((target("avx2"))) void votes4(const ShotVotes& v, size_t i, const 
   const __m256d tr = _mm256_div_pd(
       _mm256_sub_pd(distance, _mm256_blendv_pd(_mm256_set1_pd(r14), _mm256_set1_pd(r34), outer_m)),
       _mm256_set1_pd(r12));
-  const int past_r = (mask(_mm256_cmp_pd(distance, _mm256_set1_pd(r34), _CMP_GT_OQ)) & outer) |
+  const int past_r = w.past_r = (mask(_mm256_cmp_pd(distance, _mm256_set1_pd(r34), _CMP_GT_OQ)) & outer) |
                      (mask(_mm256_cmp_pd(distance, _mm256_set1_pd(r14), _CMP_LT_OQ)) & ~outer);
   // Elevation.
   const __m256d in = series_acos4(clamp4(_mm256_div_pd(z, distance), -1.0, 1.0));
@@ -222,19 +254,19 @@ __attribute__((target("avx2"))) void votes4(const ShotVotes& v, size_t i, const 
                                        _mm256_set1_pd(1e-30), _CMP_LT_OQ);
   const __m256d lower_m = _mm256_or_pd(_mm256_cmp_pd(in, _mm256_set1_pd(kRad90), _CMP_GT_OQ),
                                        _mm256_and_pd(near90, _mm256_cmp_pd(z, zero, _CMP_LE_OQ)));
-  const int lower = mask(lower_m);
+  const int lower = w.lower = mask(lower_m);
   const __m256d te = _mm256_div_pd(
       _mm256_sub_pd(in, _mm256_blendv_pd(_mm256_set1_pd(kRad45), _mm256_set1_pd(kRad135), lower_m)),
       _mm256_set1_pd(kRad90));
-  const int past_e = (mask(_mm256_cmp_pd(in, _mm256_set1_pd(kRad135), _CMP_GT_OQ)) & lower) |
+  const int past_e = w.past_e = (mask(_mm256_cmp_pd(in, _mm256_set1_pd(kRad135), _CMP_GT_OQ)) & lower) |
                      (mask(_mm256_cmp_pd(in, _mm256_set1_pd(kRad45), _CMP_LT_OQ)) & ~lower);
   // The volumes, then the azimuth's t where x or y is not 0.
-  alignas(16) int vol[4];
+  int* vol = w.vol;
   for (int l = 0; l < 4; ++l)
     vol[l] = volume_of({lane(y_pos, l), lane(y_zero, l), lane(x_pos, l), lane(x_zero, l), lane(x_neg, l),
                         lane(xy_pos, l), lane(ax_ge, l), lane(ax_gt, l), lane(z_pos, l), lane(outer, l)});
   const __m256d has_az_m = _mm256_or_pd(_mm256_cmp_pd(y, zero, _CMP_NEQ_UQ), _mm256_cmp_pd(x, zero, _CMP_NEQ_UQ));
-  const int has_az = mask(has_az_m);
+  w.has_az = mask(has_az_m);
   const __m256d az = _mm256_and_pd(series_atan2_double4(y, x), has_az_m);
   const __m256d sector = _mm256_cvtepi32_pd(_mm_srai_epi32(_mm_load_si128(reinterpret_cast<__m128i*>(vol)), 2));
   const __m256d centre = _mm256_add_pd(_mm256_set1_pd(-kRad7_8), _mm256_mul_pd(_mm256_set1_pd(kRad45), sector));
@@ -251,23 +283,14 @@ __attribute__((target("avx2"))) void votes4(const ShotVotes& v, size_t i, const 
   // The floats added: the cosine neighbour's |frac|-signed fraction, the
   // splits' shares (+0 past the middle; -t outside, t inside), the
   // azimuth's, the own bin's total.
-  alignas(16) float cosv[4], rv[4], ev[4], av[4], ownf[4];
-  const int up = mask(_mm256_cmp_pd(frac, zero, _CMP_GT_OQ));
-  _mm_store_ps(cosv, negate_where(_mm256_cvtpd_ps(frac), ~up & 15));
-  _mm_store_ps(rv, _mm_andnot_ps(fbits(past_r), negate_where(_mm256_cvtpd_ps(tr), outer)));
-  _mm_store_ps(ev, _mm_andnot_ps(fbits(past_e), negate_where(_mm256_cvtpd_ps(te), lower)));
-  _mm_store_ps(av, negate_where(_mm256_cvtpd_ps(ta), ~mask(ahead_m) & 15));
-  _mm_store_ps(ownf, _mm256_cvtpd_ps(own));
-  const int ahead = mask(ahead_m);
-  for (int l = 0; l < 4; ++l) {
-    const int v = vol[l], st = step[l], base = v * kSlots;
-    h[base + (lane(up, l) ? (st + 1) % kCosBins : (st - 1 + kCosBins) % kCosBins)] += cosv[l];
-    h[lane(past_r, l) ? kSpare : (lane(outer, l) ? v - 2 : v + 2) * kSlots + st] += rv[l];
-    h[lane(past_e, l) ? kSpare : (lane(lower, l) ? v + 1 : v - 1) * kSlots + st] += ev[l];
-    if (lane(has_az, l))
-      h[(lane(ahead, l) ? (v + 4) % kVolumes : (v - 4 + kVolumes) % kVolumes) * kSlots + st] += av[l];
-    h[base + st] += ownf[l];
-  }
+  w.up = mask(_mm256_cmp_pd(frac, zero, _CMP_GT_OQ));
+  _mm_store_ps(w.cosv, negate_where(_mm256_cvtpd_ps(frac), ~w.up & 15));
+  _mm_store_ps(w.rv, _mm_andnot_ps(fbits(past_r), negate_where(_mm256_cvtpd_ps(tr), outer)));
+  _mm_store_ps(w.ev, _mm_andnot_ps(fbits(past_e), negate_where(_mm256_cvtpd_ps(te), lower)));
+  _mm_store_ps(w.av, negate_where(_mm256_cvtpd_ps(ta), ~mask(ahead_m) & 15));
+  _mm_store_ps(w.ownf, _mm256_cvtpd_ps(own));
+  w.ahead = mask(ahead_m);
+  add4(w, h);
 }
 
 #endif
