@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Structure limits of the source tree: function length, and PCL's headers.
 
-    scripts/structure_check.py [--max-function 120] [DIR ...]
+    scripts/structure_check.py [--max-function 80] [DIR ...]
 
 Prints every function body in a C++ file (.h/.cpp) over --max-function
 lines (from the line of its opening brace to the line of its closing
@@ -123,7 +123,7 @@ def check(dirs, max_function):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--max-function", type=int, default=120)
+    ap.add_argument("--max-function", type=int, default=80)
     ap.add_argument("dirs", nargs="*", default=["src"])
     a = ap.parse_args(argv)
     problems = check(a.dirs, a.max_function)
