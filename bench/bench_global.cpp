@@ -17,6 +17,7 @@
 #include "recognition/pipeline.h"
 #include "recognition/preprocess/preprocess.h"
 #include "recognition/refine/refine.h"
+#include "recognition/registry.h"
 #include "recognition/verify/verify.h"
 #include "scenes/generator.h"
 #include "scenes/views.h"

@@ -14,6 +14,7 @@
 #include "recognition/method.h"
 #include "recognition/pipeline.h"
 #include "recognition/refine/refine.h"
+#include "recognition/registry.h"
 
 namespace pb {
 namespace {

@@ -6,7 +6,7 @@
 
 #include "core/error.h"
 #include "recognition/pcl_console.h"
-#include "recognition/settings.h"
+#include "recognition/recognition_settings.h"
 
 namespace pb {
 
@@ -89,6 +89,12 @@ std::unique_ptr<Method> make_method(const RecognitionSettings& s) {
 
 std::unique_ptr<Refiner> make_refiner(const std::string& name, const RefineSettings& s) {
   return refinement_entry(name).make(s);
+}
+
+RefineResult refine_pose(const std::string& method, const PointSet& model, const PointSet& scene, const Pose& init,
+                         const RefineSettings& s, uint64_t seed, const KdTree3* scene_tree) {
+  const std::unique_ptr<Refiner> refiner = make_refiner(method, s);
+  return refine_pose(refiner.get(), model, scene, init, s, seed, scene_tree);
 }
 
 }  // namespace pb

@@ -46,5 +46,10 @@ std::string check_name(const YamlNode& node, const std::vector<std::string>& all
 std::unique_ptr<Method> make_method(const RecognitionSettings& s);  // for s.descriptor
 // The refinement method `name` (InputError when unknown); null for "none".
 std::unique_ptr<Refiner> make_refiner(const std::string& name, const RefineSettings& s);
+// refine_pose (refine/refine.h) with the refinement method built by name
+// (none icp icp_lm icp_plane icp_pcl icp_plane_pcl gicp ndt; InputError
+// otherwise).
+RefineResult refine_pose(const std::string& method, const PointSet& model, const PointSet& scene, const Pose& init,
+                         const RefineSettings& s, uint64_t seed, const KdTree3* scene_tree = nullptr);
 
 }  // namespace pb

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "recognition/pcl_adapter.h"
+#include "recognition/refine/internal.h"
 #include "recognition/refine/pcl_registration.h"
 
 namespace pb {
@@ -33,9 +34,9 @@ Gicp::MatricesVectorPtr plane_covariances(const std::vector<Vec3f>& normals) {
 // Plane-to-plane registration; the covariances from the normals when
 // covariances_from_normals and both clouds have them, else PCL's from k
 // neighbours.
-class GicpRefiner : public Refiner {
+class GicpRefiner : public refine_detail::RefinerWith<GicpSettings> {
  public:
-  GicpRefiner(const RegistrationSettings& r, const GicpSettings& s) : r_(r), s_(s) {}
+  using RefinerWith::RefinerWith;
   bool needs_normals() const override { return s_.covariances_from_normals; }
 
   RegistrationOutcome align(const RegistrationProblem& p, uint64_t /*seed: no random choice*/) const override {
@@ -70,10 +71,6 @@ class GicpRefiner : public Refiner {
     return pcl_align<StopReport::kFlagAndCap>(gicp, pcl_adapter::xyz(p.src), pcl_adapter::xyz(p.tgt), r_, configure,
                                               after_inputs);
   }
-
- private:
-  RegistrationSettings r_;
-  GicpSettings s_;
 };
 
 }  // namespace

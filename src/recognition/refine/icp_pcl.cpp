@@ -10,6 +10,7 @@
 
 #include "core/random.h"
 #include "recognition/pcl_adapter.h"
+#include "recognition/refine/internal.h"
 #include "recognition/refine/pcl_registration.h"
 
 namespace pb {
@@ -19,9 +20,9 @@ namespace {
 using namespace refine_detail;
 
 // Point-to-point, on icp.sample_points of the source points (seeded).
-class IcpPclRefiner : public Refiner {
+class IcpPclRefiner : public refine_detail::RefinerWith<IcpSettings> {
  public:
-  IcpPclRefiner(const RegistrationSettings& r, const IcpSettings& s) : r_(r), s_(s) {}
+  using RefinerWith::RefinerWith;
   bool needs_normals() const override { return false; }
   RegistrationOutcome align(const RegistrationProblem& p, uint64_t seed) const override {
     Counted<pcl::IterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ>> icp;
@@ -29,10 +30,6 @@ class IcpPclRefiner : public Refiner {
     return pcl_align<StopReport::kCriteria>(icp, src, pcl_adapter::xyz(p.tgt), r_,
                                             [&](auto& reg) { configure_icp_family(reg, r_); }, no_after_inputs());
   }
-
- private:
-  RegistrationSettings r_;
-  IcpSettings s_;
 };
 
 // Point-to-plane, on every source point.

@@ -20,4 +20,15 @@ constexpr int kTargetLeafSize = 24;
 // point-to-plane and plane-to-plane metrics do not depend on it).
 std::vector<Vec3f> estimate_normals(const std::vector<Vec3f>& pts, int k);
 
+// A refiner's state: the common settings and its own subsection.
+template <class Own>
+class RefinerWith : public Refiner {
+ public:
+  RefinerWith(const RegistrationSettings& r, const Own& s) : r_(r), s_(s) {}
+
+ protected:
+  RegistrationSettings r_;
+  Own s_;
+};
+
 }  // namespace pb::refine_detail

@@ -10,15 +10,16 @@
 #include <algorithm>
 
 #include "recognition/pcl_adapter.h"
+#include "recognition/refine/internal.h"
 #include "recognition/refine/pcl_registration.h"
 
 namespace pb {
 
 namespace {
 
-class NdtRefiner : public Refiner {
+class NdtRefiner : public refine_detail::RefinerWith<NdtSettings> {
  public:
-  NdtRefiner(const RegistrationSettings& r, const NdtSettings& s) : r_(r), s_(s) {}
+  using RefinerWith::RefinerWith;
   bool needs_normals() const override { return false; }
 
   RegistrationOutcome align(const RegistrationProblem& p, uint64_t /*seed: no random choice*/) const override {
@@ -37,10 +38,6 @@ class NdtRefiner : public Refiner {
     return pcl_align<StopReport::kBeforeCap>(ndt, pcl_adapter::xyz(p.src), pcl_adapter::xyz(p.tgt), r_, configure,
                                              no_after_inputs());
   }
-
- private:
-  RegistrationSettings r_;
-  NdtSettings s_;
 };
 
 }  // namespace

@@ -158,12 +158,6 @@ class Refiner;
 RefineResult refine_pose(const Refiner* refiner, const PointSet& model, const PointSet& scene, const Pose& init,
                          const RefineSettings& s, uint64_t seed, const KdTree3* scene_tree = nullptr);
 
-// The same with the method built by name from the registry (registry.h:
-// none icp icp_lm icp_plane icp_pcl icp_plane_pcl gicp ndt; InputError
-// otherwise).
-RefineResult refine_pose(const std::string& method, const PointSet& model, const PointSet& scene,
-                         const Pose& init, const RefineSettings& s, uint64_t seed,
-                         const KdTree3* scene_tree = nullptr);
 
 // How well `model` (model frame) at T_cam_model fits `scene` (camera frame):
 // the mean squared distance (mm^2) of the model points to their nearest

@@ -16,7 +16,6 @@
 #include "recognition/pcl_adapter.h"
 #include "recognition/refine/internal.h"
 #include "recognition/refine/refine.h"
-#include "recognition/registry.h"
 #include "recognition/scatter.h"
 
 namespace pb {
@@ -167,12 +166,6 @@ RefineResult refine_pose(const Refiner* refiner, const PointSet& model, const Po
   if (refiner->needs_normals()) add_normals(model, scene, init, s, u);
   apply(refiner->align(u.p, seed), init, u.c, res);
   return res;
-}
-
-RefineResult refine_pose(const std::string& method, const PointSet& model, const PointSet& scene,
-                         const Pose& init, const RefineSettings& s, uint64_t seed, const KdTree3* scene_tree) {
-  const std::unique_ptr<Refiner> refiner = make_refiner(method, s);
-  return refine_pose(refiner.get(), model, scene, init, s, seed, scene_tree);
 }
 
 double registration_fitness(const PointSet& model, const PointSet& scene, const Pose& T_cam_model,
