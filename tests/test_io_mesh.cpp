@@ -270,3 +270,24 @@ TEST(MeshIo, PlyHeaderGrammarIsChecked) {
   std::ofstream(no_vertex) << "ply\nformat ascii 1.0\nelement point 1\nproperty float x\nend_header\n1\n";
   expect_mesh_error([&] { load_mesh(no_vertex); }, no_vertex);
 }
+
+// The element counts come from the same header parser, from the header
+// alone: a cut-off body is no error, a broken header is one naming the file
+// and the field.
+TEST(MeshIo, PlyElementCountsReadTheHeaderAlone) {
+  const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                             "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const auto counts = pb::ply_element_counts("m.ply", header + "0 0", "model");
+  EXPECT_EQ(counts, (std::map<std::string, uint64_t>{{"face", 1}, {"vertex", 3}}));
+  const auto cloud = pb::ply_element_counts(
+      "c.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\nend_header\n", "model");
+  EXPECT_EQ(cloud, (std::map<std::string, uint64_t>{{"vertex", 0}}));
+  try {
+    pb::ply_element_counts("b.ply", "ply\nformat ascii 1.0\nelement vertex x\nend_header\n", "model");
+    FAIL() << "a bad element line was accepted";
+  } catch (const pb::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("b.ply"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("model"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(pb::ply_element_counts("t.ply", "ply\nformat ascii 1.0\nelement vertex 3\n", "model"), pb::InputError);
+}

@@ -166,6 +166,9 @@ TEST(Settings, ApplySettingReadsOneFieldByItsPath) {
   EXPECT_EQ(s.relative.count("preprocess.voxel_mm"), 0u);
   EXPECT_EQ(s.preprocess.voxel_mm, 3);
   EXPECT_EQ(pb::apply_setting(s, "descriptor", grid["d"]).descriptor, "shot");
+  s = pb::apply_setting(s, "refine.ndt.resolution_mm", grid["b"]);  // a nested subsection
+  EXPECT_DOUBLE_EQ(s.relative.at("refine.ndt.resolution_mm"), 0.04);
+  EXPECT_EQ(pb::apply_setting(s, "refine.icp.coarse_points", grid["e"]).refine.icp.coarse_points, 3);
   try {
     pb::apply_setting(s, "global.top_k", grid["c"]);
     FAIL() << "a negative top_k was accepted";

@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "io/cloud.h"
 #include "io/mesh_io.h"
+#include "io/ply_check.h"
 #include "models/registry.h"
 #include "scenes/import_clouds.h"
 #include "scenes/views.h"
@@ -17,25 +18,23 @@ namespace pbcli {
 
 namespace {
 
-// The vertex and face counts a PLY header declares (-1: none declared);
-// false unless `path` is a PLY whose header ends within 200 lines.
+// The vertex and face counts a PLY header declares (-1: none declared), by
+// io's header parser (ply_check.h) on the file's first MiB; false for a
+// file that does not start as a PLY. InputError for a broken header.
 bool ply_element_counts(const std::string& path, long* vertices, long* faces) {
   std::ifstream in(path, std::ios::binary);
-  std::string line;
-  if (!std::getline(in, line) || line.rfind("ply", 0) != 0) return false;
-  *vertices = *faces = -1;
-  for (int n = 0; n < 200 && std::getline(in, line); ++n) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line == "end_header") return true;
-    std::istringstream ss(line);
-    std::string word, kind;
-    long count = -1;
-    if (ss >> word >> kind >> count && word == "element") {
-      if (kind == "vertex") *vertices = count;
-      if (kind == "face") *faces = count;
-    }
-  }
-  return false;
+  std::string head(1 << 20, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<size_t>(in.gcount()));
+  if (head.rfind("ply", 0) != 0) return false;
+  const auto counts = pb::ply_element_counts(path, head, "model");
+  const auto count = [&](const char* name) {
+    const auto it = counts.find(name);
+    return it == counts.end() ? -1L : static_cast<long>(it->second);
+  };
+  *vertices = count("vertex");
+  *faces = count("face");
+  return true;
 }
 
 // A PLY whose header declares zero vertices or zero faces (assimp refuses

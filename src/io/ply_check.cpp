@@ -278,13 +278,19 @@ uint64_t vertex_count(const Walk& walk, const std::vector<Element>& elements) {
   return vertex->count;
 }
 
-void read_ply(const Walk& walk, const std::string& bytes) {
+// The checked header; *body: where the body starts.
+PlyHeader read_header(const Walk& walk, const std::string& bytes, size_t* body) {
   if (!(bytes.compare(0, 4, "ply\n") == 0 || bytes.compare(0, 5, "ply\r\n") == 0))
     throw InputError(walk.path, walk.field, "not a PLY file (the first line is not 'ply')");
-  size_t end = 0, body = 0;
-  find_end_header(walk, bytes, &end, &body);
+  size_t end = 0;
+  find_end_header(walk, bytes, &end, body);
   check_header_bytes(walk, bytes, end);
-  const PlyHeader h = parse_header(walk, bytes.substr(0, end));
+  return parse_header(walk, bytes.substr(0, end));
+}
+
+void read_ply(const Walk& walk, const std::string& bytes) {
+  size_t body = 0;
+  const PlyHeader h = read_header(walk, bytes, &body);
   const uint64_t vertices = vertex_count(walk, h.elements);
   walk_body(walk, bytes, body, h.format, h.elements, h.signs, vertices);
 }
@@ -297,6 +303,14 @@ std::vector<Vec3f> read_ply_vertices(const std::string& path, const std::string&
   std::vector<Vec3f> xyz;
   read_ply(Walk{path, field, &xyz}, bytes);
   return xyz;
+}
+
+std::map<std::string, uint64_t> ply_element_counts(const std::string& path, const std::string& bytes,
+                                                   const std::string& field) {
+  size_t body = 0;
+  std::map<std::string, uint64_t> out;
+  for (const Element& e : read_header(Walk{path, field}, bytes, &body).elements) out[e.name] = e.count;
+  return out;
 }
 
 }  // namespace pb

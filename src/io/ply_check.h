@@ -6,6 +6,8 @@
 // is wrong.
 #pragma once
 
+#include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -24,5 +26,12 @@ void check_ply(const std::string& path, const std::string& bytes);
 // The same checks, keeping the vertices' x, y and z (a PLY point cloud; faces
 // may be absent). Errors name `field`.
 std::vector<Vec3f> read_ply_vertices(const std::string& path, const std::string& bytes, const std::string& field);
+
+// The element counts the header declares, by element name ("vertex",
+// "face", ...), read by the same header parser; the body is not read, so
+// `bytes` may be the file's beginning as long as it holds the header.
+// InputError(path, field) on a header check_ply rejects.
+std::map<std::string, uint64_t> ply_element_counts(const std::string& path, const std::string& bytes,
+                                                   const std::string& field);
 
 }  // namespace pb
