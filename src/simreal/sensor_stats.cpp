@@ -189,8 +189,8 @@ void SensorStatsAccumulator::add(const DepthImage& measured, const RenderOutput&
       if (have_normals) {
         const Vec3 ray = K.backproject(u, v, 1.0).normalized();
         const auto& n = truth.normals[p];
-        const double c = std::abs(ray.x() * n.x() + ray.y() * n.y() + ray.z() * n.z());
-        inc = std::acos(std::min(1.0, c)) * 180.0 / M_PI;
+        const double cos_inc = std::abs(ray.x() * n.x() + ray.y() * n.y() + ray.z() * n.z());
+        inc = std::acos(std::min(1.0, cos_inc)) * 180.0 / M_PI;
         count(incidence_[std::min<int>(incidence_.size() - 1, static_cast<int>(inc / s_.incidence_bin_deg))], r, c,
               missing, zt);
       }
