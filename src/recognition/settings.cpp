@@ -249,10 +249,15 @@ bool needs_sensor_floor(const RecognitionSettings& s) {
   return !s.relative.empty() && !(s.scale.min_length_mm > 0);
 }
 
-RecognitionSettings resolve_for_scene(const RecognitionSettings& in, double model_diameter_mm, const DepthImage& first,
+RecognitionSettings resolve_for_scene(const RecognitionSettings& s, double model_diameter_mm, const DepthImage& first,
                                       const Intrinsics& first_K) {
+  return resolve_for_scene(s, model_diameter_mm,
+                           needs_sensor_floor(s) ? sensor_length_floor_mm(s.scale, first, first_K) : 0.0);
+}
+
+RecognitionSettings resolve_for_scene(const RecognitionSettings& in, double model_diameter_mm, double sensor_floor_mm) {
   RecognitionSettings s = in;
-  if (needs_sensor_floor(s)) s.scale.min_length_mm = sensor_length_floor_mm(s.scale, first, first_K);
+  if (needs_sensor_floor(s)) s.scale.min_length_mm = sensor_floor_mm;
   return resolve_lengths(s, model_diameter_mm);
 }
 
@@ -295,7 +300,8 @@ nlohmann::ordered_json changes(const nlohmann::ordered_json& j, const nlohmann::
 nlohmann::ordered_json settings_changes_json(const RecognitionSettings& s) {
   const nlohmann::ordered_json all = recognition_settings_json(s);
   nlohmann::ordered_json out = {{"descriptor", s.descriptor}, {"refinement", s.refinement}};
-  out.update(changes(all, recognition_settings_json(RecognitionSettings{})));
+  static const nlohmann::ordered_json defaults = recognition_settings_json(RecognitionSettings{});
+  out.update(changes(all, defaults));
   return out;
 }
 

@@ -69,6 +69,10 @@ double depth_noise_sigma_mm(const DepthImage& image);
 // lone image (a point cloud) is its own first image.
 RecognitionSettings resolve_for_scene(const RecognitionSettings& s, double model_diameter_mm, const DepthImage& first,
                                       const Intrinsics& first_K);
+// The same with the sensor's floor already measured on the scene's first
+// image (sensor_length_floor_mm; read only when needs_sensor_floor(s)): a
+// worker measures it once per scene and scale settings.
+RecognitionSettings resolve_for_scene(const RecognitionSettings& s, double model_diameter_mm, double sensor_floor_mm);
 
 // Every setting's type, default (relative lengths as "0.05d") and what it
 // accepts, section by section: `posebench schema settings`, from which

@@ -31,8 +31,8 @@ struct WorkerCache {
   std::map<std::string, std::unique_ptr<Mesh>> meshes;
   std::map<std::string, std::unique_ptr<DepthRenderer>> renderers;  // by intrinsics, for VSD
   std::map<std::string, SceneInfo> scenes;        // each scene's JSON files, read once
-  std::map<std::string, DepthImage> first_depths;  // each scene's first image (the sensor floor of
-                                                   // relative lengths: resolve_for_scene)
+  std::map<std::string, double> sensor_floors;     // each scene's sensor floor (on its first image),
+                                                   // by scene and scale settings
   std::map<std::string, double> view_elevations;   // views.follow_scene: each scene set's, read once
 };
 WorkerCache& cache() {
@@ -212,14 +212,20 @@ void run(TrialRecord& rec, const TrialContext& ctx) {
   // lengths in mm for the object and the scene (resolve_for_scene).
   const RecognitionSettings configured =
       parse_recognition_settings(YamlNode::load_string(rec.settings.dump(), "trial " + rec.key));
-  const ImageInfo& first = scene.images.begin()->second;
-  auto first_it = cache().first_depths.find(scene_key);
-  if (first_it == cache().first_depths.end())
-    first_it = cache()
-                   .first_depths
-                   .emplace(scene_key, first.im_id == im.im_id ? depth_clean : ds.load_depth(rec.split, rec.scene_id, first))
-                   .first;
-  RecognitionSettings s = resolve_for_scene(configured, ds.model_info(obj_id).diameter, first_it->second, first.K);
+  double floor = 0;
+  if (needs_sensor_floor(configured)) {  // measured once per scene and scale settings
+    const ScaleSettings& sc = configured.scale;
+    const std::string key = scene_key + "#" + nlohmann::json({sc.sensor_floor_px, sc.sensor_floor_sigmas,
+                                                              sc.working_distance_mm}).dump();
+    auto it = cache().sensor_floors.find(key);
+    if (it == cache().sensor_floors.end()) {
+      const ImageInfo& first = scene.images.begin()->second;
+      const DepthImage first_depth = first.im_id == im.im_id ? depth_clean : ds.load_depth(rec.split, rec.scene_id, first);
+      it = cache().sensor_floors.emplace(key, sensor_length_floor_mm(sc, first_depth, first.K)).first;
+    }
+    floor = it->second;
+  }
+  RecognitionSettings s = resolve_for_scene(configured, ds.model_info(obj_id).diameter, floor);
   RecognitionSettings st = s;  // training keeps the settings' seed
   s.seed = rec.seed;
   rec.settings_resolved = nlohmann::json::parse(settings_to_json(s));
